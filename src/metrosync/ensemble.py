@@ -1,0 +1,227 @@
+"""Ensembles: B independent runs of N metronomes, their constants and initial state.
+
+Contract: `build_ensemble` turns user-level choices (N, nominal BPM, spread σ in BPM,
+explicit frequencies or metronomes, initial conditions, seed) into an `Ensemble`:
+(B, N) slider positions and the `SystemArrays` every integrator consumes, plus the
+initial state. Everything random comes from one seed through independent streams
+(frequencies, phases), so changing σ never changes the initial phases.
+
+In the model the metronomes differ only through their slider position L2⁽ⁱ⁾ (paper
+§7): a drawn natural frequency is realised by tuning L2 to it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .equations import SystemArrays
+from .errors import ParameterError, describe
+from .model import Metronome, ModelParameters, bpm_to_omega
+
+#: The coarsest step accepted: a period must span at least this many steps.
+MIN_STEPS_PER_PERIOD = 10
+
+
+@dataclass(frozen=True)
+class Ensemble:
+    """Constants and initial conditions of B runs × N metronomes.
+
+    l2, frequency_bpm, theta0, theta_dot0 : (B, N).   phi0, phi_dot0 : (B,).
+    disk_inertia : (B,) the platform's J (without the R²Σm term).
+    """
+
+    params: ModelParameters
+    system: SystemArrays
+    l2: np.ndarray
+    frequency_bpm: np.ndarray
+    disk_inertia: np.ndarray
+    theta0: np.ndarray
+    theta_dot0: np.ndarray
+    phi0: np.ndarray
+    phi_dot0: np.ndarray
+
+    @property
+    def runs(self) -> int:
+        return self.l2.shape[0]
+
+    @property
+    def n(self) -> int:
+        return self.l2.shape[1]
+
+    def shortest_period(self) -> float:
+        return float(2 * np.pi / np.max(self.system.omega))
+
+
+def build_ensemble(
+    n: int | None = 7,
+    bpm: float | None = 192.0,
+    *,
+    params: ModelParameters,
+    sigma_bpm: float = 0.0,
+    runs: int = 1,
+    seed: int | None = 0,
+    frequencies_bpm: Sequence[float] | np.ndarray | None = None,
+    metronomes: Sequence[Metronome] | None = None,
+    amplitude: float | None = None,
+    theta0: Sequence[float] | np.ndarray | None = None,
+    theta_dot0: Sequence[float] | np.ndarray | None = None,
+    phi_dot0: float = 0.0,
+) -> Ensemble:
+    """Build the constants and initial state of an ensemble.
+
+    Parameters
+    ----------
+    n, bpm : number of metronomes and their nominal beat frequency (BPM).
+    params : the model's fixed parameters (a preset, possibly changed).
+    sigma_bpm : standard deviation of the natural frequencies, BPM; each run draws its
+        own N frequencies from Normal(bpm, sigma_bpm).
+    runs : B, the number of independent runs.
+    seed : seed of every random choice.
+    frequencies_bpm : explicit natural frequencies, shape (N,) or (B, N); replaces the
+        draw (then ``n``, ``bpm`` and ``sigma_bpm`` are not used).
+    metronomes : explicit, fully specified metronomes (shape (N,)): every parameter
+        per metronome, the same in every run.
+    amplitude : swing amplitude (rad) of the random-phase start; default the
+        energy-balance amplitude 2M/(π c_θ) (MODEL-NOTES §6).
+    theta0, theta_dot0 : explicit initial angles and angular velocities, (N,) or (B, N).
+    phi_dot0 : initial angular velocity of the disk.
+    """
+    runs = _require_count("runs", runs)
+    if seed is not None and (not isinstance(seed, int | np.integer) or seed < 0):
+        raise ParameterError(f"`seed` must be a non-negative integer or None, got {describe(seed)}.")
+    freq_rng, phase_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
+    design = params.metronome
+
+    if metronomes is not None:
+        metronomes = list(metronomes)
+        if not metronomes:
+            raise ParameterError("`metronomes` is empty: give at least one Metronome.")
+        n = len(metronomes)
+        l2 = np.broadcast_to([m.l2 for m in metronomes], (runs, n)).copy()
+        per = {
+            name: np.broadcast_to([getattr(m.design, name) for m in metronomes], (runs, n)).copy()
+            for name in ("w1", "w2", "l1", "c_theta", "drive", "g")
+        }
+    else:
+        if frequencies_bpm is not None:
+            freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
+            n = freq.shape[1]
+        else:
+            n = _require_count("n", n)
+            if bpm is None or not math.isfinite(float(bpm)):
+                raise ParameterError(f"`bpm` must be a finite number, got {bpm!r}.")
+            if not (math.isfinite(sigma_bpm) and sigma_bpm >= 0):
+                raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {sigma_bpm!r}.")
+            low, high = design.bpm_range()
+            if not low <= float(bpm) <= high:
+                raise ParameterError(
+                    f"`bpm` = {bpm!r} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+                    f"of this metronome design (slider L2 in {design.l2_bounds} m). Choose a BPM "
+                    f"in range, or widen `l2_bounds`."
+                )
+            freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
+            if np.any((freq < low) | (freq > high)):
+                raise ParameterError(
+                    f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency "
+                    f"({freq[(freq < low) | (freq > high)][0]:.2f} BPM) falls outside the tunable "
+                    f"range [{low:.2f}, {high:.2f}] BPM; lower `sigma_bpm` or move `bpm` inward."
+                )
+        l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
+        per = {
+            name: np.full((runs, n), float(getattr(design, name)))
+            for name in ("w1", "w2", "l1", "c_theta", "drive", "g")
+        }
+
+    mass = per["w1"] + per["w2"]
+    h = (per["w1"] * per["l1"] - per["w2"] * l2) / mass
+    if np.any(h <= 0):
+        raise ParameterError(
+            "a metronome has h <= 0 (its centre of mass is above the pivot, so the pendulum "
+            "is inverted); lower its slider `l2` below w1*l1/w2."
+        )
+    j_i = per["w1"] * per["l1"] ** 2 + per["w2"] * l2**2
+    inertia = mass * h**2 + j_i
+    omega = np.sqrt(mass * per["g"] * h / inertia)
+    platform = params.platform
+    disk = np.full(runs, platform.disk_inertia(n))
+    radius = np.full(runs, platform.radius)
+    total = disk + radius**2 * mass.sum(axis=1)
+    system = SystemArrays(
+        mh=mass * h,
+        mgh=mass * per["g"] * h,
+        inertia=inertia,
+        c_theta=per["c_theta"],
+        drive=per["drive"],
+        omega=omega,
+        radius=radius,
+        c_phi=np.full(runs, platform.c_phi),
+        total_inertia=total,
+    )
+
+    phases = phase_rng.uniform(0.0, 2 * np.pi, size=(runs, n))
+    if theta0 is not None:
+        th0 = _per_metronome("theta0", theta0, runs, n)
+        thd0 = (
+            _per_metronome("theta_dot0", theta_dot0, runs, n)
+            if theta_dot0 is not None
+            else np.zeros((runs, n))
+        )
+    else:
+        if theta_dot0 is not None:
+            raise ParameterError("`theta_dot0` was given without `theta0`: give both, or neither.")
+        amp = params.steady_amplitude if amplitude is None else amplitude
+        if not (math.isfinite(amp) and amp >= 0):
+            raise ParameterError(
+                f"`amplitude` must be a finite angle >= 0 rad, got {amp!r}"
+                + (" (no friction: give `amplitude` or `theta0` explicitly)" if amplitude is None else "")
+                + "."
+            )
+        th0 = amp * np.cos(phases)
+        thd0 = -amp * omega * np.sin(phases)
+    if not math.isfinite(phi_dot0):
+        raise ParameterError(f"`phi_dot0` must be finite, got {phi_dot0!r}.")
+    return Ensemble(
+        params=params,
+        system=system,
+        l2=l2,
+        frequency_bpm=60.0 * omega / np.pi,
+        disk_inertia=disk,
+        theta0=th0,
+        theta_dot0=thd0,
+        phi0=np.zeros(runs),
+        phi_dot0=np.full(runs, float(phi_dot0)),
+    )
+
+
+def check_time_step(dt: float, ensemble: Ensemble) -> None:
+    """Reject a dt too coarse to resolve the fastest metronome's period."""
+    period = ensemble.shortest_period()
+    if not (math.isfinite(dt) and 0 < dt <= period / MIN_STEPS_PER_PERIOD):
+        raise ParameterError(
+            f"`dt` = {dt!r} s does not resolve the shortest period {period:.4f} s: it needs "
+            f"0 < dt <= period/{MIN_STEPS_PER_PERIOD} = {period / MIN_STEPS_PER_PERIOD:.4g} s."
+        )
+
+
+def _require_count(name: str, value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+        raise ParameterError(f"`{name}` must be an integer >= 1, got {describe(value)}.")
+    return int(value)
+
+
+def _per_metronome(name: str, values, runs: int, n: int | None) -> np.ndarray:
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim == 1:
+        arr = np.broadcast_to(arr, (runs, arr.shape[0]))
+    if arr.ndim != 2 or arr.shape[0] != runs or (n is not None and arr.shape[1] != n):
+        want = f"({n},) or ({runs}, {n})" if n is not None else f"(N,) or ({runs}, N)"
+        raise ParameterError(f"`{name}` must have shape {want}, got shape {np.shape(values)}.")
+    if arr.shape[1] < 1:
+        raise ParameterError(f"`{name}` is empty: give one value per metronome.")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"`{name}` must be finite, got {describe(values)}.")
+    return np.array(arr)

@@ -1,0 +1,115 @@
+"""Equations of motion of the disk and its N pendulums (paper §4).
+
+The contract: `accelerations` evaluates the solved form, eqs. (eqm1) and (eqm2),
+
+    φ̈  = [R Σ m_i h_i θ̇_i² sin θ_i − c_φ φ̇ − Σ 𝕄_i + A + B − C] / D
+    θ̈_i = [𝕄_i − m_i R φ̈ h_i cos θ_i − m_i g h_i sin θ_i − c_θ θ̇_i] / (m_i h_i² + J_i)
+
+with A, B, C, D as in the paper (generalised to a mass m_i per metronome). It is the
+one vectorised definition shared by the NumPy reference integrator and the accurate
+``exact`` integrator; the compiled kernel fuses the same arithmetic into one loop and
+is tested against this function. `residuals` evaluates the unsolved equations
+(metron2a) and (metron2) so that a test can check that the solved form satisfies them.
+
+All arrays broadcast over leading "batch" axes: per-metronome arrays have shape
+(..., N), per-run arrays shape (...). ``kick`` is the escapement torque 𝕄_i (N m) in
+force form; the integrators supply ±M/dt or 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SystemArrays:
+    """Per-run and per-metronome constants of an ensemble, in SI units.
+
+    Shapes: per-metronome fields (B, N), per-run fields (B,).
+
+    mh : m_i h_i.   mgh : m_i g h_i.   inertia : m_i h_i² + J_i.
+    c_theta, drive : friction c_θ and escapement impulse M of each metronome.
+    omega : small-amplitude natural frequency on a rigid support, rad/s.
+    radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
+    in eq. (metron2a)); ``inf`` pins the disk.
+    """
+
+    mh: np.ndarray
+    mgh: np.ndarray
+    inertia: np.ndarray
+    c_theta: np.ndarray
+    drive: np.ndarray
+    omega: np.ndarray
+    radius: np.ndarray
+    c_phi: np.ndarray
+    total_inertia: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.mh.shape  # type: ignore[return-value]
+
+    def run(self, b: int) -> SystemArrays:
+        """The constants of run ``b`` alone, as a batch of one."""
+        return SystemArrays(**{k: v[b : b + 1] for k, v in vars(self).items()})
+
+
+def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
+    """Solved equations of motion, eqs. (eqm1)–(eqm2).
+
+    Parameters
+    ----------
+    sys : per-run (B,) and per-metronome (B, N) constants.
+    theta, theta_dot, kick : arrays (B, N).
+    phi_dot : array (B,).
+
+    Returns
+    -------
+    phi_ddot : (B,), theta_ddot : (B, N)
+    """
+    sin_t = np.sin(theta)
+    cos_t = np.cos(theta)
+    radius = sys.radius[:, None]
+    mh_over_i = sys.mh / sys.inertia
+    a_sum = radius * mh_over_i * sys.mgh * sin_t * cos_t  # A = m²gR Σ h² sin cos / I
+    b_sum = radius * mh_over_i * sys.c_theta * theta_dot * cos_t  # B
+    c_sum = radius * mh_over_i * kick * cos_t  # C
+    d_sum = (radius * sys.mh) ** 2 / sys.inertia * cos_t**2
+    numerator = (
+        sys.radius * np.sum(sys.mh * theta_dot**2 * sin_t, axis=-1)
+        - sys.c_phi * phi_dot
+        - np.sum(kick, axis=-1)
+        + np.sum(a_sum + b_sum - c_sum, axis=-1)
+    )
+    denominator = sys.total_inertia - np.sum(d_sum, axis=-1)  # D
+    phi_ddot = numerator / denominator
+    theta_ddot = (
+        kick - radius * sys.mh * phi_ddot[:, None] * cos_t - sys.mgh * sin_t - sys.c_theta * theta_dot
+    ) / sys.inertia
+    return phi_ddot, theta_ddot
+
+
+def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot):
+    """Left minus right of the unsolved equations (metron2a) and (metron2).
+
+    Returns (disk residual (B,), pendulum residuals (B, N)); both vanish for
+    accelerations that solve the system.
+    """
+    sin_t = np.sin(theta)
+    cos_t = np.cos(theta)
+    radius = sys.radius[:, None]
+    disk = (
+        sys.total_inertia * phi_ddot
+        + sys.radius * np.sum(sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t), axis=-1)
+        + sys.c_phi * phi_dot
+        + np.sum(kick, axis=-1)
+    )
+    pendulum = (
+        sys.inertia * theta_ddot
+        + radius * sys.mh * phi_ddot[:, None] * cos_t
+        + sys.mgh * sin_t
+        + sys.c_theta * theta_dot
+        - kick
+    )
+    return disk, pendulum

@@ -1,0 +1,137 @@
+"""Mutable integration state and recording buffers of a fixed-step ensemble run.
+
+Both fixed-step backends (the compiled kernel and its NumPy twin) advance the same
+`StepState` in place, chunk after chunk, so that a driver can show progress and
+memory stays independent of the duration: only records every ``record_every`` steps
+are kept. Layouts are run-major, (B, ...), for locality inside a run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..equations import SystemArrays, accelerations
+
+# Status bits of a run (CF-style flag masks in the output file).
+STATUS_OK = 0
+STATUS_OVERTURNED = 1  # some |θ_i| passed `overturn_angle` (default π/2)
+STATUS_DIVERGED = 2  # a non-finite value appeared; the run was stopped there
+STATUS_MEANINGS = {STATUS_OVERTURNED: "overturned", STATUS_DIVERGED: "diverged"}
+
+
+@dataclass
+class StepState:
+    """State (B runs × N metronomes) and record buffers, advanced in place.
+
+    theta, theta_dot, acc_theta : (B, N)
+    phi, phi_dot, acc_phi : (B,)
+    p_phi : (B,) the disk's angular momentum (J + R²Σm) φ̇ + R Σ m h cos θ θ̇, carried as
+        state so that it changes only by the external torque impulse.
+    force_phi : (B,) external torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄.
+    last_up : (B, N) time of the last upward zero crossing, −1 before the first.
+    status : (B,) int8 bit flags.
+    r : (B, n_rec) analytic-phase order parameter at each record.
+    cross_re, cross_im, cross_count : (B, n_rec) running sums of e^{iΦ} over the
+        metronomes whose crossing-interpolated phase Φ is known at each record.
+    traj_* : trajectories (B, n_rec, N) and (B, n_rec), or (0, 0, 0) placeholders.
+    """
+
+    theta: np.ndarray
+    theta_dot: np.ndarray
+    phi: np.ndarray
+    phi_dot: np.ndarray
+    acc_theta: np.ndarray
+    acc_phi: np.ndarray
+    p_phi: np.ndarray
+    force_phi: np.ndarray
+    last_up: np.ndarray
+    status: np.ndarray
+    r: np.ndarray
+    cross_re: np.ndarray
+    cross_im: np.ndarray
+    cross_count: np.ndarray
+    traj_theta: np.ndarray
+    traj_theta_dot: np.ndarray
+    traj_phi: np.ndarray
+    traj_phi_dot: np.ndarray
+
+    @classmethod
+    def start(
+        cls,
+        sys: SystemArrays,
+        theta0: np.ndarray,
+        theta_dot0: np.ndarray,
+        phi0: np.ndarray,
+        phi_dot0: np.ndarray,
+        *,
+        n_records: int,
+        trajectories: bool,
+    ) -> StepState:
+        b, n = theta0.shape
+        theta = np.array(theta0, dtype=float, order="C")
+        theta_dot = np.array(theta_dot0, dtype=float, order="C")
+        phi_dot = np.array(phi_dot0, dtype=float)
+        rigid = np.isinf(sys.total_inertia)
+        phi_dot[rigid] = 0.0
+        no_kick = np.zeros_like(theta)
+        acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
+        coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
+        finite_inertia = np.where(rigid, 0.0, sys.total_inertia)
+        p_phi = np.where(rigid, 0.0, finite_inertia * phi_dot + coupling)
+        traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
+        return cls(
+            theta=theta,
+            theta_dot=theta_dot,
+            phi=np.array(phi0, dtype=float),
+            phi_dot=phi_dot,
+            acc_theta=np.ascontiguousarray(acc_theta),
+            acc_phi=np.ascontiguousarray(acc_phi),
+            p_phi=p_phi,
+            force_phi=-sys.c_phi * phi_dot,
+            last_up=np.full((b, n), -1.0),
+            status=np.zeros(b, dtype=np.int8),
+            r=np.full((b, n_records), np.nan),
+            cross_re=np.zeros((b, n_records)),
+            cross_im=np.zeros((b, n_records)),
+            cross_count=np.zeros((b, n_records), dtype=np.int32),
+            traj_theta=np.full(traj_shape, np.nan),
+            traj_theta_dot=np.full(traj_shape, np.nan),
+            traj_phi=np.full(traj_shape[:2], np.nan),
+            traj_phi_dot=np.full(traj_shape[:2], np.nan),
+        )
+
+    def crossing_order(self) -> np.ndarray:
+        """r from crossing-interpolated phases, (B, n_rec); NaN where some metronome
+        has no phase (before its first or after its last upward crossing)."""
+        n = self.theta.shape[1]
+        with np.errstate(invalid="ignore"):
+            r = np.hypot(self.cross_re, self.cross_im) / n
+        return np.where(self.cross_count == n, r, np.nan)
+
+
+@dataclass
+class Records:
+    """What an integrator hands back, per run: arrays (B, n_rec[, N]) and (B,)."""
+
+    r: np.ndarray
+    r_crossing: np.ndarray
+    status: np.ndarray
+    theta: np.ndarray | None = None
+    theta_dot: np.ndarray | None = None
+    phi: np.ndarray | None = None
+    phi_dot: np.ndarray | None = None
+
+
+def records_of(state: StepState) -> Records:
+    traj = state.traj_theta.shape[0] > 0
+    return Records(
+        r=state.r,
+        r_crossing=state.crossing_order(),
+        status=state.status,
+        theta=state.traj_theta if traj else None,
+        theta_dot=state.traj_theta_dot if traj else None,
+        phi=state.traj_phi if traj else None,
+        phi_dot=state.traj_phi_dot if traj else None,
+    )

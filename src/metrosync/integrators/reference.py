@@ -1,0 +1,95 @@
+"""Plain NumPy implementation of the fixed-step scheme in `verlet` (same steps, same
+records), vectorised over runs and metronomes.
+
+It is the oracle the compiled kernel is tested against, and the baseline that the
+benchmarks compare it with. Its forces come from `equations.accelerations`, the one
+vectorised statement of eqs. (eqm1)–(eqm2).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..equations import SystemArrays, accelerations
+from ._state import STATUS_DIVERGED, STATUS_OVERTURNED, StepState
+
+
+def advance_state(
+    state: StepState,
+    sys: SystemArrays,
+    *,
+    dt: float,
+    step0: int,
+    n_steps: int,
+    record_every: int,
+    overturn_angle: float,
+) -> None:
+    """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
+    n_rec = state.r.shape[1]
+    rigid = np.isinf(sys.total_inertia)
+    grid_dt = record_every * dt
+    if step0 == 0:
+        _record(state, 0, sys.omega, np.ones(state.status.shape, bool))
+    for s in range(step0, step0 + n_steps):
+        alive = (state.status & STATUS_DIVERGED) == 0
+        if not alive.any():
+            break
+        t_old = s * dt
+        th, acc = state.theta, state.acc_theta
+        th_new = th + state.theta_dot * dt + 0.5 * acc * dt * dt
+        vel_pred = state.theta_dot + acc * dt
+        phd_pred = state.phi_dot + state.acc_phi * dt
+        up = (th < 0) & (th_new > 0) & alive[:, None]
+        down = (th > 0) & (th_new < 0) & alive[:, None]
+        kick = np.where(up, sys.drive / dt, np.where(down, -sys.drive / dt, 0.0))
+        for b, i in zip(*np.nonzero(up), strict=True):
+            t_cross = t_old + dt * th[b, i] / (th[b, i] - th_new[b, i])
+            if state.last_up[b, i] >= 0:
+                _add_crossing_phase(state, b, state.last_up[b, i], t_cross, grid_dt, n_rec)
+            state.last_up[b, i] = t_cross
+        overturned = np.any(np.abs(th_new) > overturn_angle, axis=1) & alive
+        state.status[overturned] |= STATUS_OVERTURNED
+        phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, kick)
+        diverged = ~np.isfinite(phdd) & alive
+        state.status[diverged] |= STATUS_DIVERGED
+        ok = alive & ~diverged
+        force = -sys.c_phi * phd_pred - kick.sum(axis=1)
+        new_theta_dot = state.theta_dot + 0.5 * (acc + thdd) * dt
+        coupling = sys.radius * np.sum(sys.mh * np.cos(th_new) * new_theta_dot, axis=1)
+        new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt
+        with np.errstate(invalid="ignore"):
+            new_phi_dot = np.where(rigid, 0.0, (new_p - coupling) / sys.total_inertia)
+        ok2 = ok[:, None]
+        state.phi[ok] += state.phi_dot[ok] * dt + 0.5 * state.acc_phi[ok] * dt * dt
+        state.theta[...] = np.where(ok2, th_new, th)
+        state.theta_dot[...] = np.where(ok2, new_theta_dot, state.theta_dot)
+        state.acc_theta[...] = np.where(ok2, thdd, acc)
+        state.p_phi[ok] = np.where(rigid, state.p_phi, new_p)[ok]
+        state.phi_dot[ok] = new_phi_dot[ok]
+        state.force_phi[ok] = force[ok]
+        state.acc_phi[ok] = phdd[ok]
+        if (s + 1) % record_every == 0:
+            _record(state, (s + 1) // record_every, sys.omega, ok)
+
+
+def _add_crossing_phase(state, b, t_prev, t_next, grid_dt, n_rec):
+    g = np.arange(int(np.ceil(t_prev / grid_dt)), min(int(np.ceil(t_next / grid_dt)), n_rec))
+    phase = 2 * np.pi * (g * grid_dt - t_prev) / (t_next - t_prev)
+    state.cross_re[b, g] += np.cos(phase)
+    state.cross_im[b, g] += np.sin(phase)
+    state.cross_count[b, g] += 1
+
+
+def _record(state: StepState, k: int, omega: np.ndarray, which: np.ndarray) -> None:
+    x = state.theta
+    y = -state.theta_dot / omega
+    rho = np.hypot(x, y)
+    safe = np.where(rho > 0, rho, 1.0)
+    unit = np.where(rho > 0, (x + 1j * y) / safe, 0.0)
+    r = np.abs(unit.sum(axis=1)) / x.shape[1]
+    state.r[which, k] = r[which]
+    if state.traj_theta.shape[0]:
+        state.traj_theta[which, k] = x[which]
+        state.traj_theta_dot[which, k] = state.theta_dot[which]
+        state.traj_phi[which, k] = state.phi[which]
+        state.traj_phi_dot[which, k] = state.phi_dot[which]

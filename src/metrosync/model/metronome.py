@@ -1,0 +1,192 @@
+"""One metronome: a physical pendulum with a fixed and a sliding weight (paper §4–5).
+
+The bob is a massless rod with weight ``w1`` at ``L1`` below the pivot and the sliding
+weight ``w2`` at ``L2`` above it. Following the paper,
+
+    m = w1 + w2,   h = (w1 L1 - w2 L2) / m,   J_i = w1 L1² + w2 L2²,
+
+and the inertia that multiplies θ̈ in eq. (metron2) is ``m h² + J_i``. The paper calls
+``J_i`` the moment "relative to the centre of mass" but computes it about the pivot;
+we keep the paper's expression as written (MODEL-NOTES "The system").
+
+Tuning (MODEL-NOTES §1–2): one beat is half a period, so ω = π·BPM/60, and ``L2`` for
+a nominal BPM inverts the model's own small-amplitude frequency on a rigid support,
+ω² = m g h / (m h² + J_i). That relation is quadratic in ``L2``, so it is solved in
+closed form.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError, require_finite, require_positive
+
+STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
+
+
+def bpm_to_omega(bpm):
+    """Angular frequency (rad/s) of a metronome beating ``bpm`` beats per minute.
+
+    A metronome ticks twice per period, so ω = 2π·(BPM/2)/60 = π·BPM/60.
+    """
+    return np.pi * np.asarray(bpm, dtype=float) / 60.0
+
+
+def omega_to_bpm(omega):
+    """Inverse of `bpm_to_omega`."""
+    return 60.0 * np.asarray(omega, dtype=float) / np.pi
+
+
+@dataclass(frozen=True)
+class MetronomeDesign:
+    """Everything about a metronome except where its sliding weight sits.
+
+    Parameters (SI units)
+    ---------------------
+    w1, w2 : fixed and sliding weight, kg.
+    l1 : distance of ``w1`` below the pivot, m.
+    c_theta : viscous friction of the pivot, kg m²/s.
+    drive : angular momentum ``M`` given at each zero crossing by the escapement, N m s.
+    l2_bounds : the slider's reach on the rod, m; it bounds the tunable BPM range.
+    g : gravitational acceleration, m/s².
+    """
+
+    w1: float = 0.025
+    w2: float = 0.0069
+    l1: float = 0.0358
+    c_theta: float = 5e-5
+    drive: float = 6e-5
+    l2_bounds: tuple[float, float] = (0.0, 0.1)
+    g: float = STANDARD_GRAVITY
+
+    def __post_init__(self) -> None:
+        require_positive("w1", self.w1, unit="kg")
+        require_positive("w2", self.w2, allow_zero=True, unit="kg")
+        require_positive("l1", self.l1, unit="m")
+        require_positive("c_theta", self.c_theta, allow_zero=True, unit="kg m²/s")
+        require_positive("drive", self.drive, allow_zero=True, unit="N m s")
+        require_positive("g", self.g, unit="m/s²")
+        lo, hi = (require_finite("l2_bounds", b) for b in self.l2_bounds)
+        if not 0 <= lo < hi:
+            raise ParameterError(f"`l2_bounds` must satisfy 0 <= low < high, got {self.l2_bounds!r}.")
+        if self.w2 > 0 and hi >= self.w1 * self.l1 / self.w2:
+            limit = self.w1 * self.l1 / self.w2
+            raise ParameterError(
+                f"`l2_bounds` upper end {hi!r} m reaches the point where h <= 0 "
+                f"(L2 >= w1*L1/w2 = {limit:.5f} m): the pendulum would be inverted. "
+                f"Use an upper bound below {limit:.5f} m."
+            )
+
+    @property
+    def mass(self) -> float:
+        return self.w1 + self.w2
+
+    def with_l2(self, l2: float) -> Metronome:
+        return Metronome(design=self, l2=l2)
+
+    def bpm_range(self) -> tuple[float, float]:
+        """Lowest and highest nominal BPM the slider can tune to."""
+        lo, hi = self.l2_bounds
+        return (float(self.with_l2(hi).natural_bpm), float(self.with_l2(lo).natural_bpm))
+
+    def l2_for_bpm(self, bpm):
+        """Slider position ``L2`` (m) that tunes the metronome to ``bpm``.
+
+        Solves ω²(m h² + J_i) = m g h, a quadratic in ``L2``, in closed form.
+        Accepts scalars or arrays; raises `ParameterError` for BPM outside `bpm_range`.
+        """
+        bpm_arr = np.asarray(bpm, dtype=float)
+        if not np.all(np.isfinite(bpm_arr)):
+            raise ParameterError(f"`bpm` must be finite, got {bpm!r}.")
+        low, high = self.bpm_range()
+        bad = (bpm_arr < low) | (bpm_arr > high)
+        if np.any(bad):
+            worst = bpm_arr[bad].flat[0]
+            raise ParameterError(
+                f"`bpm` = {worst:.6g} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+                f"of this metronome design (slider L2 in {self.l2_bounds} m). Choose a BPM in "
+                f"range, or widen `l2_bounds`."
+            )
+        w1, w2, l1, g = self.w1, self.w2, self.l1, self.g
+        m = w1 + w2
+        a = w1 * l1
+        w2_sq = w2 * w2
+        omega_sq = bpm_to_omega(bpm_arr) ** 2
+        # ω²[(w2²/m + w2) x² - 2 a w2/m x + a²/m + w1 l1²] + g w2 x - g a = 0
+        qa = omega_sq * (w2_sq / m + w2)
+        qb = -2.0 * omega_sq * a * w2 / m + g * w2
+        qc = omega_sq * (a * a / m + w1 * l1 * l1) - g * a
+        if w2 == 0:
+            raise ParameterError("`w2` is 0: the metronome has no slider and cannot be tuned.")
+        disc = np.sqrt(np.maximum(qb * qb - 4.0 * qa * qc, 0.0))
+        # The physical branch is the larger root (the smaller one is negative, a slider
+        # below the pivot); on it ω falls monotonically as the slider moves up.
+        x = (-qb + disc) / (2.0 * qa)
+        return x if x.ndim else float(x)
+
+
+@dataclass(frozen=True)
+class Metronome:
+    """A tuned metronome: a design plus the slider position ``l2`` (m)."""
+
+    design: MetronomeDesign = field(default_factory=MetronomeDesign)
+    l2: float = 0.03
+
+    def __post_init__(self) -> None:
+        require_positive("l2", self.l2, allow_zero=True, unit="m")
+        if self.h <= 0:
+            raise ParameterError(
+                f"`l2` = {self.l2!r} m gives h = {self.h:.3g} m <= 0: the centre of mass is "
+                f"above the pivot and the pendulum is inverted. Use l2 < "
+                f"{self.design.w1 * self.design.l1 / max(self.design.w2, 1e-300):.5f} m."
+            )
+
+    @property
+    def mass(self) -> float:
+        return self.design.mass
+
+    @property
+    def h(self) -> float:
+        """Pivot to centre-of-mass distance, m (paper §4)."""
+        d = self.design
+        return (d.w1 * d.l1 - d.w2 * self.l2) / d.mass
+
+    @property
+    def j(self) -> float:
+        """The paper's J_i = w1 L1² + w2 L2², kg m²."""
+        d = self.design
+        return d.w1 * d.l1**2 + d.w2 * self.l2**2
+
+    @property
+    def inertia(self) -> float:
+        """The coefficient of θ̈ in eq. (metron2): m h² + J_i, kg m²."""
+        return self.mass * self.h**2 + self.j
+
+    @property
+    def natural_omega(self) -> float:
+        """Small-amplitude angular frequency on a rigid support, rad/s."""
+        return math.sqrt(self.mass * self.design.g * self.h / self.inertia)
+
+    @property
+    def natural_bpm(self) -> float:
+        return float(omega_to_bpm(self.natural_omega))
+
+    @property
+    def steady_amplitude(self) -> float:
+        """Energy-balance amplitude 2M/(π c_θ), rad (small-angle, rigid support)."""
+        return steady_amplitude(self.design.drive, self.design.c_theta)
+
+
+def steady_amplitude(drive: float, c_theta: float) -> float:
+    """Amplitude at which the escapement's energy input balances friction, rad.
+
+    Per half period the kick adds ``M·θ̇(0) = M A ω`` and friction removes
+    ``c_θ ∫θ̇² dt = π c_θ A² ω / 2``; equating gives ``A = 2M/(π c_θ)``.
+    Infinite when there is no friction.
+    """
+    if c_theta == 0:
+        return math.inf if drive > 0 else 0.0
+    return 2.0 * drive / (math.pi * c_theta)

@@ -1,0 +1,61 @@
+"""The freely rotating disk that carries the metronomes (paper §4–5).
+
+The disk's own moment of inertia ``J`` includes the metronome boxes. The paper gives
+only its range, J ∈ [0.0729, 0.25515] kg m², for 0 to 7 metronomes. We adopt the
+linear law that matches both ends (MODEL-NOTES §3),
+
+    J(N) = J0 + N·j,   J0 = 0.0729 kg m² (1 kg × R²),   j = (0.25515 − 0.0729)/7,
+
+which makes the coupling mean-field as N grows. A fixed ``J`` (or ``inf`` for a rigid
+support) overrides the law.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..errors import ParameterError, require_positive
+
+PAPER_J_MIN = 0.0729
+PAPER_J_MAX = 0.25515
+PAPER_N_MAX = 7
+
+
+@dataclass(frozen=True)
+class Platform:
+    """Disk parameters, SI units.
+
+    radius : R, distance of the pivots from the axis, m.
+    c_phi : viscous friction of the disk's bearing, kg m²/s.
+    j0, j_per_metronome : the law J(N) = j0 + N·j_per_metronome, kg m².
+    inertia : if set, a fixed J that ignores the law; ``math.inf`` pins the disk.
+    """
+
+    radius: float = 0.27
+    c_phi: float = 1e-5
+    j0: float = PAPER_J_MIN
+    j_per_metronome: float = (PAPER_J_MAX - PAPER_J_MIN) / PAPER_N_MAX
+    inertia: float | None = None
+
+    def __post_init__(self) -> None:
+        require_positive("radius", self.radius, unit="m")
+        require_positive("c_phi", self.c_phi, allow_zero=True, unit="kg m²/s")
+        require_positive("j0", self.j0, allow_zero=True, unit="kg m²")
+        require_positive("j_per_metronome", self.j_per_metronome, allow_zero=True, unit="kg m²")
+        if self.inertia is not None and not (self.inertia == math.inf or self.inertia > 0):
+            raise ParameterError(
+                f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), got {self.inertia!r}."
+            )
+
+    def disk_inertia(self, n: int) -> float:
+        """J for ``n`` metronomes on the disk, kg m²."""
+        if self.inertia is not None:
+            return float(self.inertia)
+        if n < 1:
+            raise ParameterError(f"`n` must be >= 1 metronome, got {n!r}.")
+        return self.j0 + n * self.j_per_metronome
+
+    @property
+    def rigid(self) -> bool:
+        return self.inertia == math.inf
