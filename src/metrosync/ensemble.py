@@ -20,7 +20,7 @@ import numpy as np
 
 from .equations import SystemArrays
 from .errors import ParameterError, describe
-from .model import Metronome, ModelParameters, bpm_to_omega
+from .model import Metronome, ModelParameters
 
 #: The coarsest step accepted: a period must span at least this many steps.
 MIN_STEPS_PER_PERIOD = 10
@@ -92,7 +92,9 @@ def build_ensemble(
     """
     runs = _require_count("runs", runs)
     if seed is not None and (not isinstance(seed, int | np.integer) or seed < 0):
-        raise ParameterError(f"`seed` must be a non-negative integer or None, got {describe(seed)}.")
+        raise ParameterError(
+            f"`seed` must be a non-negative integer or None, got {describe(seed)}."
+        )
     freq_rng, phase_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     design = params.metronome
 
@@ -177,7 +179,11 @@ def build_ensemble(
         if not (math.isfinite(amp) and amp >= 0):
             raise ParameterError(
                 f"`amplitude` must be a finite angle >= 0 rad, got {amp!r}"
-                + (" (no friction: give `amplitude` or `theta0` explicitly)" if amplitude is None else "")
+                + (
+                    " (no friction: give `amplitude` or `theta0` explicitly)"
+                    if amplitude is None
+                    else ""
+                )
                 + "."
             )
         th0 = amp * np.cos(phases)

@@ -85,7 +85,10 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
     denominator = sys.total_inertia - np.sum(d_sum, axis=-1)  # D
     phi_ddot = numerator / denominator
     theta_ddot = (
-        kick - radius * sys.mh * phi_ddot[:, None] * cos_t - sys.mgh * sin_t - sys.c_theta * theta_dot
+        kick
+        - radius * sys.mh * phi_ddot[:, None] * cos_t
+        - sys.mgh * sin_t
+        - sys.c_theta * theta_dot
     ) / sys.inertia
     return phi_ddot, theta_ddot
 

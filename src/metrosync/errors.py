@@ -33,7 +33,9 @@ def require_positive(name: str, value: float, *, allow_zero: bool = False, unit:
     value = require_finite(name, value)
     if value < 0 or (value == 0 and not allow_zero):
         bound = ">= 0" if allow_zero else "> 0"
-        raise ParameterError(f"`{name}` must be {bound}{' ' + unit if unit else ''}, got {value!r}.")
+        raise ParameterError(
+            f"`{name}` must be {bound}{' ' + unit if unit else ''}, got {value!r}."
+        )
     return value
 
 

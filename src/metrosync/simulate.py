@@ -95,7 +95,9 @@ def simulate(
     if changes:
         params = get_preset(params.with_changes(**changes))
     if integrator not in INTEGRATORS:
-        raise ParameterError(f"unknown `integrator` {integrator!r}; choose one of {list(INTEGRATORS)}.")
+        raise ParameterError(
+            f"unknown `integrator` {integrator!r}; choose one of {list(INTEGRATORS)}."
+        )
     if backend not in BACKENDS:
         raise ParameterError(f"unknown `backend` {backend!r}; choose one of {sorted(BACKENDS)}.")
     if not (math.isfinite(duration) and duration > 0):
@@ -119,7 +121,11 @@ def simulate(
     n_steps = int(round(duration / dt))
     if record_every is None:
         record_every = max(1, int(round(0.1 / dt)))
-    if isinstance(record_every, bool) or not isinstance(record_every, int | np.integer) or record_every < 1:
+    if (
+        isinstance(record_every, bool)
+        or not isinstance(record_every, int | np.integer)
+        or record_every < 1
+    ):
         raise ParameterError(f"`record_every` must be an integer >= 1 step, got {record_every!r}.")
     if record_every > n_steps:
         raise ParameterError(
@@ -129,7 +135,9 @@ def simulate(
     n_records = n_steps // record_every + 1
     window = duration / 4 if equilibrium_window is None else float(equilibrium_window)
     if not (0 < window <= duration):
-        raise ParameterError(f"`equilibrium_window` must be in (0, duration], got {equilibrium_window!r}.")
+        raise ParameterError(
+            f"`equilibrium_window` must be in (0, duration], got {equilibrium_window!r}."
+        )
     show = _sys.stderr.isatty() if progress is None else progress
 
     if integrator == "verlet":
@@ -147,7 +155,9 @@ def simulate(
             )  # fmt: skip
     settings = {
         "n": ensemble.n,
-        "bpm": "explicit" if bpm is None or frequencies_bpm is not None or metronomes is not None else bpm,
+        "bpm": "explicit"
+        if bpm is None or frequencies_bpm is not None or metronomes is not None
+        else bpm,
         "sigma_bpm": sigma_bpm,
         "runs": ensemble.runs,
         "duration": n_steps * dt,
@@ -183,7 +193,9 @@ def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, tra
     return records_of(state)
 
 
-def _to_dataset(ensemble: Ensemble, rec: Records, grid_dt: float, window: float, settings) -> xr.Dataset:
+def _to_dataset(
+    ensemble: Ensemble, rec: Records, grid_dt: float, window: float, settings
+) -> xr.Dataset:
     n_rec = rec.r.shape[1]
     time = np.arange(n_rec) * grid_dt
     r = rec.r.T
@@ -198,7 +210,11 @@ def _to_dataset(ensemble: Ensemble, rec: Records, grid_dt: float, window: float,
             r_cross,
             {"long_name": "Kuramoto order parameter (phase interpolated between upward crossings)"},
         ),
-        "r_eq": (("run",), r_eq, {"long_name": "equilibrium r (mean of r_crossing over final window)"}),
+        "r_eq": (
+            ("run",),
+            r_eq,
+            {"long_name": "equilibrium r (mean of r_crossing over final window)"},
+        ),
         "r_eq_analytic": (("run",), r_eq_analytic, {"long_name": "equilibrium r from r"}),
         "status": (
             ("run",),
@@ -214,10 +230,18 @@ def _to_dataset(ensemble: Ensemble, rec: Records, grid_dt: float, window: float,
             ensemble.frequency_bpm,
             {"units": "BPM", "long_name": "natural frequency on a rigid support"},
         ),
-        "l2": (("run", "metronome"), ensemble.l2, {"units": "m", "long_name": "slider position L2"}),
+        "l2": (
+            ("run", "metronome"),
+            ensemble.l2,
+            {"units": "m", "long_name": "slider position L2"},
+        ),
     }
     if rec.theta is not None:
-        data["theta"] = (("time", "run", "metronome"), rec.theta.transpose(1, 0, 2), {"units": "rad"})
+        data["theta"] = (
+            ("time", "run", "metronome"),
+            rec.theta.transpose(1, 0, 2),
+            {"units": "rad"},
+        )
         data["theta_dot"] = (
             ("time", "run", "metronome"),
             rec.theta_dot.transpose(1, 0, 2),

@@ -23,8 +23,15 @@ def add_ensemble_options(parser: argparse.ArgumentParser) -> None:
     """Options that define an ensemble run, shared by `simulate` and friends."""
     g = parser.add_argument_group("ensemble")
     g.add_argument("--n", type=int, default=7, help="metronomes on the disk (default 7)")
-    g.add_argument("--bpm", type=float, default=192.0, help="nominal beat frequency, BPM (default 192)")
-    g.add_argument("--sigma", type=float, default=0.75, help="spread of natural frequencies, BPM (default 0.75)")
+    g.add_argument(
+        "--bpm", type=float, default=192.0, help="nominal beat frequency, BPM (default 192)"
+    )
+    g.add_argument(
+        "--sigma",
+        type=float,
+        default=0.75,
+        help="spread of natural frequencies, BPM (default 0.75)",
+    )
     g.add_argument("--runs", type=int, default=20, help="independent runs (default 20)")
     g.add_argument("--duration", type=float, default=600.0, help="simulated time, s (default 600)")
     g.add_argument("--dt", type=float, default=0.01, help="time step, s (default 0.01)")
@@ -40,9 +47,15 @@ def add_ensemble_options(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--integrator", choices=("verlet", "exact"), default="verlet")
     g.add_argument("--backend", choices=("numba", "numpy"), default="numba")
-    g.add_argument("--amplitude", type=float, default=None, help="start amplitude, rad (random phases)")
-    g.add_argument("--theta0", type=float_list, default=None, help="initial angles, comma-separated, rad")
-    g.add_argument("--theta-dot0", type=float_list, default=None, help="initial angular velocities, rad/s")
+    g.add_argument(
+        "--amplitude", type=float, default=None, help="start amplitude, rad (random phases)"
+    )
+    g.add_argument(
+        "--theta0", type=float_list, default=None, help="initial angles, comma-separated, rad"
+    )
+    g.add_argument(
+        "--theta-dot0", type=float_list, default=None, help="initial angular velocities, rad/s"
+    )
     g.add_argument("--save-every", type=int, default=None, metavar="K",
                    help="record every K steps and keep trajectories")  # fmt: skip
 

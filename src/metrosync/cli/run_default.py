@@ -13,7 +13,9 @@ from .simulate import summary, write_netcdf
 
 
 def register(subparsers) -> None:
-    parser = subparsers.add_parser("run-default", help="run the default study (what `make run` does)")
+    parser = subparsers.add_parser(
+        "run-default", help="run the default study (what `make run` does)"
+    )
     parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
     parser.set_defaults(func=run)
 

@@ -54,7 +54,8 @@ def summary(ds, elapsed: float) -> str:
     masks = ds.status.attrs["flag_masks"]
     meanings = ds.status.attrs["flag_meanings"].split()
     flagged = ", ".join(
-        f"{int(((ds.status & mask) != 0).sum())} {meaning}" for mask, meaning in zip(masks, meanings)
+        f"{int(((ds.status & mask) != 0).sum())} {meaning}"
+        for mask, meaning in zip(masks, meanings, strict=True)
     )
     steps = a["runs"] * a["n"] * round(a["duration"] / a["dt"])
     lines = [
@@ -66,8 +67,7 @@ def summary(ds, elapsed: float) -> str:
         f"  equilibrium r (last {a['equilibrium_window']:g} s, crossing phases): "
         f"{a['r_eq_mean']:.4f} +- {a['r_eq_std']:.4f} (sigma_r over runs)",
         f"  final r (analytic phase), mean over runs: {float(ds.r.isel(time=-1).mean()):.4f}",
-        f"  runs flagged: {bad} of {a['runs']}"
-        + (f" ({flagged})" if bad else ""),
+        f"  runs flagged: {bad} of {a['runs']}" + (f" ({flagged})" if bad else ""),
         f"  {elapsed:.2f} s wall, {steps / max(elapsed, 1e-9):.3g} oscillator-steps/s",
     ]
     return "\n".join(lines)

@@ -76,10 +76,13 @@ class StepState:
         rigid = np.isinf(sys.total_inertia)
         phi_dot[rigid] = 0.0
         no_kick = np.zeros_like(theta)
-        acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
-        coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
+        # A run may diverge from its very start; it is flagged, not raised.
+        with np.errstate(over="ignore", invalid="ignore"):
+            acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
+            coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
         finite_inertia = np.where(rigid, 0.0, sys.total_inertia)
         p_phi = np.where(rigid, 0.0, finite_inertia * phi_dot + coupling)
+        finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
         return cls(
             theta=theta,
@@ -91,7 +94,7 @@ class StepState:
             p_phi=p_phi,
             force_phi=-sys.c_phi * phi_dot,
             last_up=np.full((b, n), -1.0),
-            status=np.zeros(b, dtype=np.int8),
+            status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
             r=np.full((b, n_records), np.nan),
             cross_re=np.zeros((b, n_records)),
             cross_im=np.zeros((b, n_records)),

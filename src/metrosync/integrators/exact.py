@@ -105,7 +105,7 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
             event = None
             if crossing.size:
                 roots = [
-                    brentq(lambda s, i=i: dense(s)[1 + i], dense.t_old, dense.t, xtol=1e-14)
+                    brentq(lambda s, i=i, f=dense: f(s)[1 + i], dense.t_old, dense.t, xtol=1e-14)
                     for i in crossing
                 ]
                 k = int(np.argmin(roots))

@@ -29,7 +29,12 @@ def advance_state(
     rigid = np.isinf(sys.total_inertia)
     grid_dt = record_every * dt
     if step0 == 0:
-        _record(state, 0, sys.omega, np.ones(state.status.shape, bool))
+        _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, grid_dt, n_rec)
+
+
+def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, grid_dt, n_rec):
     for s in range(step0, step0 + n_steps):
         alive = (state.status & STATUS_DIVERGED) == 0
         if not alive.any():

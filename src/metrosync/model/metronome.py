@@ -71,7 +71,9 @@ class MetronomeDesign:
         require_positive("g", self.g, unit="m/s²")
         lo, hi = (require_finite("l2_bounds", b) for b in self.l2_bounds)
         if not 0 <= lo < hi:
-            raise ParameterError(f"`l2_bounds` must satisfy 0 <= low < high, got {self.l2_bounds!r}.")
+            raise ParameterError(
+                f"`l2_bounds` must satisfy 0 <= low < high, got {self.l2_bounds!r}."
+            )
         if self.w2 > 0 and hi >= self.w1 * self.l1 / self.w2:
             limit = self.w1 * self.l1 / self.w2
             raise ParameterError(

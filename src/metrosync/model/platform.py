@@ -45,7 +45,8 @@ class Platform:
         require_positive("j_per_metronome", self.j_per_metronome, allow_zero=True, unit="kg m²")
         if self.inertia is not None and not (self.inertia == math.inf or self.inertia > 0):
             raise ParameterError(
-                f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), got {self.inertia!r}."
+                f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), "
+                f"got {self.inertia!r}."
             )
 
     def disk_inertia(self, n: int) -> float:

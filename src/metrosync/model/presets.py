@@ -47,7 +47,9 @@ class ModelParameters:
         unknown = set(changes) - set(design_changes) - set(platform_changes)
         if unknown:
             valid = sorted(set(design_fields) | set(platform_fields))
-            raise ParameterError(f"unknown model parameter(s) {sorted(unknown)}; valid names: {valid}.")
+            raise ParameterError(
+                f"unknown model parameter(s) {sorted(unknown)}; valid names: {valid}."
+            )
         return replace(
             self,
             metronome=replace(self.metronome, **design_changes),
