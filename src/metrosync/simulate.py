@@ -28,7 +28,7 @@ import xarray as xr
 from . import __version__
 from .ensemble import Ensemble, build_ensemble, check_time_step
 from .errors import ParameterError
-from .integrators import INTEGRATORS, exact
+from .integrators import INTEGRATORS
 from .integrators import reference as numpy_backend
 from .integrators import verlet as numba_backend
 from .integrators._state import STATUS_MEANINGS, Records, StepState, records_of
@@ -146,6 +146,8 @@ def simulate(
             overturn_angle, show,
         )  # fmt: skip
     else:
+        from .integrators import exact  # scipy's solvers load only when asked for
+
         with progress_bar(total=ensemble.runs, unit="run", enabled=show) as bar:
             records = exact.integrate(
                 ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi_dot0,

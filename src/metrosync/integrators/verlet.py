@@ -24,142 +24,33 @@ running sums of the crossing-interpolated phase (MODEL-NOTES "Observables").
 
 from __future__ import annotations
 
-import math
+from . import kernel_oscillators, kernel_runs, kernel_scalar
+from ._cache import heal_compile_cache
+from ._state import StepState
 
-import numba as nb
-import numpy as np
-
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED, StepState
-
-TWO_PI = 2.0 * math.pi
-
-
-@nb.njit(cache=True, inline="always")
-def _add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_dt, n_rec):
-    """Add e^{iΦ} for grid times in [t_prev, t_next), Φ rising linearly 0 → 2π."""
-    period = t_next - t_prev
-    g0 = int(math.ceil(t_prev / grid_dt))
-    g1 = min(int(math.ceil(t_next / grid_dt)), n_rec)
-    for g in range(g0, g1):
-        ph = TWO_PI * (g * grid_dt - t_prev) / period
-        cross_re[b, g] += math.cos(ph)
-        cross_im[b, g] += math.sin(ph)
-        cross_count[b, g] += 1
+#: Kernels by memory layout (see each module's docstring).
+KERNELS = {
+    "runs": kernel_runs.advance,
+    "oscillators": kernel_oscillators.advance,
+    "scalar": kernel_scalar.advance,
+}
+#: Below this many metronomes a run is too short to fill vector registers, so runs
+#: go innermost; from it on, metronomes do (measured by benchmarks/kernel.py).
+RUNS_INNERMOST_BELOW_N = 16
 
 
-@nb.njit(parallel=True, cache=True)
-def advance(
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status,
-    mh, mgh, inertia, c_theta, drive, omega, radius, c_phi, total_inertia,
-    dt, step0, n_steps, record_every, overturn_angle,
-    r, cross_re, cross_im, cross_count,
-    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot,
-):  # fmt: skip
-    """Advance every run from step ``step0`` by ``n_steps`` steps, in place."""
-    n_runs, n = theta.shape
-    n_rec = r.shape[1]
-    save = traj_theta.shape[0] > 0
-    dt2 = dt * dt
-    grid_dt = record_every * dt
-    for b in nb.prange(n_runs):
-        th_new = np.empty(n)
-        vel_pred = np.empty(n)
-        rest = np.empty(n)
-        coupling = np.empty(n)
-        rigid = math.isinf(total_inertia[b])
-        rad = radius[b]
-        if step0 == 0:
-            _record(b, 0, theta, theta_dot, phi, phi_dot, omega, r, save,
-                    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip
-        for s in range(step0, step0 + n_steps):
-            if status[b] & STATUS_DIVERGED:
-                break
-            t_old = s * dt
-            phd_pred = phi_dot[b] + acc_phi[b] * dt
-            phi_new = phi[b] + phi_dot[b] * dt + 0.5 * acc_phi[b] * dt2
-            sum_num = 0.0
-            sum_den = 0.0
-            sum_kick = 0.0
-            for i in range(n):
-                th = theta[b, i]
-                a = acc_theta[b, i]
-                tn = th + theta_dot[b, i] * dt + 0.5 * a * dt2
-                vp = theta_dot[b, i] + a * dt
-                kick = 0.0
-                if th < 0.0 and tn > 0.0:
-                    kick = drive[b, i] / dt
-                    t_cross = t_old + dt * th / (th - tn)
-                    if last_up[b, i] >= 0.0:
-                        _add_crossing_phase(cross_re, cross_im, cross_count, b,
-                                            last_up[b, i], t_cross, grid_dt, n_rec)  # fmt: skip
-                    last_up[b, i] = t_cross
-                elif th > 0.0 and tn < 0.0:
-                    kick = -drive[b, i] / dt
-                if abs(tn) > overturn_angle:
-                    status[b] |= STATUS_OVERTURNED
-                sn = math.sin(tn)
-                cs = math.cos(tn)
-                inv_i = 1.0 / inertia[b, i]
-                res = (kick - mgh[b, i] * sn - c_theta[b, i] * vp) * inv_i
-                q = mh[b, i] * cs
-                sum_num += mh[b, i] * vp * vp * sn - q * res
-                sum_den += q * q * inv_i
-                sum_kick += kick
-                th_new[i] = tn
-                vel_pred[i] = vp
-                rest[i] = res
-                coupling[i] = q * inv_i
-            force = -c_phi[b] * phd_pred - sum_kick
-            phdd = (rad * sum_num + force) / (total_inertia[b] - rad * rad * sum_den)
-            if not math.isfinite(phdd):
-                status[b] |= STATUS_DIVERGED
-                break
-            phi[b] = phi_new
-            sum_p = 0.0
-            for i in range(n):
-                thdd = rest[i] - rad * coupling[i] * phdd
-                theta_dot[b, i] += 0.5 * (acc_theta[b, i] + thdd) * dt
-                theta[b, i] = th_new[i]
-                acc_theta[b, i] = thdd
-                sum_p += mh[b, i] * math.cos(th_new[i]) * theta_dot[b, i]
-            if rigid:
-                phi_dot[b] = 0.0
-            else:
-                p_phi[b] += 0.5 * (force_phi[b] + force) * dt
-                phi_dot[b] = (p_phi[b] - rad * sum_p) / total_inertia[b]
-            force_phi[b] = force
-            acc_phi[b] = phdd
-            if (s + 1) % record_every == 0:
-                _record(b, (s + 1) // record_every, theta, theta_dot, phi, phi_dot, omega, r,
-                        save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip
+def choose_layout(n: int) -> str:
+    return "runs" if n < RUNS_INNERMOST_BELOW_N else "oscillators"
 
 
-@nb.njit(cache=True, inline="always")
-def _record(b, k, theta, theta_dot, phi, phi_dot, omega, r, save,
-            traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip
-    """Store r from the analytic phase Φ = atan2(−θ̇/ω, θ) and, if asked, the state."""
-    n = theta.shape[1]
-    re = 0.0
-    im = 0.0
-    for i in range(n):
-        x = theta[b, i]
-        y = -theta_dot[b, i] / omega[b, i]
-        rho = math.sqrt(x * x + y * y)
-        if rho > 0.0:
-            re += x / rho
-            im += y / rho
-    r[b, k] = math.sqrt(re * re + im * im) / n
-    if save:
-        for i in range(n):
-            traj_theta[b, k, i] = theta[b, i]
-            traj_theta_dot[b, k, i] = theta_dot[b, i]
-        traj_phi[b, k] = phi[b]
-        traj_phi_dot[b, k] = phi_dot[b]
-
-
-def advance_state(state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle):
-    """Typed front of `advance` for one chunk of steps."""
-    advance(
+def advance_state(
+    state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle, layout=None
+):
+    """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
+    ``layout`` (default: chosen from N)."""
+    heal_compile_cache()
+    kernel = KERNELS[layout or choose_layout(state.theta.shape[1])]
+    kernel(
         state.theta, state.theta_dot, state.phi, state.phi_dot, state.acc_theta, state.acc_phi,
         state.p_phi, state.force_phi, state.last_up, state.status,
         sys.mh, sys.mgh, sys.inertia, sys.c_theta, sys.drive, sys.omega,

@@ -1,0 +1,75 @@
+"""Guard numba's on-disk compile cache: a damaged file is deleted (and the kernel
+recompiled), never loaded.
+
+numba raises on a truncated or corrupt cache file instead of recompiling. Before the
+first kernel call, `heal_compile_cache` reads each of this package's cache files the
+way numba does (an index: a pickled version, then a pickled payload; a data file: one
+pickle) and removes the ones that fail, together with their index.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+from pathlib import Path
+
+import numba
+
+_checked = False
+OUR_MODULES = ("kernel_", "trig.", "_kernel_parts.")
+
+
+def cache_dirs() -> list[Path]:
+    here = Path(__file__).resolve().parent
+    dirs = [here / "__pycache__"]
+    override = numba.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR")
+    if override:
+        dirs.append(Path(override))
+    return [d for d in dirs if d.is_dir()]
+
+
+def _readable(path: Path) -> bool:
+    try:
+        with open(path, "rb") as f:
+            if path.suffix == ".nbi":
+                pickle.load(f)
+                pickle.loads(f.read())
+            else:
+                pickle.loads(f.read())
+    except Exception:  # any failure to read means numba would fail too
+        return False
+    return True
+
+
+def heal_compile_cache() -> list[Path]:
+    """Delete unreadable cache files of this package's kernels; return what was removed."""
+    global _checked
+    if _checked:
+        return []
+    _checked = True
+    removed = []
+    for folder in cache_dirs():
+        for path in folder.rglob("*.nb[ic]"):
+            if not _ours(path):
+                continue
+            if not _readable(path):
+                index = path if path.suffix == ".nbi" else _index_of(path)
+                for victim in {path, index}:
+                    if victim is not None and victim.exists():
+                        victim.unlink()
+                        removed.append(victim)
+    return removed
+
+
+def _ours(path: Path) -> bool:
+    # numba names the folder after the source folder ("integrators_<hash>" under
+    # NUMBA_CACHE_DIR) and each file after the module and function.
+    in_our_folder = path.parent.name == "__pycache__" or path.parent.name.startswith("integrators")
+    return in_our_folder and path.name.startswith(OUR_MODULES)
+
+
+def _index_of(data_file: Path) -> Path | None:
+    # name-lineno.pyXY.K.nbc belongs to name-lineno.pyXY.nbi
+    stem = data_file.name.rsplit(".", 2)[0]
+    candidate = data_file.with_name(stem + ".nbi")
+    return candidate if candidate.exists() else None
