@@ -33,7 +33,9 @@ def require_positive(name: str, value: float, *, allow_zero: bool = False, unit:
     value = require_finite(name, value)
     if value < 0 or (value == 0 and not allow_zero):
         bound = ">= 0" if allow_zero else "> 0"
-        raise ParameterError(f"`{name}` must be {bound}{' ' + unit if unit else ''}, got {value!r}.")
+        raise ParameterError(
+            f"`{name}` must be {bound}{' ' + unit if unit else ''}, got {value!r}."
+        )
     return value
 
 
@@ -41,3 +43,34 @@ def describe(value: Any) -> str:
     """Short repr for error messages (arrays are summarised, not dumped)."""
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
+
+
+class LogFormatError(MetrosyncError, ValueError):
+    """A light-gate log cannot be read: it is empty, malformed, or inconsistent.
+
+    The message names the file (when known), the line number and what to do.
+    """
+
+
+class EmptyLogError(LogFormatError):
+    """A light-gate log holds no gate record at all."""
+
+
+class ChannelCountError(LogFormatError):
+    """The number of gates per record changes in the middle of a log (or between logs)."""
+
+
+class TimestampError(LogFormatError):
+    """Timestamps go backwards in a way that no counter wrap explains."""
+
+
+class StrictModeError(LogFormatError):
+    """A line was not a gate record, and strict reading was asked for."""
+
+
+class AnalysisError(MetrosyncError, ValueError):
+    """Cleaned light-gate data do not allow the requested analysis (too few passes)."""
+
+
+class CalibrationError(MetrosyncError, ValueError):
+    """A parameter cannot be estimated from the data given (no solution, or not unique)."""
