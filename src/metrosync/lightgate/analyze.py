@@ -99,8 +99,10 @@ def analyze(
     per_log = [[c[j] for j in chosen] for c in cleaned]
 
     spans = []
-    for log, chans in zip(logs, per_log):
-        ch_spans = [ph.channel_span(c.kept, log.source, j) for j, c in zip(chosen, chans)]
+    for log, chans in zip(logs, per_log, strict=True):
+        ch_spans = [
+            ph.channel_span(c.kept, log.source, j) for j, c in zip(chosen, chans, strict=True)
+        ]
         spans.append((max(s for s, _ in ch_spans), min(e for _, e in ch_spans)))
     grid = ph.common_grid(spans, grid_dt)
     if grid.size < 2:
@@ -124,7 +126,8 @@ def analyze(
     r_eq = float(equilibrium_order(r, grid, window))
     sigma = ph.frequency_spread(mean_freq)
     reports = "\n".join(
-        log.report() + "\n" + cleaning_report(c, log.source) for log, c in zip(logs, cleaned)
+        log.report() + "\n" + cleaning_report(c, log.source)
+        for log, c in zip(logs, cleaned, strict=True)
     )
     data = {
         "r": (("time",), r, {"long_name": "Kuramoto order parameter, mean over logs"}),

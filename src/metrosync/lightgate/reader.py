@@ -236,7 +236,8 @@ def _check_bits(counter_bits) -> int | str | None:
         or not (lo <= counter_bits <= hi)
     ):
         raise ParameterError(
-            f"`counter_bits` must be 'auto', None or an integer in [{lo}, {hi}], got {counter_bits!r}."
+            f"`counter_bits` must be 'auto', None or an integer in [{lo}, {hi}], "
+            f"got {counter_bits!r}."
         )
     return int(counter_bits)
 

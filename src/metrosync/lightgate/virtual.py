@@ -202,7 +202,7 @@ def format_log(time, theta, theta_dot, gate: LightGate = LightGate()) -> str:
     shown = (gate.start_tick + ticks) % modulus
     flip = gate.interrupted_level == 0
     lines = [_line(state, flip, gate.start_tick % modulus)]
-    for ch, ent, value in zip(channel[order], entering[order], shown):
+    for ch, ent, value in zip(channel[order], entering[order], shown, strict=True):
         state[ch] = ent
         lines.append(_line(state, flip, int(value)))
     return "\n".join(lines) + "\n"
