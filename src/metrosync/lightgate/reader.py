@@ -205,7 +205,7 @@ def parse_log(
             f"'0-1-0-0 1450'); {len(skipped)} lines skipped."
         )
     records = _drop_partial_ends(records, skipped, lines, strict, source)
-    records = _drop_partial_last_tick(records, skipped, lines, terminated, bits, strict, source)
+    records = _drop_partial_last_tick(records, skipped, lines, terminated, strict, source)
 
     numbers = np.array([r[0] for r in records], dtype=np.int64)
     levels = np.array([[int(c) for c in r[1]] for r in records], dtype=np.uint8)
@@ -286,18 +286,16 @@ def _drop_partial_ends(records, skipped, lines, strict, source):
     return out
 
 
-def _drop_partial_last_tick(records, skipped, lines, terminated, bits, strict, source):
-    """An unterminated last line whose time runs backwards is a cut-off timestamp."""
+def _drop_partial_last_tick(records, skipped, lines, terminated, strict, source):
+    """An unterminated last line whose time runs backwards is a cut-off timestamp.
+
+    A cut timestamp can look like a counter wrap; a wrap that falls exactly on a cut
+    final line is the rarer event, and losing that one record costs nothing.
+    """
     if terminated or len(records) < 2 or records[-1][0] != len(lines):
         return records
-    previous, last = records[-2][2], records[-1][2]
-    if last >= previous:
+    if records[-1][2] >= records[-2][2]:
         return records
-    modulus = None if bits in (None, "auto") else 1 << bits
-    if bits == "auto":
-        modulus = 1 << max(max(r[2] for r in records).bit_length(), COUNTER_BITS_RANGE[0])
-    if modulus is not None and previous - last > modulus // 2:
-        return records  # a plausible wrap: keep it
     number = records[-1][0]
     _skip(skipped, number, "partial record (cut-off timestamp)", lines[number - 1], strict, source)
     return records[:-1]
