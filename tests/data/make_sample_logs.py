@@ -22,8 +22,16 @@ def clean_text() -> str:
     from metrosync import simulate
     from metrosync.lightgate import LightGate, format_log
 
-    ds = simulate(3, 192.0, sigma_bpm=0.5, duration=20.0, seed=SEED, record_every=1,
-                  trajectories=True, progress=False)  # fmt: skip
+    ds = simulate(
+        3,
+        192.0,
+        sigma_bpm=0.5,
+        duration=20.0,
+        seed=SEED,
+        record_every=1,
+        trajectories=True,
+        progress=False,
+    )
     gate = LightGate(offset=0.1, width=0.05, counter_bits=16, start_tick=60000, seed=SEED)
     return format_log(ds.time.values, ds.theta.values[:, 0], ds.theta_dot.values[:, 0], gate)
 
@@ -32,18 +40,28 @@ def damage(text: str) -> str:
     """Make a clean capture messy, deterministically."""
     lines = text.splitlines()
     # Inverted polarity: this logger prints 0 for an interrupted beam.
-    lines = ["-".join("1" if c == "0" else "0" for c in line.split()[0].split("-"))
-             + " " + line.split()[1] for line in lines]  # fmt: skip
+    lines = [
+        "-".join("1" if c == "0" else "0" for c in line.split()[0].split("-"))
+        + " "
+        + line.split()[1]
+        for line in lines
+    ]
     # A missed pass on gate 1: the two lines of one interruption lose that gate's change.
-    hits = [i for i in range(1, len(lines))
-            if lines[i].split()[0].split("-")[1] != lines[i - 1].split()[0].split("-")[1]]  # fmt: skip
+    hits = [
+        i
+        for i in range(1, len(lines))
+        if lines[i].split()[0].split("-")[1] != lines[i - 1].split()[0].split("-")[1]
+    ]
     for i in hits[40:42]:
         gates = lines[i].split()[0].split("-")
         gates[1] = "1"
         lines[i] = "-".join(gates) + " " + lines[i].split()[1]
     # A glitch on gate 2: 3 ticks (0.19 ms) of interruption while its beam is open.
-    j = next(i for i in range(100, len(lines) - 1)
-             if lines[i].split()[0][4] == "1" and lines[i + 1].split()[0][4] == "1")  # fmt: skip
+    j = next(
+        i
+        for i in range(100, len(lines) - 1)
+        if lines[i].split()[0][4] == "1" and lines[i + 1].split()[0][4] == "1"
+    )
     t = int(lines[j].split()[1])
     gates = lines[j].split()[0].split("-")
     gates[2] = "0"
@@ -52,8 +70,15 @@ def damage(text: str) -> str:
     lines.insert(j + 2, "-".join(gates) + f" {t + 4}")
     lines.insert(60, "")
     lines.insert(200, "")
-    banner = ["", "Welcome to minicom 2.7.1", "", "OPTIONS: I18n", "Port /dev/ttyUSB0, 14:02:11",
-              "Press CTRL-A Z for help on special keys", ""]  # fmt: skip
+    banner = [
+        "",
+        "Welcome to minicom 2.7.1",
+        "",
+        "OPTIONS: I18n",
+        "Port /dev/ttyUSB0, 14:02:11",
+        "Press CTRL-A Z for help on special keys",
+        "",
+    ]
     body = "\r\n".join(banner + lines)
     return body[:-3]  # the capture stopped in the middle of the last line
 

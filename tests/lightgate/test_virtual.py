@@ -19,7 +19,10 @@ def test_edges_match_the_exact_crossings_of_a_sine():
     amp, omega, offset, width = 0.7, 20.0, 0.1, 0.05
     initial, times, entering = gate_edges(t, th, thd, offset=offset, width=width)
     assert not initial
-    lo, hi = np.arcsin((offset - width / 2) / amp) / omega, np.arcsin((offset + width / 2) / amp) / omega
+    lo, hi = (
+        np.arcsin((offset - width / 2) / amp) / omega,
+        np.arcsin((offset + width / 2) / amp) / omega,
+    )
     assert entering[0] and np.isclose(times[0], lo, atol=2e-6)
     assert not entering[1] and np.isclose(times[1], hi, atol=2e-6)
     assert times.size % 2 == 0 and np.all(entering[0::2]) and not np.any(entering[1::2])

@@ -29,7 +29,10 @@ def mean_square_speed(amplitude):
     """G(A) = ⟨θ̇²⟩ / ω0² over a swing of amplitude A (rad); A²/2 for small A."""
     m = np.sin(np.asarray(amplitude, dtype=float) / 2) ** 2
     k = ellipk(m)
-    return 4.0 * (ellipe(m) - (1.0 - m) * k) / k
+    # E − (1−m)K cancels for small m; its series (π/2)(m/2 + m²/16 + 3m³/128) does not.
+    series = np.pi / 2 * m * (0.5 + m * (1 / 16 + m * 3 / 128))
+    diff = np.where(m < 1e-3, series, ellipe(m) - (1.0 - m) * k)
+    return 4.0 * diff / k
 
 
 def envelope_coordinate(amplitude):
