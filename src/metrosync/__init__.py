@@ -37,3 +37,7 @@ __all__ = [
     "omega_to_bpm",
     "simulate",
 ]
+
+from .lightgate import analyze  # noqa: E402
+
+__all__ += ["analyze"]

@@ -43,3 +43,34 @@ def describe(value: Any) -> str:
     """Short repr for error messages (arrays are summarised, not dumped)."""
     text = repr(value)
     return text if len(text) <= 80 else text[:77] + "..."
+
+
+class LogFormatError(MetrosyncError, ValueError):
+    """A light-gate log cannot be read: it is empty, malformed, or inconsistent.
+
+    The message names the file (when known), the line number and what to do.
+    """
+
+
+class EmptyLogError(LogFormatError):
+    """A light-gate log holds no gate record at all."""
+
+
+class ChannelCountError(LogFormatError):
+    """The number of gates per record changes in the middle of a log (or between logs)."""
+
+
+class TimestampError(LogFormatError):
+    """Timestamps go backwards in a way that no counter wrap explains."""
+
+
+class StrictModeError(LogFormatError):
+    """A line was not a gate record, and strict reading was asked for."""
+
+
+class AnalysisError(MetrosyncError, ValueError):
+    """Cleaned light-gate data do not allow the requested analysis (too few passes)."""
+
+
+class CalibrationError(MetrosyncError, ValueError):
+    """A parameter cannot be estimated from the data given (no solution, or not unique)."""
