@@ -86,7 +86,8 @@ def execute(
     """Compute ``specs`` with the chosen executor, storing each point when it is done."""
     if scheduler is not None and scheduler != "local" and not scheduler.startswith("tcp://"):
         raise ParameterError(
-            f"`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', got {scheduler!r}."
+            "`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', "
+            f"got {scheduler!r}."
         )
     if n_workers is not None and (isinstance(n_workers, bool) or n_workers < 1):
         raise ParameterError(f"`n_workers` must be an integer >= 1, got {n_workers!r}.")

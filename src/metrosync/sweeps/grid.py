@@ -250,7 +250,7 @@ class Grid:
         swept_model = [name for name in self.axes if name in MODEL_PARAMETERS]
         bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed["bpm"],)
         for values in itertools.product(*(self.axes[name] for name in swept_model)):
-            params = self.model_parameters(dict(zip(swept_model, values)))
+            params = self.model_parameters(dict(zip(swept_model, values, strict=True)))
             low, high = params.metronome.bpm_range()
             bad = [b for b in bpms if not low <= b <= high]
             if bad:
@@ -309,7 +309,7 @@ class Grid:
         """Every grid point, in C order of the axes."""
         names = list(self.axes)
         for index in itertools.product(*(range(n) for n in self.shape)):
-            coords = {name: self.axes[name][i] for name, i in zip(names, index)}
+            coords = {name: self.axes[name][i] for name, i in zip(names, index, strict=True)}
             yield self._point(index, coords)
 
     def _point(self, index: tuple[int, ...], coords: dict[str, Any]) -> PointSpec:

@@ -51,7 +51,10 @@ class SweepResult:
         for index in itertools.product(*(range(n) for n in self.grid.shape)):
             message = str(ds.error.values[index])
             if message:
-                coords = {name: vals[i] for (name, vals), i in zip(self.grid.axes.items(), index)}
+                coords = {
+                    name: vals[i]
+                    for (name, vals), i in zip(self.grid.axes.items(), index, strict=True)
+                }
                 out.append((coords, message))
         return out
 
@@ -135,10 +138,11 @@ def sweep(
 def _warn_overturn(grid: Grid) -> None:
     swept = [name for name in grid.axes if name in MODEL_PARAMETERS]
     for values in itertools.product(*(grid.axes[name] for name in swept)):
-        params = grid.model_parameters(dict(zip(swept, values)))
+        params = grid.model_parameters(dict(zip(swept, values, strict=True)))
         if params.overturns:
+            where = dict(zip(swept, values, strict=True))
             warnings.warn(
-                f"with {params.name!r} parameters {dict(zip(swept, values))} the energy-balance "
+                f"with {params.name!r} parameters {where} the energy-balance "
                 f"amplitude is {params.steady_amplitude:.2f} rad > pi/2: pendulums overturn; such "
                 f"runs are flagged in `status`.",
                 OverturnWarning,
