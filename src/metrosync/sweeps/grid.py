@@ -280,12 +280,15 @@ class Grid:
             )
         axes = dict(data.get("grid", {}))
         fixed = dict(data.get("fixed", {}))
-        for name in overrides.pop("axes", {}) or {}:
+        # A parameter given on the command line replaces the file's, swept or fixed.
+        new_axes = dict(overrides.pop("axes", None) or {})
+        new_fixed = dict(overrides.pop("fixed", None) or {})
+        for name in new_axes:
             fixed.pop(name, None)
-        axes.update(overrides.get("axes", {}) or {})
-        for name in overrides.get("fixed", {}) or {}:
+        for name in new_fixed:
             axes.pop(name, None)
-        fixed.update(overrides.pop("fixed", {}) or {})
+        axes.update(new_axes)
+        fixed.update(new_fixed)
         options = {k: data[k] for k in ("seed", *OPTIONS) if k in data}
         options.update(overrides)
         return cls(axes=axes, fixed=fixed, **options)
