@@ -102,9 +102,15 @@ def bootstrap(
     r_runs = np.asarray(r_runs, dtype=float)
     rng = np.random.default_rng(seed)
     runs = r_runs.shape[-1]
-    idx = rng.integers(0, runs, size=(n_boot, *r_runs.shape))
-    replicas = np.take_along_axis(np.broadcast_to(r_runs, idx.shape), idx, axis=-1)
-    return estimate(bpm, replicas)
+    # In batches, so that memory stays bounded for many runs and replicas.
+    batch = max(1, 2_000_000 // r_runs.size)
+    parts: dict[str, list[np.ndarray]] = {m: [] for m in METHODS}
+    for start in range(0, n_boot, batch):
+        idx = rng.integers(0, runs, size=(min(batch, n_boot - start), *r_runs.shape))
+        replicas = np.take_along_axis(np.broadcast_to(r_runs, idx.shape), idx, axis=-1)
+        for m, values in estimate(bpm, replicas).items():
+            parts[m].append(values)
+    return {m: np.concatenate(parts[m]) for m in METHODS}
 
 
 @dataclass(frozen=True)
