@@ -56,7 +56,7 @@ def main() -> None:
         print(
             f"{label:>32}: {wall:7.1f} s wall (incl. start-up and merge), "
             f"{ex.throughput:.3g} oscillator-steps/s over the points, "
-            f"full Fig. 10 would take ~{wall * factor / 60:.0f} min"
+            f"so the full-size sweep would take ~{work * factor / ex.throughput / 60:.0f} min"
         )
 
 
