@@ -41,3 +41,6 @@ __all__ = [
 from .lightgate import analyze  # noqa: E402
 
 __all__ += ["analyze"]
+from .sweeps import sweep  # noqa: E402
+
+__all__ += ["sweep"]

@@ -1,0 +1,103 @@
+"""``metrosync sweep``: run a parameter grid, resumably, in process or on Dask."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import ParameterError
+
+#: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
+GRID_OPTIONS = {
+    "n": "metronomes on the disk",
+    "bpm": "nominal beat frequency, BPM",
+    "sigma": "spread of natural frequencies, BPM",
+    "runs": "independent runs per point",
+    "duration": "simulated time, s",
+    "dt": "time step, s",
+    "seed": "sweep seed (a list gives independent replicas)",
+    "drive": "escapement impulse M, N m s",
+    "c-theta": "pendulum friction, kg m2/s",
+    "c-phi": "disk friction, kg m2/s",
+    "inertia": "disk inertia J, kg m2 (inf pins the disk)",
+}
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "sweep",
+        help="run a parameter grid (resumable; in process or on a Dask cluster)",
+        description=(
+            "Run one ensemble simulation per grid point and merge them into one NetCDF file "
+            "with a dimension per swept parameter. Give a value (fixed) or a grid "
+            "(START:STOP:STEP or a comma list) to any parameter option, and/or a TOML grid "
+            "file. Finished points are kept in the store, so running the same command again "
+            "after an interruption computes only what is missing."
+        ),
+    )
+    parser.add_argument("grid", nargs="?", type=Path, help="TOML grid file ([grid], [fixed])")
+    g = parser.add_argument_group("parameters (VALUE or START:STOP:STEP or A,B,C)")
+    for name, text in GRID_OPTIONS.items():
+        g.add_argument(f"--{name}", metavar="SPEC", default=None, help=text)
+    g.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=SPEC",
+                   help="any model parameter, e.g. --set l1=0.035 (repeatable)")  # fmt: skip
+    g.add_argument("--preset", default=None, help="parameter preset (default: 'default')")
+    o = parser.add_argument_group("run")
+    o.add_argument("--out", type=Path, required=True, help="merged result, FILE.nc")
+    o.add_argument("--store", type=Path, default=None,
+                   help="finished points directory (default: OUT with suffix .points)")  # fmt: skip
+    o.add_argument("--keep-r", action="store_true", help="also keep r(t) of every run")
+    o.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+                   help="run on a Dask LocalCluster or an existing Dask scheduler")  # fmt: skip
+    o.add_argument("--workers", type=int, default=None, help="workers of --scheduler local")
+    o.add_argument("--retry-failed", action="store_true", help="recompute points stored as failed")
+    o.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.set_defaults(func=run)
+
+
+def grid_from_args(args):
+    from ..sweeps.grid import Grid
+
+    axes, fixed = {}, {}
+    items = [
+        (name.replace("-", "_"), getattr(args, name.replace("-", "_"))) for name in GRID_OPTIONS
+    ]
+    for item in args.changes:
+        name, sep, spec = item.partition("=")
+        if not sep or not spec.strip():
+            raise ParameterError(f"`--set` expects NAME=SPEC, got {item!r}.")
+        items.append((name.strip(), spec.strip()))
+    for name, spec in items:
+        if spec is None:
+            continue
+        name = "sigma_bpm" if name == "sigma" else name
+        (axes if (":" in spec or "," in spec) else fixed)[name] = spec
+    options = {"keep_r": True} if args.keep_r else {}
+    if args.preset is not None:
+        options["preset"] = args.preset
+    if args.grid is not None:
+        return Grid.from_toml(args.grid, axes=axes, fixed=fixed, **options)
+    if not axes:
+        raise ParameterError(
+            "nothing to sweep: give a grid file or a grid to some option, e.g. --bpm 150:220:2.5."
+        )
+    return Grid(axes=axes, fixed=fixed, **options)
+
+
+def run(args) -> int:
+    from ..sweeps import sweep
+
+    grid = grid_from_args(args)
+    store = args.store if args.store is not None else args.out.with_suffix(".points")
+    shape = dict(zip(grid.axes, grid.shape, strict=True))
+    print(f"metrosync sweep: {grid.size} points, grid {shape}, store {store}")
+    result = sweep(
+        grid,
+        store,
+        out=args.out,
+        scheduler=args.scheduler,
+        n_workers=args.workers,
+        progress=False if args.no_progress else None,
+        retry_failed=args.retry_failed,
+    )
+    print(result.summary())
+    return 0 if result.complete else 1

@@ -1,0 +1,14 @@
+"""Parameter sweeps: grids, a resumable point store, executors, and ω_c analysis.
+
+``grid``       swept axes, fixed settings, per-point seeds and content hashes
+``store``      one atomically written file per finished point; the merged dataset
+``executors``  in process, Dask LocalCluster, or an existing Dask cluster
+``sweep``      the `sweep` entry point
+``critical``   the critical frequency ω_c(N) and its finite-size extrapolation
+"""
+
+from .grid import Grid, parse_values
+from .store import PointStore, merge
+from .sweep import SweepResult, sweep
+
+__all__ = ["Grid", "PointStore", "SweepResult", "merge", "parse_values", "sweep"]

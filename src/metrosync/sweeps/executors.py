@@ -1,0 +1,174 @@
+"""Executors: where grid points run.
+
+Contract: `execute` computes the given points and writes each to the store as soon as
+it is done, from the calling process (the store never needs to be shared with remote
+workers). Each point is one `metrosync.simulate` call, a pure function of its
+`PointSpec`, so the stored results do not depend on the executor:
+
+``None``            in this process, one point after another; the compiled kernel
+                    already spreads each point's runs over all cores.
+``"local"``         a Dask `LocalCluster` on 127.0.0.1, one single-threaded process
+                    per worker (points in parallel).
+``"tcp://H:P"``     an existing Dask scheduler (``dask.distributed``), so a sweep can
+                    use many machines.
+
+A point whose simulation raises is stored as failed (with the message) and the sweep
+goes on; a point lost with its worker is not stored, so the next run computes it.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from tqdm import tqdm
+
+from ..errors import OverturnWarning, ParameterError
+from .grid import PointSpec
+from .store import PointStore, point_dataset
+
+
+@dataclass
+class Execution:
+    """What one `execute` call did.
+
+    computed : keys computed now.   failed : key -> error message (stored as failed).
+    lost : key -> why no result came back (not stored; the next run retries them).
+    seconds : wall time.   work : oscillator-steps computed now.
+    """
+
+    computed: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    lost: dict[str, str] = field(default_factory=dict)
+    seconds: float = 0.0
+    work: int = 0
+
+    @property
+    def throughput(self) -> float:
+        """Oscillator-steps per second of wall time."""
+        return self.work / self.seconds if self.seconds > 0 else float("nan")
+
+
+def run_point(spec: PointSpec, threads: int | None = None):
+    """Simulate one point; returns (point dataset, seconds, host). Never raises for a
+    simulation error: that becomes a failed point."""
+    from ..simulate import simulate
+
+    if threads is not None:
+        import numba
+
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    started = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            # The sweep warns once up front; overturned runs are flagged in `status`.
+            warnings.simplefilter("ignore", OverturnWarning)
+            result = simulate(**spec.kwargs, trajectories=False, progress=False)
+        ds = point_dataset(spec, result)
+    except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
+        ds = point_dataset(spec, None, f"{type(error).__name__}: {error}")
+    return ds, time.perf_counter() - started, socket.gethostname()
+
+
+def execute(
+    specs: Sequence[PointSpec],
+    store: PointStore,
+    *,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool = False,
+) -> Execution:
+    """Compute ``specs`` with the chosen executor, storing each point when it is done."""
+    if scheduler is not None and scheduler != "local" and not scheduler.startswith("tcp://"):
+        raise ParameterError(
+            "`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', "
+            f"got {scheduler!r}."
+        )
+    if n_workers is not None and (isinstance(n_workers, bool) or n_workers < 1):
+        raise ParameterError(f"`n_workers` must be an integer >= 1, got {n_workers!r}.")
+    report = Execution()
+    started = time.perf_counter()
+    total = sum(spec.work for spec in specs)
+    with tqdm(
+        total=total, unit="osc-step", unit_scale=True, desc="sweep", disable=not progress,
+        dynamic_ncols=True, leave=False,
+    ) as bar:  # fmt: skip
+
+        def done(spec: PointSpec, ds, seconds: float, host: str) -> None:
+            store.write(ds, seconds=seconds, host=host)
+            report.computed.append(spec.key)
+            if ds.attrs["error"]:
+                report.failed[spec.key] = ds.attrs["error"]
+            else:
+                report.work += spec.work
+            bar.update(spec.work)
+            bar.set_postfix_str(f"{len(report.computed)}/{len(specs)} points", refresh=False)
+
+        try:
+            if scheduler is None:
+                for spec in specs:
+                    done(spec, *run_point(spec))
+            else:
+                _execute_dask(specs, scheduler, n_workers, done, report)
+        finally:
+            report.seconds = time.perf_counter() - started
+    return report
+
+
+def _execute_dask(specs, scheduler, n_workers, done, report) -> None:
+    try:
+        from dask.distributed import Client, LocalCluster, as_completed
+    except ImportError:  # pragma: no cover - dask[distributed] is a dependency
+        raise ParameterError(
+            "`scheduler` needs dask.distributed: pip install 'dask[distributed]'."
+        ) from None
+    cluster = None
+    if scheduler == "local":
+        workers = n_workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
+        threads = max(1, (os.cpu_count() or 1) // workers)
+        client = Client(cluster)
+    else:
+        if n_workers is not None:
+            raise ParameterError(
+                "`n_workers` applies to scheduler='local' only; an existing cluster has its own."
+            )
+        threads = None
+        try:
+            client = Client(scheduler, timeout="20s")
+        except OSError as error:
+            raise ParameterError(
+                f"cannot reach the Dask scheduler at {scheduler!r}: {error}"
+            ) from None
+    try:
+        by_key = {}
+        for spec in specs:
+            future = client.submit(
+                run_point, spec, threads, key=f"metrosync-point-{spec.key}", retries=1
+            )
+            by_key[future.key] = (spec, future)
+        for future in as_completed([f for _, f in by_key.values()]):
+            spec, _ = by_key[future.key]
+            try:
+                ds, seconds, host = future.result()
+            except Exception as error:  # noqa: BLE001 - a lost worker loses a point, not the sweep
+                report.lost[spec.key] = f"{type(error).__name__}: {error}"
+                continue
+            done(spec, ds, seconds, host)
+            future.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

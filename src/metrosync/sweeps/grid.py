@@ -1,0 +1,386 @@
+"""Sweep grids: which parameters vary, over which values, and what every point runs.
+
+Contract: a `Grid` holds the swept axes (name -> tuple of values, in order) and the
+fixed settings. Every point of the Cartesian product becomes a `PointSpec`: the full
+keyword arguments of one `metrosync.simulate` call plus a content hash. The hash
+covers every input that can change the result (all ensemble settings, the fully
+resolved model parameters, the point's seed, what is kept, and the package version),
+so a stored point is reused only when it would be recomputed bit for bit.
+
+Values come from TOML (`Grid.from_toml`) or from text (`parse_values`):
+``150:220:2.5`` is an inclusive range with a step, ``7,16,32`` a list, ``192`` a
+single value. Each point's seed is drawn from the sweep seed and the point's own
+parameter values (not its position in the grid), so enlarging a grid leaves the
+points already computed valid, and any executor reproduces the same draws.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..errors import ParameterError, describe
+from ..model import MetronomeDesign, Platform, get_preset
+
+#: Ensemble settings of `simulate`, with their type and default in a sweep.
+ENSEMBLE_SETTINGS: dict[str, tuple[type, Any]] = {
+    "n": (int, 7),
+    "bpm": (float, 192.0),
+    "sigma_bpm": (float, 0.75),
+    "runs": (int, 20),
+    "duration": (float, 600.0),
+    "dt": (float, 0.01),
+    "seed": (int, 0),
+}
+#: Model parameters that can be swept or fixed (routed through ``simulate(changes=)``).
+MODEL_PARAMETERS = tuple(
+    sorted(
+        name
+        for name in (*MetronomeDesign.__dataclass_fields__, *Platform.__dataclass_fields__)
+        if name != "l2_bounds"
+    )
+)
+#: Other names people use for the same parameter.
+ALIASES = {
+    "N": "n",
+    "omega0": "bpm",
+    "sigma": "sigma_bpm",
+    "M": "drive",
+    "J": "inertia",
+    "seeds": "seed",
+}
+UNITS = {
+    "bpm": "BPM",
+    "sigma_bpm": "BPM",
+    "duration": "s",
+    "dt": "s",
+    "drive": "N m s",
+    "c_theta": "kg m2/s",
+    "c_phi": "kg m2/s",
+    "inertia": "kg m2",
+    "j0": "kg m2",
+    "j_per_metronome": "kg m2",
+    "w1": "kg",
+    "w2": "kg",
+    "l1": "m",
+    "radius": "m",
+    "g": "m/s2",
+}
+#: Grid size above which a typo (e.g. a step of 0.0025 for 2.5) is more likely than intent.
+MAX_POINTS_PER_AXIS = 100_000
+#: Sweep-level options (TOML top level) and their defaults.
+OPTIONS: dict[str, Any] = {
+    "preset": "default",
+    "keep_r": False,
+    "equilibrium_window": None,
+    "record_every": None,
+    "integrator": "verlet",
+    "backend": "numba",
+}
+
+
+def canonical_name(name: str) -> str:
+    """The parameter's canonical name, or a `ParameterError` listing the valid ones."""
+    name = ALIASES.get(name, name).replace("-", "_")
+    if name not in ENSEMBLE_SETTINGS and name not in MODEL_PARAMETERS:
+        valid = sorted({*ENSEMBLE_SETTINGS, *MODEL_PARAMETERS, *ALIASES})
+        raise ParameterError(f"unknown sweep parameter {name!r}; valid names: {valid}.")
+    return name
+
+
+def _kind(name: str) -> type:
+    return ENSEMBLE_SETTINGS[name][0] if name in ENSEMBLE_SETTINGS else float
+
+
+def _convert(name: str, value: Any) -> int | float:
+    """One checked value of parameter ``name``."""
+    if isinstance(value, bool) or not isinstance(
+        value, int | float | np.integer | np.floating | str
+    ):
+        raise ParameterError(f"`{name}` values must be numbers, got {describe(value)}.")
+    try:
+        number = float(value)
+    except ValueError:
+        raise ParameterError(f"`{name}`: {value!r} is not a number.") from None
+    if not math.isfinite(number) and not (name == "inertia" and number == math.inf):
+        raise ParameterError(f"`{name}` values must be finite, got {value!r}.")
+    if _kind(name) is int:
+        if number != int(number):
+            raise ParameterError(f"`{name}` takes whole numbers, got {value!r}.")
+        number = int(number)
+        lowest = 0 if name == "seed" else 1
+        if number < lowest:
+            raise ParameterError(f"`{name}` must be >= {lowest}, got {value!r}.")
+        return number
+    if name in ("duration", "dt") and number <= 0:
+        raise ParameterError(f"`{name}` must be > 0 s, got {value!r}.")
+    if name == "sigma_bpm" and number < 0:
+        raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {value!r}.")
+    # 12 significant digits undo float drift of ranges (0.1*3 -> 0.3) so values hash stably.
+    return float(f"{number:.12g}")
+
+
+def parse_values(name: str, spec: Any) -> tuple:
+    """Values of one parameter from a range ``"a:b:step"``, a list, or a single value.
+
+    Ranges include ``b`` when it lies on the grid (within 1e-9 of a step).
+
+    Examples
+    --------
+    >>> parse_values("bpm", "180:190:2.5")
+    (180.0, 182.5, 185.0, 187.5, 190.0)
+    >>> parse_values("n", "7,16,32")
+    (7, 16, 32)
+    """
+    if isinstance(spec, list | tuple):
+        items = list(spec)
+    elif isinstance(spec, str) and ":" in spec:
+        parts = spec.split(":")
+        if len(parts) != 3:
+            raise ParameterError(
+                f"`{name}` range {spec!r} must read START:STOP:STEP, e.g. 150:220:2.5."
+            )
+        try:
+            start, stop, step = (float(p) for p in parts)
+        except ValueError:
+            raise ParameterError(
+                f"`{name}` range {spec!r}: START, STOP, STEP must be numbers."
+            ) from None
+        if not all(math.isfinite(v) for v in (start, stop, step)) or step <= 0 or stop < start:
+            raise ParameterError(
+                f"`{name}` range {spec!r} needs finite START <= STOP and STEP > 0."
+            )
+        count = math.floor((stop - start) / step + 1e-9) + 1
+        if count > MAX_POINTS_PER_AXIS:
+            raise ParameterError(
+                f"`{name}` range {spec!r} has {count} values (more than {MAX_POINTS_PER_AXIS}); "
+                f"check STEP."
+            )
+        items = [start + k * step for k in range(count)]
+    elif isinstance(spec, str):
+        items = [item for item in spec.split(",") if item.strip()]
+    else:
+        items = [spec]
+    if not items:
+        raise ParameterError(f"`{name}` has no values, got {spec!r}.")
+    values = tuple(_convert(name, item) for item in items)
+    if len(set(values)) != len(values):
+        raise ParameterError(f"`{name}` lists a value twice: {values!r}.")
+    return values
+
+
+@dataclass(frozen=True)
+class PointSpec:
+    """One grid point: where it sits, what it runs, and its content hash.
+
+    index : position along each axis.   coords : swept name -> value.
+    kwargs : the complete keyword arguments of `metrosync.simulate`.
+    keep_r : keep r(t) per run.   key : content hash (hex).   work : oscillator-steps.
+    """
+
+    index: tuple[int, ...]
+    coords: dict[str, Any]
+    kwargs: dict[str, Any]
+    keep_r: bool
+    key: str
+    work: int
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Swept axes and fixed settings of a sweep.
+
+    Parameters
+    ----------
+    axes : swept parameter -> values (each a list, a tuple or a text spec, see
+        `parse_values`); the order of the axes is the order of the dimensions.
+    fixed : parameters held fixed (ensemble settings or model parameters by name).
+    seed : the sweep seed; each point's seed derives from it and the point's values.
+        Sweeping ``seed`` instead gives independent replicas of the whole grid.
+    preset : the model preset the changes apply to.
+    keep_r : keep r(t) of every run (large: points × runs × records).
+    equilibrium_window, record_every, integrator, backend : passed to `simulate`.
+    """
+
+    axes: Mapping[str, Any]
+    fixed: Mapping[str, Any] = field(default_factory=dict)
+    seed: int = 0
+    preset: str = "default"
+    keep_r: bool = False
+    equilibrium_window: float | None = None
+    record_every: int | None = None
+    integrator: str = "verlet"
+    backend: str = "numba"
+
+    def __post_init__(self) -> None:
+        axes: dict[str, tuple] = {}
+        for raw, spec in dict(self.axes).items():
+            name = canonical_name(raw)
+            if name in axes:
+                raise ParameterError(f"`{raw}` is swept twice (as {name!r}).")
+            axes[name] = parse_values(name, spec)
+        if not axes:
+            raise ParameterError("a sweep needs at least one swept parameter in `axes`.")
+        fixed: dict[str, Any] = {}
+        for raw, value in dict(self.fixed).items():
+            name = canonical_name(raw)
+            if name in axes:
+                raise ParameterError(f"`{name}` is both swept and fixed; keep one.")
+            (fixed[name],) = parse_values(name, value)
+        for name, (_, default) in ENSEMBLE_SETTINGS.items():
+            if name not in axes and name not in fixed:
+                fixed[name] = self.seed if name == "seed" else default
+        object.__setattr__(self, "axes", axes)
+        object.__setattr__(self, "fixed", fixed)
+        get_preset(self.preset, warn=False)  # an unknown preset fails here, not per point
+        self._check_model()
+
+    def _check_model(self) -> None:
+        """Build every distinct parameter set once, so bad values fail before any work."""
+        swept_model = [name for name in self.axes if name in MODEL_PARAMETERS]
+        bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed["bpm"],)
+        for values in itertools.product(*(self.axes[name] for name in swept_model)):
+            params = self.model_parameters(dict(zip(swept_model, values, strict=True)))
+            low, high = params.metronome.bpm_range()
+            bad = [b for b in bpms if not low <= b <= high]
+            if bad:
+                raise ParameterError(
+                    f"`bpm` = {bad[0]!r} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+                    f"of the metronome design; narrow the `bpm` axis."
+                )
+
+    @classmethod
+    def from_toml(cls, path: str | Path, **overrides) -> Grid:
+        """Read a grid from TOML: ``[grid]`` swept values, ``[fixed]`` fixed ones, and
+        top-level ``seed``, ``preset``, ``keep_r``, ``equilibrium_window``,
+        ``record_every``, ``integrator``, ``backend``. ``overrides`` replace or extend
+        (``axes``/``fixed`` are merged by name)."""
+        path = Path(path)
+        try:
+            data = tomllib.loads(path.read_text())
+        except OSError as error:
+            raise ParameterError(f"cannot read grid file {str(path)!r}: {error}") from None
+        except tomllib.TOMLDecodeError as error:
+            raise ParameterError(f"grid file {str(path)!r} is not valid TOML: {error}") from None
+        unknown = set(data) - {"grid", "fixed", "seed", *OPTIONS}
+        if unknown:
+            raise ParameterError(
+                f"grid file {str(path)!r}: unknown key(s) {sorted(unknown)}; expected [grid], "
+                f"[fixed], seed, {', '.join(OPTIONS)}."
+            )
+        axes = dict(data.get("grid", {}))
+        fixed = dict(data.get("fixed", {}))
+        # A parameter given on the command line replaces the file's, swept or fixed.
+        new_axes = dict(overrides.pop("axes", None) or {})
+        new_fixed = dict(overrides.pop("fixed", None) or {})
+        for name in new_axes:
+            fixed.pop(name, None)
+        for name in new_fixed:
+            axes.pop(name, None)
+        axes.update(new_axes)
+        fixed.update(new_fixed)
+        options = {k: data[k] for k in ("seed", *OPTIONS) if k in data}
+        options.update(overrides)
+        return cls(axes=axes, fixed=fixed, **options)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(len(values) for values in self.axes.values())
+
+    @property
+    def size(self) -> int:
+        return math.prod(self.shape)
+
+    def model_parameters(self, swept: Mapping[str, Any] | None = None):
+        """The resolved `ModelParameters` for the fixed changes plus ``swept`` ones."""
+        changes = {k: v for k, v in self.fixed.items() if k in MODEL_PARAMETERS}
+        changes.update({k: v for k, v in (swept or {}).items() if k in MODEL_PARAMETERS})
+        params = get_preset(self.preset, warn=False)
+        return params.with_changes(**changes) if changes else params
+
+    def points(self) -> Iterator[PointSpec]:
+        """Every grid point, in C order of the axes."""
+        names = list(self.axes)
+        for index in itertools.product(*(range(n) for n in self.shape)):
+            coords = {name: self.axes[name][i] for name, i in zip(names, index, strict=True)}
+            yield self._point(index, coords)
+
+    def _point(self, index: tuple[int, ...], coords: dict[str, Any]) -> PointSpec:
+        values = {**self.fixed, **coords}
+        changes = {k: v for k, v in values.items() if k in MODEL_PARAMETERS}
+        kwargs = {
+            "n": values["n"],
+            "bpm": values["bpm"],
+            "sigma_bpm": values["sigma_bpm"],
+            "runs": values["runs"],
+            "duration": values["duration"],
+            "dt": values["dt"],
+            "seed": point_seed(values["seed"], {k: v for k, v in values.items() if k != "seed"}),
+            "preset": self.preset,
+            "changes": changes or None,
+            "integrator": self.integrator,
+            "backend": self.backend,
+            "record_every": self.record_every,
+            "equilibrium_window": self.equilibrium_window,
+        }
+        resolved = self.model_parameters(coords).as_dict()
+        resolved.pop("preset")  # the name changes with `changes`; the values are what count
+        key_input = {
+            "simulate": kwargs,
+            "model": resolved,
+            "keep_r": self.keep_r,
+            "metrosync_version": __version__,
+        }
+        key = hashlib.sha256(_canonical_json(key_input).encode()).hexdigest()
+        steps = round(values["duration"] / values["dt"])
+        work = values["runs"] * values["n"] * steps
+        return PointSpec(index, coords, kwargs, self.keep_r, key, work)
+
+    def describe(self) -> dict[str, Any]:
+        """Every setting as file attributes (NetCDF-safe types)."""
+        attrs: dict[str, Any] = {f"fixed_{k}": _attr(v) for k, v in self.fixed.items()}
+        attrs.update(
+            swept=" ".join(self.axes),
+            sweep_seed=self.fixed.get("seed", self.seed) if "seed" not in self.axes else "swept",
+            preset=self.preset,
+            keep_r=int(self.keep_r),
+            integrator=self.integrator,
+            backend=self.backend,
+            equilibrium_window=_attr(self.equilibrium_window),
+            record_every=_attr(self.record_every),
+            metrosync_version=__version__,
+        )
+        unswept = {k: v for k, v in self.model_parameters().as_dict().items() if k not in self.axes}
+        attrs.update({f"model_{k}": _attr(v) for k, v in unswept.items()})
+        return attrs
+
+
+def point_seed(sweep_seed: int, values: Mapping[str, Any]) -> int:
+    """A 63-bit seed for one point, a pure function of the sweep seed and its values."""
+    digest = hashlib.sha256(_canonical_json(dict(values)).encode()).digest()
+    entropy = [int(sweep_seed), int.from_bytes(digest[:16], "little")]
+    return int(np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
+def _canonical_json(obj: Any) -> str:
+    return json.dumps(obj, sort_keys=True, default=repr, allow_nan=True)
+
+
+def _attr(value: Any) -> Any:
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return int(value)
+    if isinstance(value, float) and math.isinf(value):
+        return "inf"
+    return value

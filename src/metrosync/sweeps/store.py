@@ -1,0 +1,210 @@
+"""The point store: one file per finished grid point, and the merged sweep.
+
+Contract: a store is a directory. ``points/<key>.nc`` holds one finished point, named
+by its content hash (`PointSpec.key`), written to a temporary file and moved into
+place with `os.replace`, so a file at that name is always complete; a crash loses at
+most the points in flight. A point is finished when its file exists; a sweep started
+again skips those points, and a point whose inputs changed has another key, so a
+stale file is never read for it. ``log.jsonl`` gets one line per point computed
+(key, seconds, host), appended after the file is in place.
+
+`merge` gathers the points of a grid into one `xarray.Dataset` with one dimension per
+swept parameter (plus ``run``, and ``time`` when r(t) is kept). Point files hold only
+deterministic content, so the merge does not depend on which executor ran them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import uuid
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from ..integrators._state import STATUS_MEANINGS
+from .grid import UNITS, Grid, PointSpec
+
+#: Status of every run of a point whose simulation raised (no result).
+STATUS_FAILED = 4
+#: Status value of a run that does not exist (a point with fewer runs than the largest).
+STATUS_ABSENT = -1
+FLAG_MEANINGS = {**STATUS_MEANINGS, STATUS_FAILED: "failed"}
+
+
+def point_dataset(spec: PointSpec, result: xr.Dataset | None, error: str = "") -> xr.Dataset:
+    """What is kept of one point: per-run r_eq and status, and optionally r(t).
+
+    ``result`` is the `simulate` output, or None with ``error`` saying why it failed.
+    """
+    runs = spec.kwargs["runs"]
+    attrs = {"key": spec.key, "seed": spec.kwargs["seed"], "error": error}
+    if result is None:
+        nan = np.full(runs, np.nan)
+        data = {
+            "r_eq": ("run", nan),
+            "r_eq_analytic": ("run", nan.copy()),
+            "status": ("run", np.full(runs, STATUS_FAILED, dtype=np.int8)),
+        }
+        attrs.update(r_eq_mean=np.nan, r_eq_std=np.nan)
+        return xr.Dataset(data, attrs=attrs)
+    data = {
+        "r_eq": ("run", result.r_eq.values),
+        "r_eq_analytic": ("run", result.r_eq_analytic.values),
+        "status": ("run", result.status.values.astype(np.int8)),
+    }
+    coords = {}
+    if spec.keep_r:
+        data["r"] = (("time", "run"), result.r.values)
+        data["r_crossing"] = (("time", "run"), result.r_crossing.values)
+        coords["time"] = result.time.values
+    attrs.update(r_eq_mean=result.attrs["r_eq_mean"], r_eq_std=result.attrs["r_eq_std"])
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+class PointStore:
+    """A directory of finished points (see the module docstring)."""
+
+    def __init__(self, root: str | Path) -> None:
+        self.root = Path(root)
+        self.points = self.root / "points"
+        self.log_path = self.root / "log.jsonl"
+
+    def path(self, key: str) -> Path:
+        return self.points / f"{key}.nc"
+
+    def has(self, key: str) -> bool:
+        return self.path(key).is_file()
+
+    def failed(self, key: str) -> bool:
+        """True when the stored point records a failed simulation."""
+        with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
+            return bool(ds.attrs.get("error", ""))
+
+    def write(self, ds: xr.Dataset, *, seconds: float = float("nan"), host: str = "") -> Path:
+        """Write one point atomically, then log it."""
+        self.points.mkdir(parents=True, exist_ok=True)
+        key = ds.attrs["key"]
+        final = self.path(key)
+        tmp = self.points / f".{key}.{uuid.uuid4().hex}.partial"
+        try:
+            ds.to_netcdf(tmp, engine="h5netcdf")
+            os.replace(tmp, final)
+        finally:
+            tmp.unlink(missing_ok=True)
+        line = json.dumps(
+            {"key": key, "seconds": round(seconds, 4), "host": host or socket.gethostname()}
+        )
+        with open(self.log_path, "a") as log:
+            log.write(line + "\n")
+        return final
+
+    def read(self, key: str) -> xr.Dataset:
+        with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
+            loaded = ds.load()
+        if loaded.attrs.get("key") != key:
+            raise OSError(f"point file {self.path(key)} holds key {loaded.attrs.get('key')!r}")
+        return loaded
+
+    def logged_keys(self) -> list[str]:
+        """Keys of every computation logged, in order (a key twice = computed twice)."""
+        if not self.log_path.exists():
+            return []
+        lines = self.log_path.read_text().splitlines()
+        return [json.loads(line)["key"] for line in lines if line.strip()]
+
+
+def merge(grid: Grid, store: PointStore) -> xr.Dataset:
+    """One dataset for the whole grid; a point not in the store is marked ``missing``.
+
+    Variables (``*axes`` = one dimension per swept parameter, in grid order):
+    r_eq, r_eq_analytic (*axes, run); status (*axes, run) int8 bit flags, -1 for no
+    such run; r_eq_mean, r_eq_std, n_flagged, seed, error (*axes); and with
+    ``keep_r`` r, r_crossing (*axes, time, run).
+    """
+    specs = list(grid.points())
+    loaded: dict[tuple[int, ...], xr.Dataset | None] = {
+        spec.index: store.read(spec.key) if store.has(spec.key) else None for spec in specs
+    }
+    shape = grid.shape
+    n_run = max(spec.kwargs["runs"] for spec in specs)
+    r_eq = np.full((*shape, n_run), np.nan)
+    r_eq_analytic = np.full((*shape, n_run), np.nan)
+    status = np.full((*shape, n_run), STATUS_ABSENT, dtype=np.int8)
+    mean = np.full(shape, np.nan)
+    std = np.full(shape, np.nan)
+    seed = np.zeros(shape, dtype=np.int64)
+    error = np.full(shape, "", dtype=object)
+    times = [ds.time.values for ds in loaded.values() if ds is not None and "time" in ds.coords]
+    time = max(times, key=len) if times else None
+    if time is not None:
+        r_t = np.full((*shape, len(time), n_run), np.nan)
+        r_cross = np.full((*shape, len(time), n_run), np.nan)
+    for spec in specs:
+        i = spec.index
+        seed[i] = spec.kwargs["seed"]
+        ds = loaded[i]
+        if ds is None:
+            error[i] = "missing"
+            continue
+        runs = ds.sizes["run"]
+        r_eq[i][:runs] = ds.r_eq.values
+        r_eq_analytic[i][:runs] = ds.r_eq_analytic.values
+        status[i][:runs] = ds.status.values
+        mean[i], std[i] = ds.attrs["r_eq_mean"], ds.attrs["r_eq_std"]
+        error[i] = ds.attrs.get("error", "")
+        if time is not None and "r" in ds:
+            steps = ds.sizes["time"]
+            r_t[i][:steps, :runs] = ds.r.values
+            r_cross[i][:steps, :runs] = ds.r_crossing.values
+    dims = tuple(grid.axes)
+    flags = {
+        "long_name": "run status bit flags (0 ok, -1 no such run)",
+        "flag_masks": np.array(list(FLAG_MEANINGS), dtype=np.int8),
+        "flag_meanings": " ".join(FLAG_MEANINGS.values()),
+    }
+    flagged = ((status > 0).sum(axis=-1)).astype(np.int64)
+    data: dict[str, Any] = {
+        "r_eq": ((*dims, "run"), r_eq, {"long_name": "equilibrium r per run (crossing phases)"}),
+        "r_eq_analytic": (
+            (*dims, "run"),
+            r_eq_analytic,
+            {"long_name": "equilibrium r per run (analytic phase)"},
+        ),
+        "status": ((*dims, "run"), status, flags),
+        "r_eq_mean": (dims, mean, {"long_name": "equilibrium r, mean over runs"}),
+        "r_eq_std": (dims, std, {"long_name": "sigma_r: std of equilibrium r over runs"}),
+        "n_flagged": (dims, flagged, {"long_name": "runs with a nonzero status"}),
+        "seed": (dims, seed, {"long_name": "seed passed to simulate for this point"}),
+        "error": (dims, error.astype(str), {"long_name": "why the point has no result ('' = ok)"}),
+    }
+    coords: dict[str, Any] = {
+        name: (name, np.asarray(values), {"units": UNITS[name]} if name in UNITS else {})
+        for name, values in grid.axes.items()
+    }
+    coords["run"] = np.arange(n_run)
+    if time is not None:
+        data["r"] = ((*dims, "time", "run"), r_t, {"long_name": "Kuramoto r (analytic phase)"})
+        data["r_crossing"] = (
+            (*dims, "time", "run"),
+            r_cross,
+            {"long_name": "Kuramoto r (crossing phases)"},
+        )
+        coords["time"] = ("time", time, {"units": "s"})
+    return xr.Dataset(data, coords=coords, attrs=grid.describe())
+
+
+def write_dataset(ds: xr.Dataset, path: str | Path) -> Path:
+    """Write the merged sweep to NetCDF atomically (a crash never leaves half a file)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.partial")
+    try:
+        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=False)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path

@@ -1,0 +1,151 @@
+"""`sweep`: run a parameter grid, resumably, on any executor, into one dataset.
+
+Contract: ``sweep(grid, store)`` computes every point of ``grid`` that the store does
+not already hold, writes each as soon as it is done, and returns the merged dataset
+(see `metrosync.sweeps.store.merge`) with a report of what was computed, reused,
+failed or lost. Calling it again with the same grid and store finishes an
+interrupted sweep and gives the same dataset as an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import itertools
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import xarray as xr
+
+from ..errors import OverturnWarning
+from .executors import Execution, execute
+from .grid import MODEL_PARAMETERS, Grid
+from .store import PointStore, merge, write_dataset
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """The merged dataset and what this call did.
+
+    dataset : the merged sweep.   store : the store directory.
+    reused : points found in the store.   execution : points computed now, failed
+    (stored with their error) and lost (not stored; a rerun computes them).
+    """
+
+    dataset: xr.Dataset
+    grid: Grid
+    store: Path
+    reused: int
+    execution: Execution
+    out: Path | None = None
+
+    @property
+    def complete(self) -> bool:
+        return not bool((self.dataset.error == "missing").any())
+
+    def failures(self) -> list[tuple[dict[str, Any], str]]:
+        """(coords, message) of every point without a result, failed or missing."""
+        ds = self.dataset
+        out = []
+        for index in itertools.product(*(range(n) for n in self.grid.shape)):
+            message = str(ds.error.values[index])
+            if message:
+                coords = {
+                    name: vals[i]
+                    for (name, vals), i in zip(self.grid.axes.items(), index, strict=True)
+                }
+                out.append((coords, message))
+        return out
+
+    def summary(self) -> str:
+        ex = self.execution
+        ds = self.dataset
+        lines = [
+            f"metrosync sweep: {self.grid.size} points over {', '.join(self.grid.axes)}; "
+            f"{len(ex.computed)} computed, {self.reused} reused from {self.store}",
+            f"  {ex.seconds:.2f} s wall, {ex.work:.3g} oscillator-steps, "
+            f"{ex.throughput:.3g} oscillator-steps/s",
+            f"  runs flagged (overturned/diverged): {int(ds.n_flagged.sum())}",
+        ]
+        failures = self.failures()
+        if failures:
+            lines.append(f"  {len(failures)} point(s) without a result:")
+            for coords, message in failures[:20]:
+                where = ", ".join(f"{k}={v}" for k, v in coords.items())
+                lines.append(f"    {where}: {message}")
+            if len(failures) > 20:
+                lines.append(f"    ... and {len(failures) - 20} more")
+        if ex.lost:
+            lines.append("  points lost with their worker are computed when the sweep runs again")
+        if self.out is not None:
+            lines.append(f"  wrote {self.out}")
+        return "\n".join(lines)
+
+
+def sweep(
+    grid: Grid | Mapping[str, Any],
+    store: str | Path,
+    *,
+    out: str | Path | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool | None = None,
+    retry_failed: bool = False,
+    fixed: Mapping[str, Any] | None = None,
+    **grid_options: Any,
+) -> SweepResult:
+    """Run every point of a parameter grid and merge the results.
+
+    Parameters
+    ----------
+    grid : a `Grid`, or its swept axes (name -> values, e.g. ``{"bpm": "150:220:2.5",
+        "n": [7, 16]}``), completed by ``fixed`` and ``grid_options`` (``seed``,
+        ``preset``, ``keep_r``, ... see `Grid`).
+    store : directory of finished points; reused across calls and across grids.
+    out : also write the merged dataset to this NetCDF file (atomically).
+    scheduler : None (in process), ``"local"`` (Dask LocalCluster on loopback) or
+        ``"tcp://HOST:PORT"`` (an existing Dask cluster).
+    n_workers : worker processes for ``"local"`` (default: one per core).
+    progress : show a progress bar with ETA; default when stderr is a terminal.
+    retry_failed : compute again the points stored as failed.
+
+    Returns
+    -------
+    SweepResult, whose ``dataset`` has one dimension per swept parameter.
+    """
+    import sys
+
+    if not isinstance(grid, Grid):
+        grid = Grid(axes=grid, fixed=fixed or {}, **grid_options)
+    elif fixed or grid_options:
+        raise TypeError("give `fixed` and grid options only with a mapping of axes, not a Grid.")
+    _warn_overturn(grid)
+    points = PointStore(store)
+    specs = list(grid.points())
+    todo = [
+        spec
+        for spec in specs
+        if not points.has(spec.key) or (retry_failed and points.failed(spec.key))
+    ]
+    show = sys.stderr.isatty() if progress is None else progress
+    execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
+    dataset = merge(grid, points)
+    out_path = write_dataset(dataset, out) if out is not None else None
+    return SweepResult(dataset, grid, points.root, len(specs) - len(todo), execution, out_path)
+
+
+def _warn_overturn(grid: Grid) -> None:
+    swept = [name for name in grid.axes if name in MODEL_PARAMETERS]
+    for values in itertools.product(*(grid.axes[name] for name in swept)):
+        params = grid.model_parameters(dict(zip(swept, values, strict=True)))
+        if params.overturns:
+            where = dict(zip(swept, values, strict=True))
+            warnings.warn(
+                f"with {params.name!r} parameters {where} the energy-balance "
+                f"amplitude is {params.steady_amplitude:.2f} rad > pi/2: pendulums overturn; such "
+                f"runs are flagged in `status`.",
+                OverturnWarning,
+                stacklevel=3,
+            )
+            return

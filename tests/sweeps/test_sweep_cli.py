@@ -1,0 +1,47 @@
+"""``metrosync sweep`` and ``metrosync critical`` from the command line."""
+
+import xarray as xr
+
+from metrosync.cli import main
+
+
+def test_sweep_then_critical(tmp_path, capsys):
+    out = tmp_path / "s.nc"
+    args = ["sweep", "--bpm", "184:192:2", "--n", "2,3", "--runs", "4", "--duration", "5",
+            "--set", "c_phi=2e-5", "--out", str(out), "--no-progress"]  # fmt: skip
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "10 computed, 0 reused" in text and "oscillator-steps/s" in text
+    assert (tmp_path / "s.points" / "points").is_dir()
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.r_eq.dims == ("n", "bpm", "run") and ds.attrs["fixed_c_phi"] == 2e-5
+    assert main(args) == 0
+    assert "0 computed, 10 reused" in capsys.readouterr().out
+
+    assert main(["critical", str(out), "--bootstrap", "50", "--out", str(tmp_path / "c.nc")]) == 0
+    text = capsys.readouterr().out
+    assert "omega_c (sigma_r peak)" in text and "N -> inf (peak)" in text
+    assert (tmp_path / "s_critical.png").stat().st_size > 0
+    with xr.open_dataset(tmp_path / "c.nc", engine="h5netcdf") as c:
+        assert c.omega_c_peak.dims == ("n",) and c.omega_c_peak.attrs["units"] == "BPM"
+
+
+def test_grid_file_with_overrides(tmp_path, capsys):
+    grid = tmp_path / "g.toml"
+    grid.write_text('[grid]\nbpm = "186:190:2"\n[fixed]\nn = 2\nruns = 2\nduration = 5\n')
+    out = tmp_path / "g.nc"
+    assert main(["sweep", str(grid), "--sigma", "0,0.5", "--out", str(out), "--no-progress"]) == 0
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert dict(ds.sizes) == {"bpm": 3, "sigma_bpm": 2, "run": 2}
+
+
+def test_errors_are_reported_not_raised(tmp_path, capsys):
+    out = str(tmp_path / "x.nc")
+    assert main(["sweep", "--bpm", "150:220", "--out", out]) == 2
+    assert "START:STOP:STEP" in capsys.readouterr().err
+    assert main(["sweep", "--runs", "4", "--out", out]) == 2
+    assert "nothing to sweep" in capsys.readouterr().err
+    assert main(["sweep", "--bpm", "180,190", "--set", "colour=1", "--out", out]) == 2
+    assert "unknown sweep parameter 'colour'" in capsys.readouterr().err
+    assert main(["critical", str(tmp_path / "missing.nc")]) == 2
+    assert "cannot read sweep" in capsys.readouterr().err
