@@ -36,4 +36,20 @@ __all__ = [
     "get_preset",
     "omega_to_bpm",
     "simulate",
+    "animate",
+    "plot_run",
+    "write_page",
+    "write_wav",
 ]
+
+#: Names served lazily from `metrosync.show`, so that importing metrosync does not
+#: import matplotlib.
+_SHOW = ("animate", "plot_run", "write_page", "write_wav")
+
+
+def __getattr__(name: str):
+    if name in _SHOW:
+        from . import show
+
+        return getattr(show, name)
+    raise AttributeError(f"module 'metrosync' has no attribute {name!r}")

@@ -5,6 +5,8 @@ recorded, through `RecordedRun`; none of them simulates again.
 """
 
 from .animation import animate
+from .page import write_page
+from .plots import plot_run
 from .recording import NoTrajectoriesError, RecordedRun
 from .sound import ClickTrack, click_track, crossing_times, write_wav
 
@@ -15,5 +17,7 @@ __all__ = [
     "animate",
     "click_track",
     "crossing_times",
+    "plot_run",
+    "write_page",
     "write_wav",
 ]
