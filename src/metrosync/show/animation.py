@@ -39,10 +39,14 @@ ROD_SCALE = 0.35
 PHASE_CMAP = "hsv"
 
 
+def frame_count(start: float, end: float, fps: float, speedup: float) -> int:
+    """Number of frames of the window [start, end]: floor((end − start)·fps/speedup) + 1."""
+    return int(math.floor((end - start) * fps / speedup + 1e-9)) + 1
+
+
 def frame_times(start: float, end: float, fps: float, speedup: float) -> np.ndarray:
     """(K,) simulated times of the frames: start + k·speedup/fps, k = 0 … K−1."""
-    count = int(math.floor((end - start) * fps / speedup + 1e-9)) + 1
-    return start + np.arange(count) * (speedup / fps)
+    return start + np.arange(frame_count(start, end, fps, speedup)) * (speedup / fps)
 
 
 def _check_positive(name: str, value) -> float:
@@ -181,12 +185,13 @@ def animate(
     writer = writer_for(path, fps)
     recorded = RecordedRun.from_dataset(ds, run)
     start, end = recorded.window(start, end)
-    times = frame_times(start, end, fps, speedup)
-    if times.size > MAX_FRAMES:
+    count = frame_count(start, end, fps, speedup)
+    if count > MAX_FRAMES:
         raise ParameterError(
-            f"{times.size} frames exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
+            f"{count} frames exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
             f"lower `fps` (now {fps:g}) or shorten the window."
         )
+    times = frame_times(start, end, fps, speedup)
     view = DiskView(recorded, start, end, size=size)
     path.parent.mkdir(parents=True, exist_ok=True)
     # The writers pick the format from the suffix, so the temporary name keeps it.
