@@ -36,6 +36,10 @@ __all__ = [
     "get_preset",
     "omega_to_bpm",
     "simulate",
+    "animate",
+    "plot_run",
+    "write_page",
+    "write_wav",
 ]
 
 from .lightgate import analyze  # noqa: E402
@@ -44,3 +48,15 @@ __all__ += ["analyze"]
 from .sweeps import sweep  # noqa: E402
 
 __all__ += ["sweep"]
+
+#: Names served lazily from `metrosync.show`, so that importing metrosync does not
+#: import matplotlib.
+_SHOW = ("animate", "plot_run", "write_page", "write_wav")
+
+
+def __getattr__(name: str):
+    if name in _SHOW:
+        from . import show
+
+        return getattr(show, name)
+    raise AttributeError(f"module 'metrosync' has no attribute {name!r}")

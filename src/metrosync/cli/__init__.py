@@ -14,7 +14,10 @@ import warnings
 from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("simulate", "presets", "run_default", "analyze", "calibrate", "sweep", "critical")
+SUBCOMMANDS = (
+    "simulate", "presets", "run_default", "analyze", "calibrate", "sweep", "critical",
+    "animate", "listen", "page",
+)  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,38 @@
+"""``metrosync listen``: a stereo WAV with one click per metronome at each tick."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ._show_source import add_source_options, load_or_simulate
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "listen",
+        help="write the ticks of a run as a WAV file",
+        description="Write a stereo WAV with a click for every zero crossing of every "
+        "pendulum (the instant a metronome ticks), panned by its place on the disk. "
+        "Simulating here records every step, so clicks fall on the simulated crossings.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    add_source_options(parser, record_seconds=None)
+    out = parser.add_argument_group("sound")
+    out.add_argument("--out", type=Path, default=Path("metrosync.wav"), help="FILE.wav")
+    out.add_argument("--speedup", type=float, default=1.0, help="play faster than real time")
+    out.add_argument("--sample-rate", type=int, default=44100, help="samples per second")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..show.sound import write_wav
+
+    ds = load_or_simulate(args)
+    track = write_wav(
+        ds, args.out, run=args.run, speedup=args.speedup, start=args.start, end=args.end,
+        sample_rate=args.sample_rate,
+    )  # fmt: skip
+    clicks = sum(len(t) for t in track.click_times)
+    print(f"wrote {args.out} ({track.duration:.1f} s, {clicks} clicks, {track.sample_rate} Hz)")
+    return 0

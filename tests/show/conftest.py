@@ -1,0 +1,23 @@
+"""Shared fixtures of the `metrosync.show` tests: small recorded runs."""
+
+from __future__ import annotations
+
+import pytest
+
+import metrosync
+
+
+@pytest.fixture(scope="session")
+def recorded_ds():
+    """N = 7, 20 s, every step recorded with trajectories."""
+    return metrosync.simulate(7, 192.0, sigma_bpm=0.3, duration=20.0, record_every=1,
+                              trajectories=True, seed=3)  # fmt: skip
+
+
+@pytest.fixture(scope="session")
+def pair_ds():
+    """Two metronomes at different rates, every step recorded: one on each side."""
+    return metrosync.simulate(
+        None, None, frequencies_bpm=[188.0, 196.0], theta0=[0.3, -0.2], theta_dot0=[0.0, 1.0],
+        duration=12.0, record_every=1, trajectories=True,
+    )  # fmt: skip

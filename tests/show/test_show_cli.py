@@ -1,0 +1,51 @@
+"""`metrosync animate`, `listen` and `page`: from a file or by simulating."""
+
+from __future__ import annotations
+
+import wave
+
+import pytest
+
+from metrosync.cli import main
+from metrosync.cli.simulate import write_netcdf
+
+SMALL = ["--n", "3", "--duration", "4", "--sigma", "0.5"]
+
+
+def test_listen_simulates_every_step(tmp_path, capsys):
+    out = tmp_path / "ticks.wav"
+    assert main(["listen", *SMALL, "--speedup", "2", "--out", str(out)]) == 0
+    with wave.open(str(out)) as f:
+        assert f.getnframes() == 2 * 44100
+    assert "clicks" in capsys.readouterr().out
+
+
+def test_animate_and_page_read_a_simulation_file(recorded_ds, tmp_path):
+    source = tmp_path / "run.nc"
+    write_netcdf(recorded_ds, source)
+    gif = tmp_path / "a.gif"
+    html = tmp_path / "a.html"
+    assert main(["animate", str(source), "--fps", "4", "--speedup", "4", "--end", "4",
+                 "--dpi", "30", "--out", str(gif)]) == 0  # fmt: skip
+    assert main(["page", str(source), "--out", str(html)]) == 0
+    assert gif.stat().st_size > 0 and html.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["listen", "missing.nc"], "does not exist"),
+        (["page", "{nc}", "--n", "5"], "not both"),
+        (["animate", "{nc}", "--run", "3"], "`run`"),
+        (["listen", "{bare}"], "no trajectories"),
+    ],
+)
+def test_errors_are_reported_with_exit_code_2(recorded_ds, tmp_path, capsys, argv, message):
+    import metrosync
+
+    nc, bare = tmp_path / "run.nc", tmp_path / "bare.nc"
+    write_netcdf(recorded_ds, nc)
+    write_netcdf(metrosync.simulate(2, 192.0, duration=1.0), bare)
+    argv = [a.format(nc=nc, bare=bare) for a in argv]
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err

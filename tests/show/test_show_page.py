@@ -1,0 +1,154 @@
+"""The playback page: self-contained, faithful data, and it plays in a real browser."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import time
+
+import numpy as np
+import pytest
+
+from metrosync.errors import ParameterError
+from metrosync.show.page import page_data, write_page
+from metrosync.show.recording import RecordedRun
+
+
+def embedded_data(text: str) -> dict:
+    match = re.search(r'<script type="application/json" id="run-data">(.*?)</script>', text, re.S)
+    return json.loads(match.group(1))
+
+
+def test_page_is_self_contained(recorded_ds, tmp_path):
+    text = write_page(recorded_ds, tmp_path / "run.html").read_text(encoding="utf-8")
+    assert not re.search(r"(src|href)\s*=", text)  # nothing to fetch
+    assert "http://" not in text and "https://" not in text
+    assert "fetch(" not in text and "XMLHttpRequest" not in text
+    for element in (
+        'id="play"',
+        'id="seek"',
+        'id="speed"',
+        'id="disk"',
+        'id="wheel"',
+        'id="order"',
+    ):
+        assert element in text
+
+
+def test_embedded_data_is_the_recorded_run(recorded_ds):
+    run = RecordedRun.from_dataset(recorded_ds)
+    data = page_data(run, start=2.0, end=8.0, max_rate=20.0)
+    assert data["dt"] == pytest.approx(0.05)  # every step is 0.01 s; thinned to 20/s
+    assert data["t0"] <= 2.0 and data["t0"] + (data["count"] - 1) * data["dt"] >= 8.0 - 1e-9
+    index = np.round((data["t0"] + data["dt"] * np.arange(data["count"])) / 0.01).astype(int)
+    np.testing.assert_allclose(np.array(data["theta"]).T, run.theta[index], atol=5e-6)
+    np.testing.assert_allclose(data["phi"], run.phi[index], atol=5e-6)
+    np.testing.assert_allclose(data["r"], run.r[index], atol=5e-5)
+
+
+def test_script_closing_tags_in_text_cannot_break_the_page(recorded_ds, tmp_path):
+    ds = recorded_ds.copy()
+    ds.attrs["bpm"] = "</script><b>"
+    text = write_page(ds, tmp_path / "odd.html").read_text(encoding="utf-8")
+    assert text.count("</script>") == 2
+    assert embedded_data(text)["title"].startswith("N = 7, </script><b> BPM")
+
+
+def test_bad_max_rate_is_refused(recorded_ds):
+    with pytest.raises(ParameterError, match="`max_rate`"):
+        page_data(RecordedRun.from_dataset(recorded_ds), max_rate=0)
+
+
+# -- end to end, in headless Chromium ------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def chromium_executable():
+    """Debian's chromium, installed with apt-get when missing (needs root)."""
+    found = shutil.which("chromium")
+    if found:
+        return found
+    if os.geteuid() != 0:
+        pytest.skip("chromium is not installed and installing it needs root (apt-get)")
+    if shutil.which("apt-get") is None:
+        pytest.skip("chromium is not installed and apt-get is not available")
+    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
+    for command in (["apt-get", "update"], ["apt-get", "install", "-y", "chromium"]):
+        done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=900)
+        if done.returncode != 0 and command[1] == "install":
+            pytest.skip(f"could not install chromium: {done.stderr.strip()[-300:]}")
+    found = shutil.which("chromium")
+    if not found:
+        pytest.skip("apt-get installed chromium but it is not on PATH")
+    return found
+
+
+@pytest.fixture
+def browser(chromium_executable, tmp_path):
+    from cdp import Browser
+
+    profile = tmp_path / "profile"
+    profile.mkdir()
+    with Browser(chromium_executable, profile) as b:  # closing kills its process group
+        yield b
+
+
+def test_page_plays_in_headless_chromium(recorded_ds, tmp_path, browser):
+    path = write_page(recorded_ds, tmp_path / "run.html")
+    browser.open_page(path.resolve().as_uri())
+    rect = browser.evaluate(
+        "(() => { const r = document.getElementById('disk').getBoundingClientRect();"
+        " return {x: r.x, y: r.y, width: r.width, height: r.height}; })()"
+    )
+    browser.pump(0.3)
+    still = [browser.screenshot(rect) for _ in range(2)]
+    assert still[0] == still[1]  # paused: nothing moves by itself
+    browser.evaluate("document.getElementById('play').click()")
+    assert browser.evaluate("document.getElementById('play').textContent") == "Pause"
+    browser.pump(0.4)
+    first = browser.screenshot(rect)
+    browser.pump(0.4)
+    second = browser.screenshot(rect)
+    assert first != second
+    assert float(browser.evaluate("document.getElementById('seek').value")) > 0.0
+    browser.pump(0.1)
+    assert browser.console_errors() == []
+    # The check can fail: an error logged by the page is seen.
+    browser.evaluate("console.error('probe')")
+    browser.pump(0.1)
+    assert browser.console_errors() == ["probe"]
+
+
+def test_browser_processes_are_gone_after_close(chromium_executable, tmp_path):
+    from cdp import Browser
+
+    profile = tmp_path / "profile"
+    profile.mkdir()
+    b = Browser(chromium_executable, profile)
+    b.call("Browser.getVersion", session=False)
+    group = b.process.pid
+    assert living_members(group)
+    b.close()
+    deadline = time.monotonic() + 10
+    while living_members(group) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert living_members(group) == []
+
+
+def living_members(group: int) -> list[int]:
+    """Processes of process group ``group`` that are not zombies (from /proc)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == group and fields[0] != "Z":
+            found.append(int(entry))
+    return found

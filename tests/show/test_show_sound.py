@@ -1,0 +1,122 @@
+"""The click track: file format and length, and clicks on the simulated crossings."""
+
+from __future__ import annotations
+
+import wave
+
+import numpy as np
+import pytest
+
+import metrosync
+from metrosync.errors import ParameterError
+from metrosync.show.recording import RecordedRun
+from metrosync.show.sound import click_track, crossing_times, write_wav
+
+
+def simulated_crossings(theta, time):
+    """Zero crossings of an every-step trajectory, found as the integrator finds them:
+    a strict sign change between consecutive steps, time interpolated linearly."""
+    out = []
+    for k in range(theta.size - 1):
+        a, b = theta[k], theta[k + 1]
+        if (a < 0 < b) or (a > 0 > b):
+            out.append(time[k] + (time[k + 1] - time[k]) * a / (a - b))
+    return np.array(out)
+
+
+def read_wav(path):
+    with wave.open(str(path), "rb") as f:
+        params = (f.getnchannels(), f.getsampwidth(), f.getframerate(), f.getnframes())
+        pcm = np.frombuffer(f.readframes(f.getnframes()), dtype="<i2").reshape(-1, 2)
+    return params, pcm / 32767.0
+
+
+def onsets(channel, threshold=0.25, quiet=30):
+    """Samples where |x| first exceeds ``threshold`` after ``quiet`` samples below it."""
+    loud = np.abs(channel) > threshold
+    index = np.flatnonzero(loud)
+    return np.array([k for k in index if not loud[max(0, k - quiet) : k].any()])
+
+
+@pytest.mark.parametrize(
+    ("rate", "speedup", "start", "end"), [(44100, 1.0, None, None), (22050, 2.5, 2.0, 13.0)]
+)
+def test_wav_sample_rate_channels_and_length(recorded_ds, tmp_path, rate, speedup, start, end):
+    path = tmp_path / "ticks.wav"
+    write_wav(recorded_ds, path, sample_rate=rate, speedup=speedup, start=start, end=end)
+    (channels, width, framerate, frames), samples = read_wav(path)
+    span = (end or 20.0) - (start or 0.0)
+    assert (channels, width, framerate) == (2, 2, rate)
+    assert frames == round(span / speedup * rate)
+    assert 0.05 < np.abs(samples).max() <= 0.9 + 1e-4  # audible, never clipping
+
+
+@pytest.mark.parametrize("speedup", [1.0, 3.0])
+def test_clicks_fall_on_the_simulated_crossings_within_one_sample(pair_ds, tmp_path, speedup):
+    rate = 44100
+    path = tmp_path / "pair.wav"
+    write_wav(pair_ds, path, sample_rate=rate, speedup=speedup, start=1.0)
+    _, samples = read_wav(path)
+    time = pair_ds.time.values
+    # Metronome 0 sits at x = +R (right channel), metronome 1 at x = −R (left).
+    for metronome, channel in ((0, 1), (1, 0)):
+        expected = simulated_crossings(pair_ds.theta.values[:, 0, metronome], time)
+        expected = expected[(expected >= 1.0) & (expected < 12.0)]
+        expected_audio = (expected - 1.0) / speedup
+        heard = onsets(samples[:, channel]) / rate
+        assert heard.size == expected.size > 20
+        assert np.max(np.abs(heard - expected_audio)) <= 1.0 / rate
+
+
+def test_crossings_use_both_directions_and_match_the_integrator(pair_ds):
+    run = RecordedRun.from_dataset(pair_ds)
+    assert run.every_step
+    found = crossing_times(run)
+    for i in range(2):
+        theta = run.theta[:, i]
+        expected = simulated_crossings(theta, run.time)
+        np.testing.assert_allclose(found[i], expected, rtol=0, atol=1e-12)
+        # Up and down crossings alternate: half a period apart on average.
+        period = 120.0 / float(pair_ds.frequency_bpm[0, i])
+        assert np.median(np.diff(found[i])) == pytest.approx(period / 2, rel=0.05)
+
+
+def test_sparse_records_find_crossings_by_hermite_interpolation():
+    kwargs = dict(
+        frequencies_bpm=[188.0, 196.0], theta0=[0.3, -0.2], duration=12.0, trajectories=True
+    )
+    every = crossing_times(
+        RecordedRun.from_dataset(metrosync.simulate(None, None, record_every=1, **kwargs))
+    )
+    sparse = crossing_times(
+        RecordedRun.from_dataset(metrosync.simulate(None, None, record_every=5, **kwargs))
+    )
+    for a, b in zip(every, sparse, strict=True):
+        assert a.size == b.size
+        # Records 0.05 s apart (five steps, escapement kicks in between) still place
+        # each crossing within 2 ms, typically within half a millisecond.
+        assert np.max(np.abs(a - b)) < 2e-3
+        assert np.median(np.abs(a - b)) < 5e-4
+
+
+def test_pan_follows_the_place_on_the_disk(pair_ds):
+    track = click_track(RecordedRun.from_dataset(pair_ds), end=3.0)
+    left, right = np.abs(track.samples).sum(axis=0)
+    assert right > 0 and left > 0
+    only_right = click_track(RecordedRun.from_dataset(pair_ds.isel(metronome=[0])), end=3.0)
+    l0, r0 = np.abs(only_right.samples).sum(axis=0)
+    assert l0 < 0.05 * r0
+
+
+@pytest.mark.parametrize(
+    ("options", "name"),
+    [
+        ({"speedup": 0}, "speedup"),
+        ({"sample_rate": 1000}, "sample_rate"),
+        ({"start": 50.0}, "start"),
+        ({"start": 5.0, "end": 4.0}, "end"),
+    ],
+)
+def test_bad_options_name_the_argument(pair_ds, options, name):
+    with pytest.raises(ParameterError, match=f"`{name}`"):
+        click_track(RecordedRun.from_dataset(pair_ds), **options)
