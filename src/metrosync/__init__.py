@@ -37,3 +37,7 @@ __all__ = [
     "omega_to_bpm",
     "simulate",
 ]
+
+from .reproduce import reproduce  # noqa: E402
+
+__all__ += ["reproduce"]

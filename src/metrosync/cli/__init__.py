@@ -14,7 +14,7 @@ import warnings
 from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-SUBCOMMANDS = ("simulate", "presets", "run_default")
+SUBCOMMANDS = ("simulate", "presets", "run_default", "reproduce")
 
 
 def build_parser() -> argparse.ArgumentParser:
