@@ -91,7 +91,7 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : the z-study, with ``z`` and ``status`` (regime, theta2).
     """
-    fig, ax = plt.subplots(figsize=(6.4, 4.4), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(6.4, 5.6), layout="constrained")
     markers = "osD^v"
     for i, regime in enumerate(ds.regime.values):
         z = ds.z.sel(regime=regime)
@@ -120,7 +120,7 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
     ax.set_xlabel("θ₂(0) (rad)")
     ax.set_ylabel("z")
     ax.set_ylim(-1.05, 1.05)
-    ax.legend(fontsize=7, loc="upper left")
+    fig.legend(fontsize=7, loc="outside lower center", ncols=1)
     a = ds.attrs
     ax.set_title(
         f"z figure (§6): N = 2, {a['bpm']:g} BPM, θ₁(0) = {a['theta1_0']} rad, θ̇(0) = 0\n"

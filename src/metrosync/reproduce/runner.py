@@ -298,7 +298,7 @@ def _reduce_z(ds: xr.Dataset, study: ZStudy) -> xr.Dataset:
 def _assemble(study: Study, mode: str, points: list[Point], parts: list[xr.Dataset]) -> xr.Dataset:
     first = parts[0]
     if isinstance(study, TimeSeriesStudy):
-        ds = xr.concat([p.drop_attrs() for p in parts], dim="case")
+        ds = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="case")
         ds = ds.assign_coords(
             case=[c.label for c in study.cases],
             n=("case", [c.n for c in study.cases]),
@@ -308,7 +308,7 @@ def _assemble(study: Study, mode: str, points: list[Point], parts: list[xr.Datas
         ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
     elif isinstance(study, SweepStudy):
         grid = study.grid(mode)
-        stacked = xr.concat([p.drop_attrs() for p in parts], dim="point")
+        stacked = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="point")
         shape = (len(grid.ns), len(grid.bpms))
         ds = xr.Dataset(
             coords={"n": list(grid.ns), "bpm": ("bpm", list(grid.bpms), {"units": "BPM"})}
@@ -352,7 +352,7 @@ def _assemble_z(study: ZStudy, points: list[Point], parts: list[xr.Dataset]) -> 
         by_regime.setdefault(point.coords["regime"], []).append(part)
     rows = []
     for r in range(len(study.regimes)):
-        joined = xr.concat([p.drop_attrs() for p in by_regime[r]], dim="run")
+        joined = xr.concat([p.drop_attrs(deep=False) for p in by_regime[r]], dim="run")
         rows.append(joined.assign_coords(run=np.arange(joined.sizes["run"])))
     ds = xr.concat(rows, dim="regime").rename(run="theta2")
     ds = ds.assign_coords(
