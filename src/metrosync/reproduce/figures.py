@@ -56,7 +56,7 @@ def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
     ax.set_ylabel("r")
     ax.set_ylim(0, 1.02)
     ax.set_xlim(0, float(ds.time[-1]))
-    ax.legend(title=ds.attrs.get("legend_title") or None, fontsize=8, loc="lower right")
+    ax.legend(title=ds.attrs.get("legend_title") or None, fontsize=8, loc="best")
     ax.set_title(f"{ds.attrs['figure']}: {ds.attrs['title']}\n{_subtitle(ds)}", fontsize=9)
     return _save(fig, stem)
 
