@@ -117,7 +117,10 @@ def claim_identical(ds: xr.Dataset) -> Verdict:
         f"runs with r_eq ≥ {R_COMPLETE}: "
         + ", ".join(f"N = {n}: {c:.0%}" for n, c in zip(ds.n.values, complete, strict=True))
         + f"; time for the run-mean r to stay ≥ {R_COMPLETE}: "
-        + ", ".join(f"N = {n}: {t:.0f} s" for n, t in zip(ds.n.values, times, strict=True))
+        + ", ".join(
+            f"N = {n}: " + (f"{t:.0f} s" if np.isfinite(t) else "not within the run")
+            for n, t in zip(ds.n.values, times, strict=True)
+        )
         + f"; flagged runs {flagged}."
         + (" Runs that do not synchronize completely: " + "; ".join(stuck) + "." if stuck else "")
     )
