@@ -26,6 +26,7 @@ def test_bad_experiment_folder_fails_before_any_work(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_one_study_end_to_end(tmp_path, capsys):
     code = main(
         ["reproduce", "--quick", "--only", "fig8_bottom", "--out", str(tmp_path), "--no-progress"]

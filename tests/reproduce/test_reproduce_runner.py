@@ -66,3 +66,13 @@ def test_z_study_records_warnings_instead_of_raising(tmp_path):
     ok = ds.status.sel(theta2=-0.1) == 0
     np.testing.assert_allclose(ds.z.sel(theta2=-0.1).where(ok, drop=True), -1.0, atol=0.05)
     np.testing.assert_array_equal(ds.drive.values, [0.0, 6e-5, 6e-4, 1e-4])
+
+
+def test_run_mean_is_drawn_only_where_every_run_has_a_phase(tmp_path):
+    result = run_study(SMALL, "quick", tmp_path)
+    direct = simulate(**points_of(SMALL, "quick")[0].kwargs, progress=False)
+    r = direct.r_crossing.values
+    full = np.isfinite(r).all(axis=1)
+    drawn = result.dataset.r_mean.isel(case=0).values
+    np.testing.assert_array_equal(np.isfinite(drawn), full)
+    np.testing.assert_allclose(drawn[full], r[full].mean(axis=1))

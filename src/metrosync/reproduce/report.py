@@ -169,7 +169,9 @@ def _timing_section(rep) -> list[str]:
         "",
         f"Estimated `--full` total: about {total_est / 3600:.1f} h on this machine, from the "
         "throughput measured here (it scales with cores; results are identical for any "
-        "thread count). `--full` keeps every finished point under `points/` and resumes.",
+        "thread count). `--full` keeps every finished point under `points/` and resumes; "
+        "a point is keyed by its `simulate` arguments, not by the metrosync version, so "
+        "delete `points/` after upgrading.",
         "",
     ]
     return s

@@ -35,8 +35,6 @@ from .studies import Study, SweepStudy, TimeSeriesStudy, ZStudy
 #: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
 Z_BATCH = 12
 DT = 0.01
-#: Fraction of runs that must have a crossing phase for the run-mean r(t) to be drawn.
-MEAN_COVERAGE = 0.9
 
 
 @dataclass(frozen=True)
@@ -245,9 +243,11 @@ def _reduce_ensemble(ds: xr.Dataset) -> xr.Dataset:
     r_cross = ds.r_crossing.values
     finite = np.isfinite(r_cross)
     count = finite.sum(axis=1)
-    # Near the ends only some runs have a crossing phase; averaging over those few would
-    # draw spikes, so the mean is kept only where nearly every run contributes.
-    enough = count >= max(1, int(np.ceil(MEAN_COVERAGE * r_cross.shape[1])))
+    # Near the ends only some runs have a crossing phase; averaging over whichever runs
+    # happen to have one would draw spikes, so the mean is drawn only where every run
+    # that ever has a phase (all but overturned or diverged ones) contributes.
+    active = finite.any(axis=0)
+    enough = finite[:, active].all(axis=1) & active.any()
     with np.errstate(invalid="ignore", divide="ignore"):
         r_mean = np.where(enough, np.where(finite, r_cross, 0.0).sum(axis=1) / count, np.nan)
     freq = ds.frequency_bpm.values
