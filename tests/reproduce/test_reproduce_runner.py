@@ -76,3 +76,10 @@ def test_run_mean_is_drawn_only_where_every_run_has_a_phase(tmp_path):
     drawn = result.dataset.r_mean.isel(case=0).values
     np.testing.assert_array_equal(np.isfinite(drawn), full)
     np.testing.assert_allclose(drawn[full], r[full].mean(axis=1))
+
+
+def test_long_runs_report_progress_point_by_point(tmp_path):
+    lines = []
+    run_study(SMALL, "quick", tmp_path, log=lines.append)
+    assert len(lines) == 6
+    assert lines[-1].startswith("  fig8_bottom: 6/6 points")

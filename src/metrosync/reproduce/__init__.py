@@ -2,6 +2,7 @@
 
 ``studies``     the studies, declared as data (grids, statistics per mode)
 ``runner``      runs a study through `metrosync.simulate`, resumably, into NetCDF
+``assemble``    reduces each simulate result and joins a study's points
 ``figures``     one plotting function per figure (PNG + PDF)
 ``claims``      verdicts on the paper's claims from the study data
 ``consistency`` the parameter-consistency table
