@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -16,7 +15,6 @@ def register(subparsers) -> None:
         description="Run the paper's simulation studies, write NetCDF data, PNG/PDF figures "
         "and REPORT.md with a verdict on each claim. Finished simulations are kept under "
         "OUT/points/, so an interrupted run resumes.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument(
@@ -34,7 +32,7 @@ def register(subparsers) -> None:
         help="the paper's statistics (100 runs a point), hours",
     )
     parser.set_defaults(mode="quick")
-    parser.add_argument("--out", type=Path, default=Path("results"), help="output folder")
+    parser.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
     parser.add_argument(
         "--experiment",
         type=Path,
