@@ -32,7 +32,9 @@ def register(subparsers) -> None:
         help="the paper's statistics (100 runs a point), hours",
     )
     parser.set_defaults(mode="quick")
-    parser.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
+    parser.add_argument(
+        "--out", type=Path, default=Path("results"), help="output folder (default: results)"
+    )
     parser.add_argument(
         "--experiment",
         type=Path,
