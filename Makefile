@@ -16,7 +16,7 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/metrosync run-default --out results
+	$(BIN)/metrosync reproduce --quick --out results
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

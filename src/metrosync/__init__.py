@@ -2,12 +2,18 @@
 
 A model, integrators, observables and analysis tools for the system of Boda, Néda,
 Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
+
+One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
+`sweep` (parameter grids), `reproduce` (the paper's studies), and `animate`,
+`write_wav`, `write_page`, `plot_run` (seeing and hearing a run). The last group is
+imported on first use, so that ``import metrosync`` stays quick.
 """
 
 __version__ = "0.1.0"
 
 from .ensemble import Ensemble, build_ensemble  # noqa: E402
 from .errors import MetrosyncError, OverturnWarning, ParameterError  # noqa: E402
+from .lightgate import analyze  # noqa: E402
 from .model import (  # noqa: E402
     PRESETS,
     Metronome,
@@ -20,6 +26,16 @@ from .model import (  # noqa: E402
 )
 from .simulate import simulate  # noqa: E402
 
+#: Names served on first use from the modules that need matplotlib or dask.
+_LAZY = {
+    "animate": "show",
+    "plot_run": "show",
+    "write_page": "show",
+    "write_wav": "show",
+    "sweep": "sweeps",
+    "reproduce": "paper",
+}
+
 __all__ = [
     "PRESETS",
     "Ensemble",
@@ -31,32 +47,19 @@ __all__ = [
     "ParameterError",
     "Platform",
     "__version__",
+    "analyze",
     "bpm_to_omega",
     "build_ensemble",
     "get_preset",
     "omega_to_bpm",
     "simulate",
-    "animate",
-    "plot_run",
-    "write_page",
-    "write_wav",
+    *_LAZY,
 ]
-
-from .lightgate import analyze  # noqa: E402
-
-__all__ += ["analyze"]
-from .sweeps import sweep  # noqa: E402
-
-__all__ += ["sweep"]
-
-#: Names served lazily from `metrosync.show`, so that importing metrosync does not
-#: import matplotlib.
-_SHOW = ("animate", "plot_run", "write_page", "write_wav")
 
 
 def __getattr__(name: str):
-    if name in _SHOW:
-        from . import show
+    if name in _LAZY:
+        import importlib
 
-        return getattr(show, name)
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
     raise AttributeError(f"module 'metrosync' has no attribute {name!r}")

@@ -15,8 +15,8 @@ from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = (
-    "simulate", "presets", "run_default", "analyze", "calibrate", "sweep", "critical",
-    "animate", "listen", "page",
+    "simulate", "presets", "run_default", "reproduce", "analyze", "calibrate", "sweep",
+    "critical", "animate", "listen", "page",
 )  # fmt: skip
 
 

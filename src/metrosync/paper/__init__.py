@@ -1,0 +1,17 @@
+"""Reproduce the paper's simulation figures and claims, with an honest report.
+
+``studies``     the studies, declared as data (grids, statistics per mode)
+``runner``      runs a study through `metrosync.simulate`, resumably, into NetCDF
+``assemble``    reduces each simulate result and joins a study's points
+``figures``     one plotting function per figure (PNG + PDF)
+``claims``      verdicts on the paper's claims from the study data
+``consistency`` the parameter-consistency table
+``experiment``  Fig. 9 from light-gate logs (optional)
+``report``      REPORT.md
+``pipeline``    `reproduce`, the entry point tying them together
+"""
+
+from .pipeline import Reproduction, reproduce
+from .studies import STUDIES, paper_sigma_to_bpm
+
+__all__ = ["STUDIES", "Reproduction", "paper_sigma_to_bpm", "reproduce"]

@@ -1,0 +1,185 @@
+"""Reduce each `simulate` result to what a study keeps, and assemble a study's dataset.
+
+Contract: `reduce_ensemble` and `reduce_z` turn one `simulate` dataset into the small
+per-point dataset that is cached (run-mean r(t), per-run equilibrium r and status; or
+z per run); `assemble` joins a study's points into one dataset on the study's own
+coordinates (``case``; ``n`` × ``bpm``; ``regime`` × ``theta2``) with the run
+statistics (mean r_eq and σ_r) and the attributes shared by every point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..observables import ensemble_statistics, z_order
+from .studies import Study, SweepStudy, TimeSeriesStudy, ZStudy
+
+
+def reduce_ensemble(ds: xr.Dataset) -> xr.Dataset:
+    """Keep what the figures and the report need: run-mean r(t) and per-run r_eq."""
+    r_cross = ds.r_crossing.values
+    finite = np.isfinite(r_cross)
+    count = finite.sum(axis=1)
+    # Near the ends only some runs have a crossing phase; averaging over whichever runs
+    # happen to have one would draw spikes, so the mean is drawn only where every run
+    # that ever has a phase (all but overturned or diverged ones) contributes.
+    active = finite.any(axis=0)
+    enough = finite[:, active].all(axis=1) & active.any()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r_mean = np.where(enough, np.where(finite, r_cross, 0.0).sum(axis=1) / count, np.nan)
+    freq = ds.frequency_bpm.values
+    spread = freq.std(axis=1, ddof=1) if freq.shape[1] > 1 else np.zeros(freq.shape[0])
+    return xr.Dataset(
+        {
+            "r_mean": ("time", r_mean, {"long_name": "run-mean r, crossing-interpolated phase"}),
+            "r_analytic_mean": (
+                "time",
+                ds.r.mean("run").values,
+                {"long_name": "run-mean r, analytic phase"},
+            ),
+            "r_eq": ds.r_eq,
+            "r_eq_analytic": ds.r_eq_analytic,
+            "status": ds.status,
+            "sigma_realized": (
+                "run",
+                spread,
+                {"units": "BPM", "long_name": "std of the drawn natural frequencies"},
+            ),
+        },
+        coords={"time": ds.time, "run": ds.run},
+    )
+
+
+def reduce_z(ds: xr.Dataset) -> xr.Dataset:
+    """z per run over the whole run (the paper's average) and over its last quarter."""
+    t = ds.time.values
+    theta = ds.theta.values
+    late = t >= t[-1] * 0.75
+    z_all, z_late, amp = [], [], []
+    for b in range(theta.shape[1]):
+        z_all.append(z_order(t, theta[:, b, 0], theta[:, b, 1]))
+        z_late.append(z_order(t, theta[:, b, 0], theta[:, b, 1], start=t[-1] * 0.75))
+        amp.append(float(np.abs(theta[late, b, :]).max()))
+    theta2 = ds.theta.values[0, :, 1]
+    return xr.Dataset(
+        {
+            "z": ("run", np.array(z_all), {"long_name": "z over the whole run"}),
+            "z_late": ("run", np.array(z_late), {"long_name": "z over the last quarter"}),
+            "amplitude_late": (
+                "run",
+                np.array(amp),
+                {"units": "rad", "long_name": "max |θ| over the last quarter"},
+            ),
+            "status": ds.status,
+            "theta2_0": ("run", theta2, {"units": "rad"}),
+        },
+        coords={"run": ds.run},
+    )
+
+
+def assemble(study: Study, mode: str, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
+    first = parts[0]
+    if isinstance(study, TimeSeriesStudy):
+        ds = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="case")
+        ds = ds.assign_coords(
+            case=[c.label for c in study.cases],
+            n=("case", [c.n for c in study.cases]),
+            bpm=("case", [c.bpm for c in study.cases], {"units": "BPM"}),
+            sigma_bpm=("case", [c.sigma_bpm for c in study.cases], {"units": "BPM"}),
+        )
+        ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
+    elif isinstance(study, SweepStudy):
+        grid = study.grid(mode)
+        stacked = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="point")
+        shape = (len(grid.ns), len(grid.bpms))
+        ds = xr.Dataset(
+            coords={"n": list(grid.ns), "bpm": ("bpm", list(grid.bpms), {"units": "BPM"})}
+        )
+        for name in ("r_eq", "r_eq_analytic", "status", "sigma_realized"):
+            values = stacked[name].values.reshape(shape + (-1,))
+            ds[name] = (("n", "bpm", "run"), values, stacked[name].attrs)
+        ds["r_mean"] = (("n", "bpm", "time"), stacked.r_mean.values.reshape(shape + (-1,)))
+        ds = ds.assign_coords(time=stacked.time, run=stacked.run)
+        ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
+    else:
+        ds = _assemble_z(study, coords, parts)
+    # Attributes that vary between points live in coordinates and variables instead.
+    varying = {
+        "point_digest",
+        "n",
+        "bpm",
+        "sigma_bpm",
+        "r_eq_mean",
+        "r_eq_std",
+        "seed",
+        "disk_inertia",
+        "runs",
+        "warnings",
+    }
+    if isinstance(study, ZStudy):
+        varying |= {"preset", "c_theta", "c_phi", "drive", "theta0", "theta_dot0"}
+    common = {k: v for k, v in first.attrs.items() if k not in varying}
+    ds.attrs = {**common, **ds.attrs}
+    if isinstance(study, TimeSeriesStudy):
+        ds.attrs["legend_title"] = study.legend_title
+    elif isinstance(study, SweepStudy):
+        ds.attrs["sigma_bpm_study"] = study.sigma_bpm
+    ds.attrs["warnings"] = " | ".join(sorted({p.attrs["warnings"] for p in parts}))
+    return ds
+
+
+def _assemble_z(study: ZStudy, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
+    by_regime: dict[int, list[xr.Dataset]] = {}
+    for where, part in zip(coords, parts, strict=True):
+        by_regime.setdefault(where["regime"], []).append(part)
+    rows = []
+    for r in range(len(study.regimes)):
+        joined = xr.concat([p.drop_attrs(deep=False) for p in by_regime[r]], dim="run")
+        rows.append(joined.assign_coords(run=np.arange(joined.sizes["run"])))
+    ds = xr.concat(rows, dim="regime").rename(run="theta2")
+    ds = ds.assign_coords(
+        theta2=("theta2", ds.theta2_0.values[0], {"units": "rad", "long_name": "θ₂(0)"}),
+        regime=[g.label for g in study.regimes],
+        **{
+            name: (
+                "regime",
+                [_regime_value(study, g, parts, coords, name) for g in study.regimes],
+                {"units": unit},
+            )
+            for name, unit in (("drive", "N m s"), ("c_theta", "kg m2/s"), ("c_phi", "kg m2/s"))
+        },
+        preset=("regime", [g.preset for g in study.regimes]),
+        from_paper=("regime", [g.from_paper for g in study.regimes]),
+    ).drop_vars("theta2_0")
+    ds.attrs = {"bpm": study.bpm, "theta1_0": study.theta1, "theta_dot0": 0.0}
+    return ds
+
+
+def _regime_value(study, regime, parts, coords, name) -> float:
+    for where, part in zip(coords, parts, strict=True):
+        if study.regimes[where["regime"]] is regime:
+            return float(part.attrs[name])
+    return float("nan")
+
+
+def _statistics(r_eq: xr.DataArray) -> tuple[xr.DataArray, xr.DataArray]:
+    """Mean and σ_r (sample std) of r_eq across runs; ``run`` must be the last dim."""
+    values = r_eq.transpose(..., "run").values
+    pairs = np.array([ensemble_statistics(row) for row in values.reshape(-1, values.shape[-1])])
+    dims = [d for d in r_eq.dims if d != "run"]
+    coords = {d: r_eq[d] for d in dims}
+    shape = values.shape[:-1]
+    mean = xr.DataArray(
+        pairs[:, 0].reshape(shape),
+        dims=dims,
+        coords=coords,
+        attrs={"long_name": "equilibrium r, mean over runs"},
+    )
+    std = xr.DataArray(
+        pairs[:, 1].reshape(shape),
+        dims=dims,
+        coords=coords,
+        attrs={"long_name": "σ_r, sample std of equilibrium r over runs"},
+    )
+    return mean, std

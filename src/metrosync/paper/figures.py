@@ -1,0 +1,166 @@
+"""One plotting function per reproduced figure, laid out like the paper's own.
+
+Contract: each function takes the study's assembled `xarray.Dataset` (from
+`metrosync.paper.runner`) and a path stem, writes ``<stem>.png`` and
+``<stem>.pdf``, and returns the list of written paths. Axes carry the paper's
+quantities and units (t in s, ω₀ in BPM, θ₂(0) in rad); r is the run-mean of the
+crossing-interpolated order parameter, the paper's experimental phase method.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import xarray as xr  # noqa: E402
+
+FORMATS = ("png", "pdf")
+DPI = 110
+
+
+def _save(fig, stem: Path) -> list[Path]:
+    stem = Path(stem)
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for ext in FORMATS:
+        path = stem.with_suffix(f".{ext}")
+        tmp = path.with_name(f".{path.name}.partial")
+        fig.savefig(tmp, dpi=DPI, format=ext)
+        tmp.replace(path)
+        paths.append(path)
+    plt.close(fig)
+    return paths
+
+
+def _subtitle(ds: xr.Dataset) -> str:
+    a = ds.attrs
+    runs = ds.sizes.get("run", a.get("runs", "?"))
+    mode = a.get("mode", "")
+    return f"{mode} mode: mean of {runs} runs × {a.get('duration', 0):g} s, dt = {a.get('dt')} s"
+
+
+def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """Figs. 8 and 11: ⟨r⟩(t) over runs, one curve per case of the study.
+
+    ds : a time-series study, with ``r_mean`` (case, time) and ``case`` labels.
+    """
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
+    colors = plt.cm.viridis(np.linspace(0.0, 0.9, ds.sizes["case"]))
+    for color, case in zip(colors, ds.case.values, strict=True):
+        ax.plot(ds.time, ds.r_mean.sel(case=case), lw=1.2, color=color, label=str(case))
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("r")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlim(0, float(ds.time[-1]))
+    ax.legend(title=ds.attrs.get("legend_title") or None, fontsize=8, loc="best")
+    ax.set_title(f"{ds.attrs['figure']}: {ds.attrs['title']}\n{_subtitle(ds)}", fontsize=9)
+    return _save(fig, stem)
+
+
+def plot_sweep(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """Fig. 10: equilibrium r (top) and σ_r (bottom) against ω₀, one curve per N.
+
+    ds : a sweep study, with ``r_eq_mean`` and ``sigma_r`` (n, bpm).
+    """
+    fig, (top, bottom) = plt.subplots(
+        2, 1, figsize=(6.4, 7.0), sharex=True, constrained_layout=True
+    )
+    colors = plt.cm.plasma(np.linspace(0.0, 0.85, ds.sizes["n"]))
+    for color, n in zip(colors, ds.n.values, strict=True):
+        kw = {"color": color, "marker": "o", "ms": 3, "lw": 1.2, "label": f"N = {int(n)}"}
+        top.plot(ds.bpm, ds.r_eq_mean.sel(n=n), **kw)
+        bottom.plot(ds.bpm, ds.sigma_r.sel(n=n), **kw)
+    top.axvline(185, color="0.5", ls="--", lw=0.8, label="paper's ω_c = 185 BPM")
+    bottom.axvline(185, color="0.5", ls="--", lw=0.8)
+    top.set_ylabel("r")
+    top.set_ylim(0, 1.02)
+    bottom.set_ylabel("σ_r")
+    bottom.set_xlabel("ω₀ (BPM)")
+    top.legend(fontsize=8, loc="lower right")
+    sigma = ds.attrs.get("sigma_bpm_study", float(ds.sigma_realized.mean()))
+    top.set_title(f"{ds.attrs['figure']}: σ = {sigma:.3g} BPM\n{_subtitle(ds)}", fontsize=9)
+    return _save(fig, stem)
+
+
+def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """The §6 figure: z against θ₂(0), one curve per regime; hollow markers = overturned.
+
+    ds : the z-study, with ``z`` and ``status`` (regime, theta2).
+    """
+    fig, ax = plt.subplots(figsize=(6.4, 5.6), layout="constrained")
+    markers = "osD^v"
+    for i, regime in enumerate(ds.regime.values):
+        z = ds.z.sel(regime=regime)
+        bad = (ds.status.sel(regime=regime) != 0).values
+        (line,) = ax.plot(
+            ds.theta2,
+            z,
+            lw=1,
+            marker=markers[i % len(markers)],
+            ms=4,
+            label=str(regime),
+            ls="-" if ds.from_paper.values[i] else ":",
+        )
+        if bad.any():
+            ax.plot(
+                ds.theta2.values[bad],
+                z.values[bad],
+                ls="none",
+                marker="o",
+                ms=9,
+                mfc="none",
+                mec=line.get_color(),
+            )
+    ax.plot([], [], ls="none", marker="o", ms=9, mfc="none", mec="k", label="pendulum overturned")
+    ax.axhline(0, color="0.7", lw=0.6)
+    ax.set_xlabel("θ₂(0) (rad)")
+    ax.set_ylabel("z")
+    ax.set_ylim(-1.05, 1.05)
+    fig.legend(fontsize=7, loc="outside lower center", ncols=1)
+    a = ds.attrs
+    ax.set_title(
+        f"z figure (§6): N = 2, {a['bpm']:g} BPM, θ₁(0) = {a['theta1_0']} rad, θ̇(0) = 0\n"
+        f"{a.get('mode', '')} mode: t = {a.get('duration', 0):g} s, dt = {a.get('dt')} s",
+        fontsize=9,
+    )
+    return _save(fig, stem)
+
+
+def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """Fig. 9: simulated against measured equilibrium r, N = 7, one point per ω₀.
+
+    ds : ``r_sim``, ``sigma_r_sim``, ``r_exp`` (bpm).
+    """
+    fig, ax = plt.subplots(figsize=(4.8, 4.6), constrained_layout=True)
+    ax.plot([0, 1], [0, 1], "k--", lw=0.8, label="r_sim = r_exp")
+    ax.errorbar(
+        ds.r_exp,
+        ds.r_sim,
+        yerr=ds.sigma_r_sim,
+        ls="none",
+        marker="o",
+        mfc="none",
+        capsize=2,
+        label="ω₀ of Table 1",
+    )
+    for bpm, x, y in zip(ds.bpm.values, ds.r_exp.values, ds.r_sim.values, strict=True):
+        ax.annotate(f"{bpm:g}", (x, y), textcoords="offset points", xytext=(4, -10), fontsize=7)
+    ax.set_xlabel("r_exp")
+    ax.set_ylabel("r_sim")
+    ax.set_xlim(0, 1.02)
+    ax.set_ylim(0, 1.02)
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title("Fig. 9: simulated vs measured equilibrium r (N = 7)", fontsize=9)
+    return _save(fig, stem)
+
+
+#: Which function draws each study kind (by the study's class name).
+PLOTTERS = {
+    "TimeSeriesStudy": plot_order_in_time,
+    "SweepStudy": plot_sweep,
+    "ZStudy": plot_z,
+}

@@ -1,0 +1,148 @@
+"""`reproduce`: run the paper's studies, draw their figures, and write REPORT.md.
+
+Contract: ``reproduce(out, mode=...)`` writes into ``out``
+
+    <study>.nc, figures/<study>.png|pdf   for every study (`studies.STUDIES`)
+    consistency.nc                        the parameter-consistency table
+    fig9.nc, figures/fig9.png|pdf         only with ``experiment``
+    points/<study>/*.nc                   finished simulate calls (resume cache)
+    REPORT.md                             verdicts, numbers, interpretations, timings
+
+and returns a `Reproduction`. Re-running with the same ``out`` reuses finished points.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import xarray as xr
+
+from .. import __version__
+from ..errors import ParameterError
+from .claims import Verdict, all_verdicts
+from .consistency import consistency_table
+from .experiment import compare_experiment, find_experiment, lightgate_analyze
+from .figures import PLOTTERS, plot_comparison
+from .report import write_report
+from .runner import StudyResult, points_of, run_study, write_atomic
+from .studies import FIG8_TOP, MODES, Study, SweepStudy, TimeSeriesStudy, ZStudy, get_studies
+
+NO_EXPERIMENT = (
+    "no light-gate data was given. Run `metrosync reproduce --experiment DIR` with one "
+    "folder of logs per ω₀ (DIR/160/*.txt, DIR/192/*.txt, …) to compare with experiment."
+)
+
+
+@dataclass
+class Reproduction:
+    """Everything a reproduction produced (see the module docstring for the files)."""
+
+    out: Path
+    mode: str
+    results: list[StudyResult]
+    verdicts: list[Verdict]
+    consistency: xr.Dataset
+    figures: dict[str, list[Path]]
+    report: Path | None = None
+    comparison: xr.Dataset | None = None
+    comparison_note: str = NO_EXPERIMENT
+    full_work: dict[str, float] = field(default_factory=dict)
+    wall_s: float = 0.0
+    version: str = __version__
+
+    @property
+    def datasets(self) -> dict[str, xr.Dataset]:
+        return {r.study.name: r.dataset for r in self.results}
+
+
+def reproduce(
+    out: Path | str = "results",
+    *,
+    mode: str = "quick",
+    studies: Sequence[str | Study] | None = None,
+    experiment: Path | str | None = None,
+    progress: bool = False,
+    log: Callable[[str], None] | None = None,
+) -> Reproduction:
+    """Reproduce the paper's simulation figures and check its claims.
+
+    Parameters
+    ----------
+    out : output folder (created).
+    mode : ``"quick"`` (reduced statistics, minutes) or ``"full"`` (the paper's, hours).
+    studies : study names or `Study` objects; default every study in `STUDIES`.
+    experiment : folder of light-gate logs, one sub-folder per ω₀ named by its BPM;
+        adds Fig. 9. Checked before anything runs.
+    progress : show progress bars.   log : called with one line per finished step.
+
+    Returns
+    -------
+    Reproduction
+    """
+    if mode not in MODES:
+        raise ParameterError(f"unknown `mode` {mode!r}; choose one of {list(MODES)}.")
+    started = time.perf_counter()
+    out = Path(out)
+    chosen = _resolve(studies)
+    if experiment is not None:
+        find_experiment(Path(experiment))
+        lightgate_analyze()
+    say = log or (lambda line: None)
+
+    say("parameter consistency table")
+    consistency = consistency_table(_bpms(chosen, mode))
+    write_atomic(consistency, out / "consistency.nc")
+
+    results, figures = [], {}
+    for study in chosen:
+        say(f"{study.name}: {study.figure} ({len(points_of(study, mode))} simulate calls)")
+        result = run_study(study, mode, out, progress=progress, log=say if mode == "full" else None)
+        results.append(result)
+        figures[study.name] = PLOTTERS[type(study).__name__](
+            result.dataset, out / "figures" / study.name
+        )
+        say(f"  {study.name}: {result.wall_s:.1f} s -> {result.path}")
+
+    rep = Reproduction(
+        out=out,
+        mode=mode,
+        results=results,
+        verdicts=[],
+        consistency=consistency,
+        figures=figures,
+        full_work={s.name: sum(p.work for p in points_of(s, "full")) for s in chosen},
+    )
+    if experiment is not None:
+        sim = rep.datasets.get(FIG8_TOP.name)
+        if sim is None:
+            sim = run_study(FIG8_TOP, mode, out, progress=progress).dataset
+        rep.comparison = compare_experiment(Path(experiment), sim)
+        write_atomic(rep.comparison, out / "fig9.nc")
+        figures["fig9"] = plot_comparison(rep.comparison, out / "figures" / "fig9")
+        rep.comparison_note = f"Simulated r from the `{FIG8_TOP.name}` study ({mode} mode)."
+    rep.verdicts = all_verdicts(rep.datasets)
+    rep.wall_s = time.perf_counter() - started
+    rep.report = write_report(out / "REPORT.md", rep)
+    say(f"wrote {rep.report}")
+    return rep
+
+
+def _resolve(studies) -> tuple[Study, ...]:
+    if studies is None:
+        return get_studies()
+    return tuple(get_studies([s])[0] if isinstance(s, str) else s for s in studies)
+
+
+def _bpms(studies: Sequence[Study], mode: str) -> list[float]:
+    bpms: set[float] = set()
+    for s in studies:
+        if isinstance(s, TimeSeriesStudy):
+            bpms |= {c.bpm for c in s.cases}
+        elif isinstance(s, SweepStudy):
+            bpms |= set(s.grid(mode).bpms)
+        elif isinstance(s, ZStudy):
+            bpms.add(s.bpm)
+    return sorted(bpms) or [192.0]

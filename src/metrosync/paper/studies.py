@@ -1,0 +1,300 @@
+"""The paper's simulation studies, declared as data.
+
+Contract: every study is a frozen dataclass that says *what* to simulate (model
+parameters, the grid of cases, the statistics of each mode) and nothing about *how*;
+`metrosync.paper.runner` turns each into calls of the public `metrosync.simulate`.
+A study's ``quick`` and ``full`` fields hold the statistics of the two modes:
+``full`` follows the paper (100 runs a point), ``quick`` is reduced so that each
+verdict of the report still rests on a measurable effect.
+
+Adding a study is a declarative change: append an instance to `STUDIES` (and, for a
+new kind of study, teach the runner and `figures` about its type).
+
+Units: BPM (ω = π·BPM/60), seconds, radians. The σ columns of the paper's Tables 1
+and 2 are converted by `paper_sigma_to_bpm` (MODEL-NOTES §4).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import ParameterError
+
+#: The logger's clock tick, s (paper §2): the unit in which Tables 1–2 read sensibly.
+LOGGER_TICK = 64e-6
+
+#: Paper Table 1: σ of the seven metronomes' natural frequencies at each nominal ω₀,
+#: in the paper's printed unit "BPM·10⁻⁷".
+TABLE1_SIGMA = {160: 8.4, 168: 7.9, 176: 7.8, 184: 9.8, 192: 8.5, 208: 8.7}
+#: Paper Table 2: σ at ω₀ = 192 BPM for each number of metronomes N, "BPM·10⁻⁷".
+TABLE2_SIGMA = {2: 5.1, 3: 8.1, 4: 7.5, 5: 7.1, 6: 6.7, 7: 8.5}
+#: The σ the paper fixes for Fig. 10, "BPM·10⁻⁷" (the mean of Table 1, rounded).
+FIG10_SIGMA = 8.0
+
+MODES = ("quick", "full")
+
+
+def paper_sigma_to_bpm(value):
+    """Convert a σ printed in the paper's Tables 1–2 to BPM (MODEL-NOTES §4).
+
+    The tables print σ ≈ 8 in units of "BPM·10⁻⁷", far too small to desynchronize
+    anything if taken literally. We read ``value × 10⁻⁷`` as beats per 64 µs clock
+    tick of the light-gate logger, so
+
+        σ_BPM = value × 10⁻⁷ / 64×10⁻⁶ s × 60 s/min   (8 → 0.75 BPM, ≈ 0.4 %).
+
+    Parameters
+    ----------
+    value : float or array, the number printed in the table (e.g. 8.5).
+
+    Returns
+    -------
+    float or ndarray, σ in BPM.
+    """
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise ParameterError(f"`value` must be finite and >= 0 (a table entry), got {value!r}.")
+    out = arr * 1e-7 / LOGGER_TICK * 60.0
+    return float(out) if out.ndim == 0 else out
+
+
+@dataclass(frozen=True)
+class Statistics:
+    """How much to simulate for each case of a study.
+
+    runs : independent runs per case.   duration : simulated time per run, s.
+    """
+
+    runs: int
+    duration: float
+
+    def __post_init__(self) -> None:
+        if isinstance(self.runs, bool) or not isinstance(self.runs, int) or self.runs < 1:
+            raise ParameterError(f"`runs` must be an integer >= 1, got {self.runs!r}.")
+        if not (np.isfinite(self.duration) and self.duration > 0):
+            raise ParameterError(f"`duration` must be a finite time > 0 s, got {self.duration!r}.")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One ensemble of a time-series study: N metronomes at ``bpm`` with spread σ (BPM)."""
+
+    n: int
+    bpm: float
+    sigma_bpm: float
+    label: str
+
+
+@dataclass(frozen=True)
+class TimeSeriesStudy:
+    """r(t) averaged over runs, one curve per case (paper Figs. 8 and 11)."""
+
+    name: str
+    figure: str
+    title: str
+    cases: tuple[Case, ...]
+    quick: Statistics
+    full: Statistics
+    preset: str = "default"
+    legend_title: str = ""
+
+    def statistics(self, mode: str) -> Statistics:
+        return getattr(self, _check_mode(mode))
+
+
+@dataclass(frozen=True)
+class SweepGrid:
+    """The (N, ω₀) grid and statistics of a sweep in one mode."""
+
+    ns: tuple[int, ...]
+    bpms: tuple[float, ...]
+    stats: Statistics
+
+
+@dataclass(frozen=True)
+class SweepStudy:
+    """Equilibrium r and σ_r against ω₀ for several N at fixed σ (paper Fig. 10)."""
+
+    name: str
+    figure: str
+    title: str
+    sigma_bpm: float
+    quick: SweepGrid
+    full: SweepGrid
+    preset: str = "default"
+
+    def grid(self, mode: str) -> SweepGrid:
+        return getattr(self, _check_mode(mode))
+
+
+@dataclass(frozen=True)
+class Regime:
+    """A parameter regime of the two-metronome z-study: a preset plus named changes."""
+
+    label: str
+    preset: str = "default"
+    changes: tuple[tuple[str, float], ...] = ()
+    from_paper: bool = True
+
+
+@dataclass(frozen=True)
+class ZGrid:
+    """θ₂(0) grid and run length of the z-study in one mode."""
+
+    theta2: tuple[float, ...]
+    duration: float
+    record_every: int = 2
+
+
+@dataclass(frozen=True)
+class ZStudy:
+    """z against θ₂(0) for two identical metronomes (paper §6), one curve per regime."""
+
+    name: str
+    figure: str
+    title: str
+    regimes: tuple[Regime, ...]
+    quick: ZGrid
+    full: ZGrid
+    bpm: float = 192.0
+    theta1: float = 0.1
+    dt: float = 0.01
+
+    def grid(self, mode: str) -> ZGrid:
+        return getattr(self, _check_mode(mode))
+
+
+Study = TimeSeriesStudy | SweepStudy | ZStudy
+
+
+def _check_mode(mode: str) -> str:
+    if mode not in MODES:
+        raise ParameterError(f"unknown `mode` {mode!r}; choose one of {list(MODES)}.")
+    return mode
+
+
+def _bpm_range(start: float, stop: float, step: float) -> tuple[float, ...]:
+    return tuple(float(x) for x in np.arange(start, stop + step / 2, step))
+
+
+FIG8_TOP = TimeSeriesStudy(
+    name="fig8_top",
+    figure="Fig. 8 (top)",
+    title="N = 7 metronomes at the experiment's frequencies (σ from Table 1)",
+    cases=tuple(
+        Case(7, float(bpm), paper_sigma_to_bpm(s), f"ω₀ = {bpm} BPM")
+        for bpm, s in TABLE1_SIGMA.items()
+    ),
+    # Cheap enough to keep the paper's statistics even in quick mode.
+    quick=Statistics(runs=100, duration=600.0),
+    full=Statistics(runs=100, duration=600.0),
+    legend_title="N = 7",
+)
+
+FIG8_BOTTOM = TimeSeriesStudy(
+    name="fig8_bottom",
+    figure="Fig. 8 (bottom)",
+    title="N = 2…7 metronomes at 192 BPM (σ from Table 2)",
+    cases=tuple(Case(n, 192.0, paper_sigma_to_bpm(s), f"N = {n}") for n, s in TABLE2_SIGMA.items()),
+    # The paper calls this decrease "not as evident" in simulation: it needs every run.
+    quick=Statistics(runs=100, duration=600.0),
+    full=Statistics(runs=100, duration=600.0),
+    legend_title="ω₀ = 192 BPM",
+)
+
+FIG10 = SweepStudy(
+    name="fig10",
+    figure="Fig. 10",
+    title="Equilibrium r and σ_r against ω₀ (σ = 0.75 BPM)",
+    sigma_bpm=paper_sigma_to_bpm(FIG10_SIGMA),
+    quick=SweepGrid(
+        ns=(7, 16, 64, 256),
+        bpms=_bpm_range(150.0, 220.0, 5.0),
+        stats=Statistics(runs=10, duration=300.0),
+    ),
+    full=SweepGrid(
+        ns=(7, 16, 32, 64, 128, 256),
+        bpms=_bpm_range(150.0, 220.0, 2.5),
+        stats=Statistics(runs=100, duration=1000.0),
+    ),
+)
+
+FIG11 = TimeSeriesStudy(
+    name="fig11",
+    figure="Fig. 11",
+    title="Identical metronomes (σ = 0) at 192 BPM",
+    cases=tuple(Case(n, 192.0, 0.0, f"N = {n}") for n in (2, 4, 8, 16, 32, 64)),
+    quick=Statistics(runs=10, duration=600.0),
+    full=Statistics(runs=100, duration=1000.0),
+    legend_title="σ = 0, ω₀ = 192 BPM",
+)
+
+#: Changes that make the frictionless, undriven limit of §6.
+FREE = (("c_theta", 0.0), ("c_phi", 0.0), ("drive", 0.0))
+
+Z_STUDY = ZStudy(
+    name="z",
+    figure="z figure (§6)",
+    title="Two identical metronomes: z against θ₂(0), θ₁(0) = 0.1 rad, θ̇(0) = 0",
+    regimes=(
+        Regime("no friction, no drive (c_θ = c_φ = M = 0)", changes=FREE),
+        Regime("published frictions, M = 6×10⁻⁵ N m s", preset="default"),
+        Regime("published, M = 6×10⁻⁴ N m s", preset="boda2013"),
+        Regime(
+            "published frictions, M = 1×10⁻⁴ N m s (large drive, no overturning; ours)",
+            changes=(("drive", 1e-4),),
+            from_paper=False,
+        ),
+    ),
+    quick=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 21), 6)), duration=1500.0),
+    full=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 81), 6)), duration=4000.0),
+)
+
+#: Every study `metrosync reproduce` runs, in report order.
+STUDIES: tuple[Study, ...] = (FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY)
+
+
+def get_studies(names: Sequence[str] | None = None) -> tuple[Study, ...]:
+    """The studies called ``names`` (all of `STUDIES` when None), in report order."""
+    if names is None:
+        return STUDIES
+    known = {s.name: s for s in STUDIES}
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise ParameterError(f"unknown study {unknown}; choose from {list(known)}.")
+    return tuple(s for s in STUDIES if s.name in set(names))
+
+
+def reduced(study: Study, **statistics) -> Study:
+    """Copy of ``study`` with its ``quick`` statistics or grid replaced (for tests).
+
+    Keyword arguments are the fields of the mode's `Statistics`, `SweepGrid` or `ZGrid`.
+    """
+    return replace(study, quick=replace(study.quick, **statistics))
+
+
+__all__ = [
+    "FIG8_BOTTOM",
+    "FIG8_TOP",
+    "FIG10",
+    "FIG11",
+    "STUDIES",
+    "TABLE1_SIGMA",
+    "TABLE2_SIGMA",
+    "Z_STUDY",
+    "Case",
+    "Regime",
+    "Statistics",
+    "Study",
+    "SweepGrid",
+    "SweepStudy",
+    "TimeSeriesStudy",
+    "ZGrid",
+    "ZStudy",
+    "get_studies",
+    "paper_sigma_to_bpm",
+    "reduced",
+]

@@ -1,0 +1,85 @@
+"""The runner calls the public `simulate` verbatim, writes NetCDF, and resumes."""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from metrosync import simulate
+from metrosync.paper.runner import points_of, run_study
+from metrosync.paper.studies import FIG8_BOTTOM, FIG10, Z_STUDY, Statistics, reduced
+
+SMALL = reduced(FIG8_BOTTOM, runs=2, duration=30.0)
+
+
+def test_a_point_is_exactly_a_public_simulate_call(tmp_path):
+    result = run_study(SMALL, "quick", tmp_path)
+    point = points_of(SMALL, "quick")[3]
+    direct = simulate(**point.kwargs, progress=False)
+    np.testing.assert_array_equal(result.dataset.r_eq.isel(case=3).values, direct.r_eq.values)
+    assert result.dataset.n.values[3] == direct.attrs["n"] == 5
+
+
+def test_study_file_holds_data_units_and_parameters(tmp_path):
+    result = run_study(SMALL, "quick", tmp_path)
+    ds = xr.load_dataset(result.path, engine="h5netcdf")
+    assert set(ds.r_eq.dims) == {"case", "run"} and ds.sizes["case"] == 6
+    assert ds.time.attrs["units"] == "s" and ds.sigma_bpm.attrs["units"] == "BPM"
+    assert ds.attrs["preset"] == "default" and ds.attrs["drive"] == 6e-5
+    assert ds.attrs["wall_time_s"] > 0 and ds.attrs["mode"] == "quick"
+    np.testing.assert_allclose(ds.r_eq_mean, ds.r_eq.mean("run"))
+
+
+def test_second_run_resumes_from_finished_points(tmp_path):
+    first = run_study(SMALL, "quick", tmp_path)
+    again = run_study(SMALL, "quick", tmp_path)
+    assert first.cached_points == 0 and again.cached_points == again.points == 6
+    assert again.computed_work == 0
+    xr.testing.assert_identical(first.dataset.r_eq, again.dataset.r_eq)
+
+
+def test_changed_statistics_or_broken_files_are_recomputed(tmp_path):
+    run_study(SMALL, "quick", tmp_path)
+    (tmp_path / "points" / SMALL.name / "case00.nc").write_bytes(b"truncated")
+    longer = run_study(reduced(SMALL, duration=40.0), "quick", tmp_path)
+    assert longer.cached_points == 0
+    assert float(longer.dataset.time[-1]) == 40.0
+
+
+def test_sweep_is_assembled_on_its_grid(tmp_path):
+    sweep = reduced(FIG10, ns=(7, 16), bpms=(170.0, 200.0), stats=Statistics(3, 30.0))
+    ds = run_study(sweep, "quick", tmp_path).dataset
+    assert ds.r_eq.dims == ("n", "bpm", "run") and ds.r_eq.shape == (2, 2, 3)
+    direct = simulate(**points_of(sweep, "quick")[3].kwargs, progress=False)
+    np.testing.assert_array_equal(ds.r_eq.sel(n=16, bpm=200.0).values, direct.r_eq.values)
+    # each drawn ensemble has the study's spread, up to sampling noise
+    assert 0.3 < float(ds.sigma_realized.sel(n=16).mean()) < 1.2
+
+
+def test_z_study_records_warnings_instead_of_raising(tmp_path):
+    ds = run_study(reduced(Z_STUDY, duration=30.0, theta2=(-0.1, 0.1)), "quick", tmp_path).dataset
+    assert ds.z.dims == ("regime", "theta2") and ds.z.shape == (4, 2)
+    assert "overturn" in ds.attrs["warnings"]
+    # identical start (θ₂ = θ₁) is in phase for every regime; θ₂ = −θ₁ is anti-phase
+    # whenever the pendulums stay below the horizontal
+    np.testing.assert_allclose(ds.z.sel(theta2=0.1), 1.0, atol=1e-6)
+    ok = ds.status.sel(theta2=-0.1) == 0
+    np.testing.assert_allclose(ds.z.sel(theta2=-0.1).where(ok, drop=True), -1.0, atol=0.05)
+    np.testing.assert_array_equal(ds.drive.values, [0.0, 6e-5, 6e-4, 1e-4])
+
+
+def test_run_mean_is_drawn_only_where_every_run_has_a_phase(tmp_path):
+    result = run_study(SMALL, "quick", tmp_path)
+    direct = simulate(**points_of(SMALL, "quick")[0].kwargs, progress=False)
+    r = direct.r_crossing.values
+    full = np.isfinite(r).all(axis=1)
+    drawn = result.dataset.r_mean.isel(case=0).values
+    np.testing.assert_array_equal(np.isfinite(drawn), full)
+    np.testing.assert_allclose(drawn[full], r[full].mean(axis=1))
+
+
+def test_long_runs_report_progress_point_by_point(tmp_path):
+    lines = []
+    run_study(SMALL, "quick", tmp_path, log=lines.append)
+    assert len(lines) == 6
+    assert lines[-1].startswith("  fig8_bottom: 6/6 points")
