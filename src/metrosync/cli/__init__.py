@@ -15,7 +15,7 @@ from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = (
-    "simulate", "presets", "run_default", "reproduce", "analyze", "calibrate", "sweep",
+    "simulate", "presets", "reproduce", "analyze", "calibrate", "sweep",
     "critical", "animate", "listen", "page",
 )  # fmt: skip
 
