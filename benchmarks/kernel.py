@@ -1,11 +1,16 @@
-"""Throughput of the fixed-step kernel, in oscillator-steps per second.
+"""Throughput of the fixed-step kernels, in oscillator-steps per second.
 
-For each (B runs, N metronomes) it times the compiled kernel over the full duration
-(default 1000 s at dt = 0.01, i.e. 10⁵ steps) and the plain NumPy implementation of
-the same scheme over fewer steps (its rate does not depend on the step count), and
-prints both with their ratio. Compilation is excluded (a warm-up call runs first).
+For each (B runs, N metronomes) it times, in one process:
+  * the kernel `simulate` uses (layout chosen from N), over the full duration;
+  * the previous kernel (scalar loop, libm trig), over the same duration;
+  * the plain NumPy implementation of the same scheme, over fewer steps (its rate does
+    not depend on the step count);
+and prints the rates with the ratios. Compilation is excluded (a warm-up call first);
+each compiled figure is the best of ``--repeats`` timings. ``--scaling`` adds the cost
+per oscillator-step as N and as B grow at fixed work, which should stay flat.
 
-    python benchmarks/kernel.py                      # the issue's (100, 7) and (100, 64)
+    python benchmarks/kernel.py                       # the (100, 7) and (100, 64) grid
+    python benchmarks/kernel.py --scaling             # plus the N and B scaling curves
     python benchmarks/kernel.py --sizes 100x7 1000x64 --duration 200
 """
 
@@ -24,18 +29,28 @@ from metrosync.integrators import reference, verlet
 from metrosync.integrators._state import StepState
 
 
-def throughput(backend, ensemble, steps: int, dt: float, record_every: int = 10) -> float:
+def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
+    """Oscillator-steps per second of one timed call (``layout=None``: NumPy)."""
     state = StepState.start(
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
-        n_records=steps // record_every + 1, trajectories=False,
+        n_records=steps // 10 + 1, trajectories=False,
     )  # fmt: skip
+    options = dict(dt=dt, step0=0, n_steps=steps, record_every=10, overturn_angle=math.pi / 2)
     start = time.perf_counter()
-    backend.advance_state(
-        state, ensemble.system, dt=dt, step0=0, n_steps=steps, record_every=record_every,
-        overturn_angle=math.pi / 2,
-    )  # fmt: skip
-    elapsed = time.perf_counter() - start
-    return ensemble.runs * ensemble.n * steps / elapsed
+    if layout is None:
+        reference.advance_state(state, ensemble.system, **options)
+    else:
+        verlet.advance_state(state, ensemble.system, layout=layout, **options)
+    return ensemble.runs * ensemble.n * steps / (time.perf_counter() - start)
+
+
+def best(ensemble, steps, dt, layout, repeats):
+    rate(ensemble, 20, dt, layout)  # compile or load the cache
+    return max(rate(ensemble, steps, dt, layout) for _ in range(repeats))
+
+
+def ensemble_of(b: int, n: int):
+    return build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=0.75, runs=b, seed=1)
 
 
 def main() -> None:
@@ -43,32 +58,44 @@ def main() -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--sizes", nargs="+", default=["100x7", "100x64"], help="BxN pairs")
-    parser.add_argument("--duration", type=float, default=1000.0, help="simulated seconds (kernel)")
+    parser.add_argument("--duration", type=float, default=1000.0, help="simulated s (kernels)")
     parser.add_argument("--dt", type=float, default=0.01)
-    parser.add_argument(
-        "--baseline-steps", type=int, default=300, help="steps for the NumPy baseline"
-    )
-    parser.add_argument(
-        "--repeats", type=int, default=3, help="kernel timings per size (best kept)"
-    )
+    parser.add_argument("--baseline-steps", type=int, default=300, help="steps for NumPy")
+    parser.add_argument("--repeats", type=int, default=3, help="timings per figure (best kept)")
+    parser.add_argument("--scaling", action="store_true", help="also the N and B scaling curves")
     args = parser.parse_args()
 
-    params = get_preset("default")
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, "
-          f"numba {numba.__version__} with {numba.get_num_threads()} threads")  # fmt: skip
-    print(f"dt = {args.dt} s, kernel over {args.duration:g} s, "
-          f"baseline over {args.baseline_steps} steps")  # fmt: skip
-    print(
-        f"{'B':>6} {'N':>6} {'kernel (osc-steps/s)':>22} {'numpy (osc-steps/s)':>22} {'ratio':>8}"
-    )
+    print(f"machine: {platform.machine()} {platform.processor() or ''}, {os.cpu_count()} CPUs, "
+          f"numba {numba.__version__}, {numba.get_num_threads()} threads")  # fmt: skip
+    print(f"dt = {args.dt} s; kernels over {args.duration:g} s; NumPy over "
+          f"{args.baseline_steps} steps; rates in oscillator-steps/s")  # fmt: skip
+    header = f"{'B':>6} {'N':>6} {'layout':>12} {'kernel':>10} {'previous':>10} {'numpy':>10}"
+    print(header + f" {'x previous':>11} {'x numpy':>9}")
+    steps = int(round(args.duration / args.dt))
     for size in args.sizes:
         b, n = (int(x) for x in size.lower().split("x"))
-        ens = build_ensemble(n, 192.0, params=params, sigma_bpm=0.75, runs=b, seed=1)
-        throughput(verlet, ens, 20, args.dt)  # compile / load the cache
-        steps = int(round(args.duration / args.dt))
-        fast = max(throughput(verlet, ens, steps, args.dt) for _ in range(args.repeats))
-        slow = throughput(reference, ens, args.baseline_steps, args.dt)
-        print(f"{b:>6} {n:>6} {fast:>22.3e} {slow:>22.3e} {fast / slow:>8.1f}")
+        ens = ensemble_of(b, n)
+        layout = verlet.choose_layout(n, b)
+        fast = best(ens, steps, args.dt, layout, args.repeats)
+        previous = best(ens, steps, args.dt, "scalar", args.repeats)
+        slow = rate(ens, args.baseline_steps, args.dt, None)
+        print(f"{b:>6} {n:>6} {layout:>12} {fast:>10.3e} {previous:>10.3e} {slow:>10.3e} "
+              f"{fast / previous:>11.1f} {fast / slow:>9.0f}")  # fmt: skip
+
+    if args.scaling:
+        work = 2e8  # oscillator-steps per timing
+        print("\ncost per oscillator-step at fixed work (ns), chosen layout")
+        for label, sizes in (
+            ("N grows, B = 100", [(100, n) for n in (2, 7, 16, 64, 256, 1024, 4096, 10000)]),
+            ("B grows, N = 7", [(b, 7) for b in (10, 100, 1000, 10000)]),
+            ("B grows, N = 64", [(b, 64) for b in (10, 100, 1000, 10000)]),
+        ):
+            print(f"  {label}:")
+            for b, n in sizes:
+                ens = ensemble_of(b, n)
+                count = max(10, int(work / (b * n)))
+                r = best(ens, count, args.dt, verlet.choose_layout(n, b), args.repeats)
+                print(f"    B = {b:>6}  N = {n:>6}  {1e9 / r:7.2f} ns  ({r:.3e} osc-steps/s)")
 
 
 if __name__ == "__main__":

@@ -39,9 +39,10 @@ def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs):
     np.testing.assert_array_equal(got.status, ref.status)
 
 
-def test_layout_follows_n():
-    assert verlet.choose_layout(7) == "runs"
-    assert verlet.choose_layout(64) == "oscillators"
+def test_layout_follows_the_problem():
+    assert verlet.choose_layout(7, 100) == "runs"
+    assert verlet.choose_layout(7, 4) == "oscillators"  # too few runs to fill a block
+    assert verlet.choose_layout(64, 100) == "oscillators"
 
 
 def test_far_wound_angles_fall_back_to_libm():
@@ -115,3 +116,11 @@ def test_a_corrupt_compile_cache_is_rebuilt_not_used(tmp_path):
     again = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert again.returncode == 0, again.stderr
     assert again.stdout == first.stdout
+    # A kernel source that changed (here: a stamp that no longer matches) purges the cache.
+    index = sorted(Path(tmp_path / "cache").rglob("kernel_*.advance-*.nbi"))
+    assert index, "the kernel was not cached again"
+    before = index[0].stat().st_mtime_ns
+    (tmp_path / "cache" / "metrosync-kernels.stamp").write_text("an older source")
+    third = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert third.returncode == 0 and third.stdout == first.stdout, third.stderr
+    assert index[0].stat().st_mtime_ns > before

@@ -1,5 +1,10 @@
-"""Guard numba's on-disk compile cache: a damaged file is deleted (and the kernel
-recompiled), never loaded.
+"""Guard numba's on-disk compile cache: a damaged or stale file is deleted (and the
+kernel recompiled), never loaded.
+
+numba invalidates a cached function only when its own source file changes, not when
+a function it inlines from another file does (`trig.sincos`, `_kernel_parts`). A stamp
+holding the hash of every kernel source file sits beside the cache; when it does not
+match, every cached kernel of this package is removed.
 
 numba raises on a truncated or corrupt cache file instead of recompiling. Before the
 first kernel call, `heal_compile_cache` reads each of this package's cache files the
@@ -9,6 +14,7 @@ pickle) and removes the ones that fail, together with their index.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import pickle
 from pathlib import Path
@@ -17,6 +23,15 @@ import numba
 
 _checked = False
 OUR_MODULES = ("kernel_", "trig.", "_kernel_parts.")
+STAMP_NAME = "metrosync-kernels.stamp"
+
+
+def source_stamp() -> str:
+    here = Path(__file__).resolve().parent
+    digest = hashlib.sha256()
+    for path in sorted(here.glob("*.py")):
+        digest.update(path.name.encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()
 
 
 def cache_dirs() -> list[Path]:
@@ -25,6 +40,11 @@ def cache_dirs() -> list[Path]:
     override = numba.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR")
     if override:
         dirs.append(Path(override))
+    for folder in dirs:  # so that the stamp is written before numba's first file
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            pass
     return [d for d in dirs if d.is_dir()]
 
 
@@ -48,16 +68,26 @@ def heal_compile_cache() -> list[Path]:
         return []
     _checked = True
     removed = []
+    stamp = source_stamp()
     for folder in cache_dirs():
+        stamp_file = folder / STAMP_NAME
+        stale = not stamp_file.exists() or stamp_file.read_text() != stamp
         for path in folder.rglob("*.nb[ic]"):
             if not _ours(path):
                 continue
-            if not _readable(path):
+            if stale:
+                path.unlink(missing_ok=True)
+                removed.append(path)
+            elif not _readable(path):
                 index = path if path.suffix == ".nbi" else _index_of(path)
                 for victim in {path, index}:
                     if victim is not None and victim.exists():
                         victim.unlink()
                         removed.append(victim)
+        try:
+            stamp_file.write_text(stamp)
+        except OSError:  # a read-only install: numba cannot cache there either
+            pass
     return removed
 
 

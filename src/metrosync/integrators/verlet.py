@@ -34,13 +34,19 @@ KERNELS = {
     "oscillators": kernel_oscillators.advance,
     "scalar": kernel_scalar.advance,
 }
-#: Below this many metronomes a run is too short to fill vector registers, so runs
-#: go innermost; from it on, metronomes do (measured by benchmarks/kernel.py).
-RUNS_INNERMOST_BELOW_N = 16
+#: Runs go innermost when a run has too few metronomes to fill vector registers and
+#: there are enough runs to fill a block; otherwise metronomes do. Both thresholds
+#: were measured with benchmarks/kernel.py on the 2-core AVX-512 machine.
+RUNS_INNERMOST_BELOW_N = 10
+RUNS_INNERMOST_FROM_B = 16
 
 
-def choose_layout(n: int) -> str:
-    return "runs" if n < RUNS_INNERMOST_BELOW_N else "oscillators"
+def choose_layout(n: int, runs: int) -> str:
+    """The kernel layout for ``runs`` runs of ``n`` metronomes (a function of the
+    problem only, never of the thread count, so results do not depend on it)."""
+    if n < RUNS_INNERMOST_BELOW_N and runs >= RUNS_INNERMOST_FROM_B:
+        return "runs"
+    return "oscillators"
 
 
 def advance_state(
@@ -49,7 +55,7 @@ def advance_state(
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from N)."""
     heal_compile_cache()
-    kernel = KERNELS[layout or choose_layout(state.theta.shape[1])]
+    kernel = KERNELS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
     kernel(
         state.theta, state.theta_dot, state.phi, state.phi_dot, state.acc_theta, state.acc_phi,
         state.p_phi, state.force_phi, state.last_up, state.status,
