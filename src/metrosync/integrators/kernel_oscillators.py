@@ -39,9 +39,9 @@ def advance(
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
         th_new = np.empty(n)
-        vel_pred = np.empty(n)
         rest = np.empty(n)
         q = np.empty(n)
+        crossed = np.empty(n, dtype=np.bool_)
         inv_i = np.empty(n)
         kick_dt = np.empty(n)
         for i in range(n):
@@ -73,6 +73,7 @@ def advance(
                 down = (th > 0.0) & (tn < 0.0)
                 kick = kick_dt[i] if up else (-kick_dt[i] if down else 0.0)
                 n_up += 1 if up else 0
+                crossed[i] = up
                 n_over += 1 if abs(tn) > overturn_angle else 0
                 n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
                 sn, cs = sincos(tn)
@@ -82,21 +83,22 @@ def advance(
                 sum_den += qi * qi * inv_i[i]
                 sum_kick += kick
                 th_new[i] = tn
-                vel_pred[i] = vp
                 rest[i] = res
                 q[i] = qi
             if n_far > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sum_num, sum_den = _libm_pass(b, n, th_new, vel_pred, kick_dt, theta, mh, mgh, c_theta, inv_i, rest, q)  # fmt: skip  # noqa: E501
+                sum_num, sum_den = _libm_pass(b, n, th_new, dt, kick_dt, theta, theta_dot, acc_theta, mh, mgh, c_theta, inv_i, rest, q)  # fmt: skip  # noqa: E501
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
             if n_up > 0:
                 t_old = s * dt
-                for i in range(n):
-                    th = theta[b, i]
-                    tn = th_new[i]
-                    if th < 0.0 and tn > 0.0:
-                        t_cross = t_old + dt * th / (th - tn)
+                for i in range(n):  # stops at the last of the n_up crossings
+                    if crossed[i]:
+                        th = theta[b, i]
+                        t_cross = t_old + dt * th / (th - th_new[i])
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                        n_up -= 1
+                        if n_up == 0:
+                            break
             force = -c_phi[b] * phd_pred - sum_kick
             phdd = (rad * sum_num + force) / (total_inertia[b] - rad * rad * sum_den)
             if not math.isfinite(phdd):
@@ -128,14 +130,14 @@ def advance(
 
 
 @nb.njit(cache=True)
-def _libm_pass(b, n, th_new, vel_pred, kick_dt, theta, mh, mgh, c_theta, inv_i, rest, q):
+def _libm_pass(b, n, th_new, dt, kick_dt, theta, theta_dot, acc_theta, mh, mgh, c_theta, inv_i, rest, q):  # fmt: skip  # noqa: E501
     """Redo the first pass with libm trig, for angles beyond the fast reduction."""
     sum_num = 0.0
     sum_den = 0.0
     for i in range(n):
         th = theta[b, i]
         tn = th_new[i]
-        vp = vel_pred[i]
+        vp = theta_dot[b, i] + acc_theta[b, i] * dt
         kick = kick_dt[i] if (th < 0.0 and tn > 0.0) else (-kick_dt[i] if (th > 0.0 and tn < 0.0) else 0.0)  # fmt: skip  # noqa: E501
         sn = math.sin(tn)
         cs = math.cos(tn)

@@ -137,14 +137,17 @@ def advance(
                 if ups[w] > 0 or overs[w] > 0:
                     if alive[w] == 0.0:
                         continue
+                    if overs[w] > 0:
+                        status[b0 + w] |= STATUS_OVERTURNED
                     for i in range(n):
+                        if ups[w] == 0:
+                            break
                         t0 = th[i, w]
                         tn = tn_s[i, w]
-                        if abs(tn) > overturn_angle:
-                            status[b0 + w] |= STATUS_OVERTURNED
                         if t0 < 0.0 and tn > 0.0:
                             t_cross = t_old + dt * t0 / (t0 - tn)
                             upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                            ups[w] -= 1
             for w in range(LANES):
                 force[w] = -cph[w] * phd_pred[w] - s_kick[w]
                 phdd[w] = (rad[w] * s_num[w] + force[w]) / (jt[w] - rad[w] * rad[w] * s_den[w])
