@@ -124,3 +124,25 @@ def test_a_corrupt_compile_cache_is_rebuilt_not_used(tmp_path):
     third = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert third.returncode == 0 and third.stdout == first.stdout, third.stderr
     assert index[0].stat().st_mtime_ns > before
+
+
+@pytest.mark.slow
+def test_every_layout_gives_the_same_ensemble_statistics():
+    """Over a long horizon rounding differences may grow; the statistics must not move."""
+    from metrosync.observables import ensemble_statistics, equilibrium_order
+
+    ens = build_ensemble(7, 184.0, params=get_preset("default"), sigma_bpm=0.75, runs=48, seed=2)
+    steps = 30_000  # 300 s
+    stats = {}
+    for layout in sorted(verlet.KERNELS):
+        state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
+                                n_records=steps // 10 + 1, trajectories=False)  # fmt: skip
+        verlet.advance_state(state, ens.system, dt=0.01, step0=0, n_steps=steps, record_every=10,
+                             overturn_angle=math.pi / 2, layout=layout)  # fmt: skip
+        time = np.arange(steps // 10 + 1) * 0.1
+        stats[layout] = ensemble_statistics(equilibrium_order(state.crossing_order().T, time, 75.0))
+    mean_ref, spread_ref = stats["scalar"]
+    standard_error = spread_ref / np.sqrt(ens.runs)
+    for layout, (mean, spread) in stats.items():
+        assert abs(mean - mean_ref) < 3 * standard_error, (layout, stats)
+        assert spread == pytest.approx(spread_ref, rel=0.3), (layout, stats)
