@@ -36,7 +36,7 @@ from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
 from .progress import progress_bar
 
-BACKENDS = {"numba": numba_backend, "numpy": numpy_backend}
+BACKENDS = {"numba": numba_backend, "numpy": numpy_backend, "gpu": None}  # gpu: imported on use
 #: Oscillator-steps per chunk between progress updates.
 CHUNK_WORK = 4_000_000
 
@@ -77,8 +77,9 @@ def simulate(
     preset : ``"default"``, ``"boda2013"`` or a `ModelParameters`.
     changes : model parameters to change by name, e.g. ``{"drive": 1e-4, "c_phi": 0}``.
     integrator : ``"verlet"`` (the paper's scheme) or ``"exact"`` (reference).
-    backend : for ``verlet``, ``"numba"`` (compiled, parallel over runs) or
-        ``"numpy"`` (plain reference, slow).
+    backend : for ``verlet``, ``"numba"`` (compiled, parallel over runs), ``"numpy"``
+        (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through numba.cuda; no
+        trajectories yet).
     frequencies_bpm, metronomes, amplitude, theta0, theta_dot0 : see `build_ensemble`.
     record_every : record every this many steps; default the step count of 0.1 s.
     trajectories : also keep θ, θ̇, φ, φ̇ at each record.
@@ -141,8 +142,9 @@ def simulate(
     show = _sys.stderr.isatty() if progress is None else progress
 
     if integrator == "verlet":
+        kernel = _backend_module(backend, trajectories)
         records = _run_fixed_step(
-            ensemble, BACKENDS[backend], dt, n_steps, record_every, n_records, trajectories,
+            ensemble, kernel, dt, n_steps, record_every, n_records, trajectories,
             overturn_angle, show,
         )  # fmt: skip
     else:
@@ -172,6 +174,25 @@ def simulate(
         "overturn_angle": overturn_angle,
     }
     return _to_dataset(ensemble, records, record_every * dt, window, settings)
+
+
+def _backend_module(backend: str, trajectories: bool):
+    if backend != "gpu":
+        return BACKENDS[backend]
+    from .integrators import kernel_cuda
+
+    if not kernel_cuda.gpu_available():
+        raise ParameterError(
+            "`backend` 'gpu' needs an NVIDIA GPU with a working CUDA driver, and numba found "
+            "none (numba.cuda.is_available() is False). Install the driver and "
+            "`pip install metrosync[gpu]` on a GPU machine, or use backend='numba'."
+        )
+    if trajectories:
+        raise ParameterError(
+            "`backend` 'gpu' does not record trajectories yet; use backend='numba' with "
+            "`trajectories=True` (or `--save-every`)."
+        )
+    return kernel_cuda
 
 
 def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, trajectories,

@@ -46,7 +46,8 @@ def add_ensemble_options(parser: argparse.ArgumentParser) -> None:
         help="change one model parameter, e.g. --set drive=1e-4 (repeatable)",
     )
     g.add_argument("--integrator", choices=("verlet", "exact"), default="verlet")
-    g.add_argument("--backend", choices=("numba", "numpy"), default="numba")
+    g.add_argument("--backend", choices=("numba", "numpy", "gpu"), default="numba",
+                   help="numba (CPU), numpy (plain reference) or gpu (NVIDIA, CUDA)")  # fmt: skip
     g.add_argument(
         "--amplitude", type=float, default=None, help="start amplitude, rad (random phases)"
     )

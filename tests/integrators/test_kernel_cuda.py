@@ -1,0 +1,57 @@
+"""The GPU kernel, checked in numba's CUDA simulator (no GPU needed), and the clear
+refusal of ``backend="gpu"`` on a machine without one."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from metrosync import ParameterError, simulate
+from metrosync.integrators import kernel_cuda
+
+SIMULATED_CHECK = """
+import math
+import numpy as np
+from metrosync import build_ensemble, get_preset
+from metrosync.integrators import kernel_cuda, reference
+from metrosync.integrators._state import StepState
+
+# 4 threads for 5 metronomes: each thread strides over two of them.
+ens = build_ensemble(5, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=2, seed=3)
+def run(advance, **kw):
+    st = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
+                         n_records=13, trajectories=False)
+    for c in range(2):  # two chunks: the state must survive the round trip to the device
+        advance(st, ens.system, dt=0.01, step0=60 * c, n_steps=60, record_every=10,
+                overturn_angle=math.pi / 2, **kw)
+    return st
+gpu = run(kernel_cuda.advance_state, threads=4)
+ref = run(reference.advance_state)
+assert np.count_nonzero(ref.cross_count) > 0, "no crossing was booked"
+for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r"):
+    np.testing.assert_allclose(getattr(gpu, name), getattr(ref, name), rtol=0, atol=1e-9)
+np.testing.assert_allclose(gpu.crossing_order(), ref.crossing_order(), atol=1e-9)
+np.testing.assert_array_equal(gpu.status, ref.status)
+print("ok")
+"""
+
+
+@pytest.mark.slow
+def test_gpu_kernel_matches_the_reference_in_the_cuda_simulator():
+    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
+    done = subprocess.run([sys.executable, "-c", SIMULATED_CHECK], env=env, capture_output=True,
+                          text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-3000:]
+
+
+@pytest.mark.skipif(kernel_cuda.gpu_available(), reason="this machine has a GPU")
+def test_gpu_backend_without_a_gpu_says_what_is_missing():
+    with pytest.raises(ParameterError, match=r"`backend` 'gpu' needs an NVIDIA GPU.*numba"):
+        simulate(3, 192, runs=2, duration=1, backend="gpu")
+
+
+def test_threads_per_block_cover_the_metronomes():
+    assert kernel_cuda.threads_for(2) == 32
+    assert kernel_cuda.threads_for(100) == 128
+    assert kernel_cuda.threads_for(10_000) == kernel_cuda.MAX_THREADS
