@@ -2,7 +2,7 @@
 
 Contract: a store is a directory. ``points/<key>.nc`` holds one finished point, named
 by its content hash (`PointSpec.key`), written to a temporary file and moved into
-place with `os.replace`, so a file at that name is always complete; a crash loses at
+place (`metrosync._files.atomic_path`), so a file at that name is always complete; a crash loses at
 most the points in flight. A point is finished when its file exists; a sweep started
 again skips those points, and a point whose inputs changed has another key, so a
 stale file is never read for it. ``log.jsonl`` gets one line per point computed
@@ -16,15 +16,14 @@ deterministic content, so the merge does not depend on which executor ran them.
 from __future__ import annotations
 
 import json
-import os
 import socket
-import uuid
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from .._files import write_netcdf
 from ..integrators._state import STATUS_MEANINGS
 from .grid import UNITS, Grid, PointSpec
 
@@ -86,15 +85,8 @@ class PointStore:
 
     def write(self, ds: xr.Dataset, *, seconds: float = float("nan"), host: str = "") -> Path:
         """Write one point atomically, then log it."""
-        self.points.mkdir(parents=True, exist_ok=True)
         key = ds.attrs["key"]
-        final = self.path(key)
-        tmp = self.points / f".{key}.{uuid.uuid4().hex}.partial"
-        try:
-            ds.to_netcdf(tmp, engine="h5netcdf")
-            os.replace(tmp, final)
-        finally:
-            tmp.unlink(missing_ok=True)
+        final = write_netcdf(ds, self.path(key))
         line = json.dumps(
             {"key": key, "seconds": round(seconds, 4), "host": host or socket.gethostname()}
         )
@@ -199,12 +191,4 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
 
 def write_dataset(ds: xr.Dataset, path: str | Path) -> Path:
     """Write the merged sweep to NetCDF atomically (a crash never leaves half a file)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.partial")
-    try:
-        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=False)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return write_netcdf(ds, path)
