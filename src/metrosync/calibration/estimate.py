@@ -38,12 +38,10 @@ class Estimate:
 
     def plot(self, path: Path | str | None = None):
         """Data and fitted curve; returns the figure, writes it to ``path`` if given."""
-        import matplotlib
+        from ..plots import finish_figure, new_figure
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
+        fig = new_figure(path, figsize=(6, 4), layout="constrained")
+        ax = fig.subplots()
         ax.plot(self.x, self.y, "o", ms=4, label="data")
         ax.plot(
             self.fit_x,
@@ -56,7 +54,4 @@ class Estimate:
         ax.set_ylabel(self.ylabel)
         ax.set_title(self.title)
         ax.legend()
-        if path is not None:
-            fig.savefig(path, dpi=120)
-            plt.close(fig)
-        return fig
+        return finish_figure(fig, path)

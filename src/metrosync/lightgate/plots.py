@@ -4,15 +4,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from ..plots import finish_figure, new_figure
 
 
 def plot_analysis(ds, path: Path | str | None = None):
-    """r(t) of each log (thin) and their mean (thick); returns the figure."""
-    fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
+    """r(t) of each log (thin) and their mean (thick); returns the figure.
+
+    ds : an `analyze` dataset, r (time) and r_runs (log, time).
+    path : write the figure there (atomically) when given.
+    """
+    fig = new_figure(path, figsize=(7, 4), layout="constrained")
+    ax = fig.subplots()
     t = ds.time.values
     for k in range(ds.sizes["log"]):
         ax.plot(t, ds.r_runs.values[k], lw=0.6, alpha=0.5, color="0.5")
@@ -27,7 +29,4 @@ def plot_analysis(ds, path: Path | str | None = None):
     ax.set_ylabel("r")
     ax.set_ylim(0, 1.02)
     ax.legend(loc="lower right")
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    return finish_figure(fig, path)

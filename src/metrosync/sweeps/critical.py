@@ -240,15 +240,19 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
 
 
 def plot_critical(result: xr.Dataset, path=None):
-    """r̄(ω₀) and σ_r(ω₀) for every N with ω_c marked, and ω_c against N with the fit."""
+    """r̄(ω₀) and σ_r(ω₀) for every N with ω_c marked, and ω_c against N with the fit.
+
+    result : a `critical_frequency` dataset.   path : write the figure there when given.
+    Returns the figure.
+    """
     import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from ..plots import finish_figure, new_figure
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), constrained_layout=True)
+    fig = new_figure(path, figsize=(14, 4.2), layout="constrained")
+    axes = fig.subplots(1, 3)
     bpm = result.bpm.values
-    colors = plt.cm.viridis(np.linspace(0, 0.9, result.sizes["n"]))
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, result.sizes["n"]))
     for color, n in zip(colors, result.n.values, strict=True):
         one = result.sel(n=n)
         axes[0].plot(bpm, one.r_mean, "o-", ms=3, color=color, label=f"N = {n}")
@@ -276,7 +280,4 @@ def plot_critical(result: xr.Dataset, path=None):
                         xycoords="axes fraction", fontsize=8, va="top")  # fmt: skip
     ax.set(xscale="log", xlabel="N", ylabel="ω_c (BPM)", title="finite-size extrapolation")
     ax.legend(loc="lower right", fontsize=8)
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    return finish_figure(fig, path)
