@@ -68,8 +68,8 @@ def analyze(
     channels : gates to analyse (0-based); default all.
     glitch, max_interruption, min_asymmetry : cleaning options, see `clean_channel`.
     grid_dt : spacing of the r(t) grid, s.
-    equilibrium_window : seconds at the end of the grid averaged for ``r_eq``;
-        default a quarter of the grid's span.
+    equilibrium_window : seconds at the end of the grid averaged for ``r_eq``, at most
+        the grid's span; default a quarter of it.
 
     Returns
     -------
@@ -121,8 +121,11 @@ def analyze(
     mean_freq = freq.mean(axis=0)
     span = grid[-1] - grid[0]
     window = span / 4 if equilibrium_window is None else float(equilibrium_window)
-    if not (0 < window):
-        raise ParameterError(f"`equilibrium_window` must be > 0 s, got {equilibrium_window!r}.")
+    if not (0 < window <= span):
+        raise ParameterError(
+            f"`equilibrium_window` must be in (0, {span:g}] s (the span of the r(t) grid), "
+            f"got {equilibrium_window!r}."
+        )
     r_eq = float(equilibrium_order(r, grid, window))
     sigma = ph.frequency_spread(mean_freq)
     reports = "\n".join(
