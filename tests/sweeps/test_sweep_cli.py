@@ -1,5 +1,7 @@
 """``metrosync sweep`` and ``metrosync critical`` from the command line."""
 
+import numpy as np
+import pytest
 import xarray as xr
 
 from metrosync.cli import main
@@ -45,3 +47,29 @@ def test_errors_are_reported_not_raised(tmp_path, capsys):
     assert "unknown sweep parameter 'colour'" in capsys.readouterr().err
     assert main(["critical", str(tmp_path / "missing.nc")]) == 2
     assert "cannot read sweep" in capsys.readouterr().err
+
+
+def test_ignored_or_failing_settings_are_not_silent(tmp_path, capsys):
+    out = str(tmp_path / "x.nc")
+    base = ["sweep", "--bpm", "186,190", "--runs", "1", "--duration", "2", "--no-progress"]
+    assert main([*base, "--workers", "2", "--out", out]) == 2
+    assert "`n_workers` (--workers) = 2 applies to scheduler='local' only" in (
+        capsys.readouterr().err
+    )
+    assert main([*base, "--dt", "0.5", "--out", out]) == 1  # every point fails: not a success
+    assert "2 point(s) without a result" in capsys.readouterr().out
+
+
+def test_critical_marks_estimates_at_the_end_of_the_grid(tmp_path, capsys):
+    bpm = np.arange(180.0, 190.5, 2.0)
+    rng = np.random.default_rng(0)
+    x = (bpm - 180)[None, :, None]  # r rises ever faster and scatters ever more: up to 190
+    r = 0.2 + 0.006 * x**2 + rng.normal(0, 1, (1, 6, 40)) * (0.002 + 0.01 * x)
+    path = tmp_path / "rising.nc"
+    xr.Dataset({"r_eq": (("n", "bpm", "run"), r)}, coords={"n": [7], "bpm": bpm}).to_netcdf(
+        path, engine="h5netcdf"
+    )
+    assert main(["critical", str(path), "--bootstrap", "20", "--no-plot"]) == 0
+    assert "* at an end of the bpm grid (180 .. 190 BPM)" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["critical", str(path), "--no-plot", "--plot", str(tmp_path / "c.png")])

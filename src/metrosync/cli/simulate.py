@@ -6,36 +6,46 @@ import argparse
 import time
 from pathlib import Path
 
-from ._options import add_ensemble_options, simulate_from_args
+from ..errors import ParameterError
+from ..plots import plot_order
+from ._io import check_output, figure_suffixes, write_outputs
+from ._options import HelpFormatter, add_aliases, add_ensemble_options, simulate_from_args
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "simulate",
         help="simulate an ensemble of metronomes",
-        description="Simulate B independent runs of N metronomes on a free disk.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        description="Simulate B independent runs of N metronomes on a free disk, print "
+        "the equilibrium order parameter, and write the dataset, a plot of r(t) and "
+        "virtual light-gate logs when asked.",
+        formatter_class=HelpFormatter,
     )
     add_ensemble_options(parser)
     out = parser.add_argument_group("output")
     out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
-    out.add_argument("--plot", type=Path, default=None, help="write r(t) to FILE.png")
+    out.add_argument("--plot", type=Path, default=None,
+                     help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
     gate = parser.add_argument_group("virtual light gate")
     gate.add_argument(
         "--lightgate-dir",
         type=Path,
         default=None,
         metavar="DIR",
-        help="write one light-gate log per run to DIR (records every step)",
+        help="write one light-gate log per run to DIR (simulates recording every step)",
     )
     gate.add_argument("--gate-offset", type=float, default=0.1, help="beam centre angle, rad")
     gate.add_argument("--gate-width", type=float, default=0.05, help="beam width, rad")
     gate.add_argument("--gate-jitter", type=float, default=0.0, help="timing noise (std), s")
     gate.add_argument("--gate-counter-bits", type=int, default=16, help="logger counter width")
+    add_aliases(parser, offset="--gate-offset", width="--gate-width", jitter="--gate-jitter",
+                counter_bits="--gate-counter-bits")  # fmt: skip
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
+    check_output(args.out, "--out")
+    check_output(args.plot, "--plot", suffixes=figure_suffixes() if args.plot else None)
     started = time.perf_counter()
     if args.lightgate_dir is None:
         ds = simulate_from_args(args)
@@ -43,14 +53,7 @@ def run(args) -> int:
         ds = _simulate_with_gate(args)
     elapsed = time.perf_counter() - started
     print(summary(ds, elapsed))
-    if args.out is not None:
-        write_netcdf(ds, args.out)
-        print(f"wrote {args.out}")
-    if args.plot is not None:
-        from ..plots import plot_order
-
-        plot_order(ds, args.plot)
-        print(f"wrote {args.plot}")
+    write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_order)
     return 0
 
 
@@ -62,11 +65,14 @@ def _simulate_with_gate(args):
     gate = LightGate(offset=args.gate_offset, width=args.gate_width, jitter=args.gate_jitter,
                      counter_bits=args.gate_counter_bits, seed=args.seed)  # fmt: skip
     if args.n > 8:
-        from ..errors import ParameterError
-
         raise ParameterError(
             f"`--lightgate-dir`: the logger follows at most 8 gates, got --n {args.n}."
         )
+    if args.lightgate_dir.exists() and not args.lightgate_dir.is_dir():
+        raise ParameterError(
+            f"`--lightgate-dir` {str(args.lightgate_dir)!r} is a file; give a directory."
+        )
+    check_output(args.lightgate_dir / "run000.log", "--lightgate-dir")
     asked = args.save_every
     fine = simulate_from_args(argparse.Namespace(**{**vars(args), "save_every": 1}))
     paths = write_logs(fine, args.lightgate_dir, gate)
@@ -83,15 +89,6 @@ def _simulate_with_gate(args):
     mean, spread = ensemble_statistics(ds.r_eq.values)
     ds.attrs.update(r_eq_mean=mean, r_eq_std=spread, record_every=every)
     return ds
-
-
-def write_netcdf(ds, path: Path) -> None:
-    """Write atomically: a crash never leaves a half-written file at ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".partial")
-    ds.to_netcdf(tmp, engine="h5netcdf")
-    tmp.replace(path)
 
 
 def summary(ds, elapsed: float) -> str:
