@@ -80,14 +80,23 @@ def _slope(bpm: np.ndarray, mean: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ``SLOPE_WINDOW`` points) on an even grid, else plain differences at midpoints.
 
     Differentiating noisy means amplifies the noise; the local quadratic fit tames it
-    and, being symmetric, leaves the position of a symmetric rise unbiased.
+    and, being symmetric, leaves the position of a symmetric rise unbiased. Where a
+    fit's window holds a NaN mean (no finite run there), its slope is NaN.
     """
     steps = np.diff(bpm)
     if bpm.size >= SLOPE_WINDOW and np.allclose(steps, steps[0], rtol=1e-6):
+        missing = ~np.isfinite(mean)
         slope = savgol_filter(
-            mean, SLOPE_WINDOW, 2, deriv=1, delta=steps[0], axis=-1, mode="interp"
-        )
-        return bpm, slope
+            np.where(missing, 0.0, mean), SLOPE_WINDOW, 2, deriv=1, delta=steps[0], axis=-1,
+            mode="interp",
+        )  # fmt: skip
+        # Position k uses the window centred on it; the first and last half-windows share
+        # the window at their end of the grid (mode="interp").
+        half = SLOPE_WINDOW // 2
+        centre = np.clip(np.arange(bpm.size), half, bpm.size - 1 - half)
+        windows = centre[:, None] + np.arange(-half, half + 1)[None, :]
+        touched = missing[..., windows].any(axis=-1)
+        return bpm, np.where(touched, np.nan, slope)
     return 0.5 * (bpm[1:] + bpm[:-1]), np.diff(mean, axis=-1) / steps
 
 
@@ -203,6 +212,15 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
         n_value = sweep.attrs.get("fixed_n", 0)
         r = r.expand_dims(n=[n_value])
     r = r.sortby("bpm").transpose("n", "bpm", "run")
+    empty = [
+        n.item() for n, row in zip(r.n.values, r.values, strict=True) if not np.isfinite(row).any()
+    ]
+    if empty:
+        raise ParameterError(
+            f"`sweep` has no finite r_eq for N = {empty}: every point failed, or the runs are "
+            f"too short for the crossing phase (each metronome must cross zero twice before "
+            f"the final window). Sweep a longer `duration`, or select other N."
+        )
     bpm = r.bpm.values.astype(float)
     step = float(np.min(np.diff(bpm)))
     values = r.values
