@@ -2,6 +2,7 @@
 
 import errno
 import re
+import subprocess
 import sys
 from pathlib import Path
 
@@ -114,3 +115,15 @@ def test_warnings_are_one_line(capsys):
     err = capsys.readouterr().err
     assert "metrosync simulate: warning:" in err and "overturn" in err
     assert "warnings.warn" not in err
+
+
+def test_a_closed_output_pipe_ends_quietly():
+    log = Path(__file__).parent.parent / "data" / "clean.log"
+    code = f"from metrosync.cli import main; raise SystemExit(main(['analyze', {str(log)!r}]))"
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)  # fmt: skip
+    child.stdout.close()  # like `metrosync analyze ... | head -0`
+    with child.stderr:
+        err = child.stderr.read()
+    assert child.wait() == 1
+    assert "Traceback" not in err and "Exception ignored" not in err and "error" not in err

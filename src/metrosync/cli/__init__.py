@@ -4,14 +4,17 @@ Each subcommand module exposes ``register(subparsers)``, which adds its parser a
 sets ``func`` to a handler taking the parsed arguments and returning an exit code.
 
 Exit codes: 0 success; 1 the work ran but did not fully succeed (a sweep with
-failed or missing points) or a file could not be written; 2 bad input, reported in
-one line that names the option, the value and what to do (a `MetrosyncError`).
+failed or missing points), a file could not be written, or the reader of the output
+went away; 2 bad input, reported in one line that names the option, the value and
+what to do (a `MetrosyncError`). Warnings print as one line each.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import os
 import re
 import sys
 import warnings
@@ -67,6 +70,12 @@ def main(argv: list[str] | None = None) -> int:
         message = name_options(str(error), getattr(args, "_aliases", None) or {})
         print(f"metrosync {args.command}: error: {message}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The reader went away (`metrosync analyze ... | head`): stop quietly, and keep
+        # the interpreter from complaining when it flushes stdout at exit.
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
     except OSError as error:
         # Disk full, permissions, a file vanishing: the environment, not a bug to trace.
         where = f" {error.filename!r}" if error.filename else ""
