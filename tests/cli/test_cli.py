@@ -127,3 +127,11 @@ def test_a_closed_output_pipe_ends_quietly():
         err = child.stderr.read()
     assert child.wait() == 1
     assert "Traceback" not in err and "Exception ignored" not in err and "error" not in err
+
+
+def test_options_that_would_be_ignored_are_not_silent(capsys):
+    assert main(["simulate", "--gate-jitter", "1e-4", "--duration", "1"]) == 2
+    assert "`--gate-jitter` sets up the virtual light gate" in capsys.readouterr().err
+    argv = ["simulate", "--integrator", "exact", "--backend", "numpy", "--n", "2", "--runs", "1"]
+    assert main([*argv, "--duration", "0.2"]) == 0
+    assert "`--backend numpy` applies to `--integrator verlet` only" in capsys.readouterr().err

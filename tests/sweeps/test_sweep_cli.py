@@ -45,6 +45,10 @@ def test_errors_are_reported_not_raised(tmp_path, capsys):
     assert "nothing to sweep" in capsys.readouterr().err
     assert main(["sweep", "--bpm", "180,190", "--set", "colour=1", "--out", out]) == 2
     assert "unknown sweep parameter 'colour'" in capsys.readouterr().err
+    assert (
+        main(["sweep", "--bpm", "180,190", "--drive", "1e-4", "--set", "M=2e-4", "--out", out]) == 2
+    )
+    assert "`drive` is given twice ('1e-4' and '2e-4'" in capsys.readouterr().err
     assert main(["critical", str(tmp_path / "missing.nc")]) == 2
     assert "cannot read sweep" in capsys.readouterr().err
 

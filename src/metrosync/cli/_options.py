@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import warnings
 
 from ..errors import ParameterError
 
@@ -85,8 +86,8 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
     g.add_argument(
         "--backend",
         choices=("numba", "numpy"),
-        default="numba",
-        help="for verlet: compiled kernel, or the plain NumPy reference (slow)",
+        default=None,
+        help="for verlet: compiled kernel, or the plain NumPy reference, slow (default: numba)",
     )
     g.add_argument(
         "--amplitude",
@@ -149,6 +150,13 @@ def simulate_from_args(args, **extra):
     """Run `metrosync.simulate` with the ensemble options of ``args``."""
     from ..simulate import simulate
 
+    if args.backend is not None and args.integrator != "verlet":
+        warnings.warn(
+            f"`--backend {args.backend}` applies to `--integrator verlet` only; "
+            f"`--integrator {args.integrator}` ignores it.",
+            UserWarning,
+            stacklevel=2,
+        )
     return simulate(
         args.n,
         args.bpm,
@@ -160,7 +168,7 @@ def simulate_from_args(args, **extra):
         preset=args.preset,
         changes=parse_changes(args.changes) or None,
         integrator=args.integrator,
-        backend=args.backend,
+        backend=args.backend or "numba",
         amplitude=args.amplitude,
         theta0=args.theta0,
         theta_dot0=args.theta_dot0,

@@ -11,6 +11,14 @@ from ..plots import plot_order
 from ._io import check_output, figure_suffixes, write_outputs
 from ._options import HelpFormatter, add_aliases, add_ensemble_options, simulate_from_args
 
+#: Options of the virtual light gate: type, default, help, and the `LightGate` field.
+GATE_OPTIONS = {
+    "--gate-offset": (float, 0.1, "beam centre angle, rad", "offset"),
+    "--gate-width": (float, 0.05, "beam width, rad", "width"),
+    "--gate-jitter": (float, 0.0, "timing noise (std), s", "jitter"),
+    "--gate-counter-bits": (int, 16, "logger counter width, bits", "counter_bits"),
+}
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -34,18 +42,23 @@ def register(subparsers) -> None:
         metavar="DIR",
         help="write one light-gate log per run to DIR (simulates recording every step)",
     )
-    gate.add_argument("--gate-offset", type=float, default=0.1, help="beam centre angle, rad")
-    gate.add_argument("--gate-width", type=float, default=0.05, help="beam width, rad")
-    gate.add_argument("--gate-jitter", type=float, default=0.0, help="timing noise (std), s")
-    gate.add_argument("--gate-counter-bits", type=int, default=16, help="logger counter width")
-    add_aliases(parser, offset="--gate-offset", width="--gate-width", jitter="--gate-jitter",
-                counter_bits="--gate-counter-bits")  # fmt: skip
+    for flag, (kind, default, text, _) in GATE_OPTIONS.items():
+        gate.add_argument(flag, type=kind, default=default, help=text)
+    add_aliases(parser, **{name: flag for flag, (*_, name) in GATE_OPTIONS.items()})
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
     check_output(args.out, "--out")
     check_output(args.plot, "--plot", suffixes=figure_suffixes() if args.plot else None)
+    if args.lightgate_dir is None:
+        given = [flag for flag, (_, default, *_) in GATE_OPTIONS.items()
+                 if getattr(args, flag[2:].replace("-", "_")) != default]  # fmt: skip
+        if given:
+            raise ParameterError(
+                f"`{given[0]}` sets up the virtual light gate; add `--lightgate-dir DIR` "
+                f"to write its logs, or drop {', '.join(given)}."
+            )
     started = time.perf_counter()
     if args.lightgate_dir is None:
         ds = simulate_from_args(args)

@@ -60,7 +60,7 @@ def register(subparsers) -> None:
 
 
 def grid_from_args(args):
-    from ..sweeps.grid import Grid
+    from ..sweeps.grid import Grid, canonical_name
 
     axes, fixed = {}, {}
     items = [
@@ -71,10 +71,17 @@ def grid_from_args(args):
         if not sep or not spec.strip():
             raise ParameterError(f"`--set` expects NAME=SPEC, got {item!r}.")
         items.append((name.strip(), spec.strip()))
+    given: dict[str, str] = {}
     for name, spec in items:
         if spec is None:
             continue
-        name = "sigma_bpm" if name == "sigma" else name
+        name = canonical_name(name)
+        if name in given:
+            raise ParameterError(
+                f"`{name}` is given twice ({given[name]!r} and {spec!r}, by an option and "
+                f"`--set`); keep one."
+            )
+        given[name] = spec
         (axes if (":" in spec or "," in spec) else fixed)[name] = spec
     options = {"keep_r": True} if args.keep_r else {}
     if args.preset is not None:
