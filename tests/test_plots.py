@@ -63,3 +63,12 @@ def test_path_and_ax_together_are_refused(run, tmp_path):
         plot_order(run, tmp_path / "x.png", ax=ax)
     assert plot_order(run, ax=ax) is fig
     plt.close(fig)
+
+
+def test_the_crossing_curve_averages_all_runs_or_none(run):
+    fig = plot_order(run)
+    y = fig.axes[0].lines[1].get_ydata()
+    every = run.r_crossing.notnull().all("run").values
+    assert np.array_equal(np.isfinite(y), every) and every.any()
+    assert np.allclose(y[every], run.r_crossing.mean("run").values[every])
+    plt.close(fig)

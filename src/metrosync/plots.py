@@ -59,17 +59,27 @@ def plot_order(ds, path: Path | str | None = None, *, ax=None):
         fig = ax.figure
     t = ds.time.values
     ax.plot(t, ds.r.mean("run"), lw=1, label="r, analytic phase")
+    # The crossing phase is undefined before a run's first crossings and after its last:
+    # averaging whichever runs have one there would jump. Show the mean where all do.
+    count = ds.r_crossing.notnull().sum("run")
     with np.errstate(all="ignore"):
-        ax.plot(t, ds.r_crossing.mean("run", skipna=True), lw=1, label="r, crossing phase")
-    window = ds.attrs.get("equilibrium_window")
-    if window:
-        ax.axvspan(t[-1] - window, t[-1], color="0.9", zorder=0, label="equilibrium window")
+        crossing = ds.r_crossing.mean("run").where(count == count.max())
+    ax.plot(t, crossing, lw=1, label="r, crossing phase")
     a = ds.attrs
     ax.set_title(
         f"N = {a['n']}, {a['bpm']} BPM, σ = {a['sigma_bpm']} BPM, mean of {a['runs']} runs"
     )
-    ax.set_xlabel("t (s)")
+    order_axes(ax, t[-1], a.get("equilibrium_window"), xlabel="t (s)")
+    return finish_figure(fig, path)
+
+
+def order_axes(ax, end: float, window: float | None, *, xlabel: str,
+               window_label: str = "equilibrium window") -> None:  # fmt: skip
+    """Finish an r(t) panel: shade the final ``window`` (s) before ``end`` that r_eq
+    averages (when there is one), label the axes, r from 0 to 1, legend."""
+    if window:
+        ax.axvspan(end - window, end, color="0.9", zorder=0, label=window_label)
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("r")
     ax.set_ylim(0, 1.02)
     ax.legend(loc="lower right")
-    return finish_figure(fig, path)
