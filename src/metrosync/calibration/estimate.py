@@ -32,6 +32,7 @@ class Estimate:
     details: dict = field(default_factory=dict)
 
     def summary(self) -> str:
+        """One line: the value with its unit and the details."""
         extra = ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}"
                           for k, v in self.details.items())  # fmt: skip
         return f"{self.name} = {self.value:.6g} {self.unit}" + (f" ({extra})" if extra else "")

@@ -29,6 +29,7 @@ SUBCOMMANDS = (
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``metrosync`` parser with every subcommand registered."""
     parser = argparse.ArgumentParser(
         prog="metrosync",
         description="Simulate and measure the synchronization of metronomes on a rotating disk.",
@@ -55,6 +56,7 @@ def name_options(message: str, aliases: dict[str, str]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run ``metrosync`` with ``argv`` (default: the process's); returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
 

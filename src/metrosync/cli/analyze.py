@@ -12,6 +12,7 @@ from ._options import HelpFormatter, add_aliases, int_list
 
 
 def counter_bits_arg(text: str):
+    """``--counter-bits``: ``auto``, ``none`` (never wraps) or a width in bits."""
     if text == "auto":
         return "auto"
     if text == "none":
@@ -86,6 +87,7 @@ def run(args) -> int:
 
 
 def summary(ds) -> str:
+    """The printed summary: frequencies, jitter, σ, r_eq and the cleaning report."""
     a = ds.attrs
     lines = [
         f"metrosync analyze: {ds.sizes['log']} log(s), {ds.sizes['metronome']} metronomes, "

@@ -105,6 +105,7 @@ def _simulate_with_gate(args):
 
 
 def summary(ds, elapsed: float) -> str:
+    """The printed summary: frequencies, r_eq ± σ_r, flagged runs, throughput."""
     a = ds.attrs
     bad = int((ds.status != 0).sum())
     masks = ds.status.attrs["flag_masks"]

@@ -60,6 +60,7 @@ def register(subparsers) -> None:
 
 
 def grid_from_args(args):
+    """The `Grid` from the grid file and the options (an option replaces the file's value)."""
     from ..sweeps.grid import Grid, canonical_name
 
     axes, fixed = {}, {}

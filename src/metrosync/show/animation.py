@@ -121,6 +121,7 @@ class DiskView:
         self.cursor = order_ax.axvline(start, color="C3", lw=1.2)
 
     def draw(self, t: float) -> None:
+        """Move every artist to simulated time ``t`` (s)."""
         run = self.run
         times = np.array([t])
         theta = run.theta_at(times)[0]

@@ -58,6 +58,7 @@ class ClickTrack:
 
     @property
     def duration(self) -> float:
+        """Length of the audio, s."""
         return self.samples.shape[0] / self.sample_rate
 
     def write(self, path: Path | str) -> Path:

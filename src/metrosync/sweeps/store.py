@@ -73,9 +73,11 @@ class PointStore:
         self.log_path = self.root / "log.jsonl"
 
     def path(self, key: str) -> Path:
+        """File of the point with content hash ``key``."""
         return self.points / f"{key}.nc"
 
     def has(self, key: str) -> bool:
+        """True when the point ``key`` is finished (its file exists)."""
         return self.path(key).is_file()
 
     def failed(self, key: str) -> bool:
@@ -95,6 +97,7 @@ class PointStore:
         return final
 
     def read(self, key: str) -> xr.Dataset:
+        """Load the point ``key``; `OSError` if its file holds another key."""
         with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
             loaded = ds.load()
         if loaded.attrs.get("key") != key:
