@@ -20,6 +20,9 @@ def test_analyze_writes_dataset_and_plot(tmp_path, capsys):
     with xr.open_dataset(out, engine="h5netcdf") as ds:
         assert set(ds.r.dims) == {"time"} and ds.frequency_bpm.dims == ("metronome",)
         assert "r_eq" in ds.attrs and "sigma_bpm" in ds.attrs
+        assert [name for name in ds.variables if "long_name" not in ds[name].attrs] == []
+        assert ds.counter_wraps.values.tolist() == [5]  # as the report says
+        assert ds.interrupted_level.values.tolist() == [[0, 0, 0]]
     assert png.stat().st_size > 1000
 
 
