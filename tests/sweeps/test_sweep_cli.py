@@ -26,6 +26,7 @@ def test_sweep_then_critical(tmp_path, capsys):
     assert (tmp_path / "s_critical.png").stat().st_size > 0
     with xr.open_dataset(tmp_path / "c.nc", engine="h5netcdf") as c:
         assert c.omega_c_peak.dims == ("n",) and c.omega_c_peak.attrs["units"] == "BPM"
+        assert [name for name in c.variables if "long_name" not in c[name].attrs] == []
 
 
 def test_grid_file_with_overrides(tmp_path, capsys):

@@ -253,7 +253,10 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
                 f"fit_form_{m}": fit.form,
             }
         )
-    coords = {"n": r.n.values, "bpm": ("bpm", bpm, bpm_units)}
+    coords = {
+        "n": ("n", r.n.values, {"long_name": "metronomes on the disk"}),
+        "bpm": ("bpm", bpm, {**bpm_units, "long_name": "nominal beat frequency ω₀"}),
+    }
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -25,7 +25,7 @@ import xarray as xr
 
 from .._files import write_netcdf
 from ..integrators._state import STATUS_MEANINGS
-from .grid import UNITS, Grid, PointSpec
+from .grid import LONG_NAMES, UNITS, Grid, PointSpec
 
 #: Status of every run of a point whose simulation raised (no result).
 STATUS_FAILED = 4
@@ -177,10 +177,9 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         "error": (dims, error.astype(str), {"long_name": "why the point has no result ('' = ok)"}),
     }
     coords: dict[str, Any] = {
-        name: (name, np.asarray(values), {"units": UNITS[name]} if name in UNITS else {})
-        for name, values in grid.axes.items()
+        name: (name, np.asarray(values), _describe(name)) for name, values in grid.axes.items()
     }
-    coords["run"] = np.arange(n_run)
+    coords["run"] = ("run", np.arange(n_run), {"long_name": "run of the ensemble at each point"})
     if time is not None:
         data["r"] = ((*dims, "time", "run"), r_t, {"long_name": "Kuramoto r (analytic phase)"})
         data["r_crossing"] = (
@@ -188,8 +187,16 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
             r_cross,
             {"long_name": "Kuramoto r (crossing phases)"},
         )
-        coords["time"] = ("time", time, {"units": "s"})
+        coords["time"] = ("time", time, {"units": "s", "long_name": "simulated time"})
     return xr.Dataset(data, coords=coords, attrs=grid.describe())
+
+
+def _describe(name: str) -> dict[str, str]:
+    """Attributes of the coordinate of swept parameter ``name``."""
+    attrs = {"long_name": LONG_NAMES.get(name, name)}
+    if name in UNITS:
+        attrs["units"] = UNITS[name]
+    return attrs
 
 
 def write_dataset(ds: xr.Dataset, path: str | Path) -> Path:
