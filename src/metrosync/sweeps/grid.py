@@ -76,27 +76,6 @@ UNITS = {
     "radius": "m",
     "g": "m/s2",
 }
-#: What each parameter is, for the coordinates of a merged sweep.
-LONG_NAMES = {
-    "n": "metronomes on the disk",
-    "bpm": "nominal beat frequency",
-    "sigma_bpm": "spread (std) of the natural frequencies",
-    "runs": "independent runs",
-    "duration": "simulated time",
-    "dt": "time step",
-    "seed": "sweep seed",
-    "drive": "escapement impulse M",
-    "c_theta": "pendulum friction",
-    "c_phi": "disk friction",
-    "inertia": "disk inertia J",
-    "j0": "disk inertia without metronomes",
-    "j_per_metronome": "disk inertia added per metronome",
-    "w1": "fixed weight",
-    "w2": "sliding weight",
-    "l1": "distance of the fixed weight below the pivot",
-    "radius": "disk radius",
-    "g": "gravitational acceleration",
-}
 #: Grid size above which a typo (e.g. a step of 0.0025 for 2.5) is more likely than intent.
 MAX_POINTS_PER_AXIS = 100_000
 #: Sweep-level options (TOML top level) and their defaults.

@@ -25,13 +25,34 @@ import xarray as xr
 
 from .._files import write_netcdf
 from ..integrators._state import STATUS_MEANINGS
-from .grid import LONG_NAMES, UNITS, Grid, PointSpec
+from .grid import UNITS, Grid, PointSpec
 
 #: Status of every run of a point whose simulation raised (no result).
 STATUS_FAILED = 4
 #: Status value of a run that does not exist (a point with fewer runs than the largest).
 STATUS_ABSENT = -1
 FLAG_MEANINGS = {**STATUS_MEANINGS, STATUS_FAILED: "failed"}
+#: What each parameter is, for the coordinates of a merged sweep.
+LONG_NAMES = {
+    "n": "metronomes on the disk",
+    "bpm": "nominal beat frequency",
+    "sigma_bpm": "spread (std) of the natural frequencies",
+    "runs": "independent runs",
+    "duration": "simulated time",
+    "dt": "time step",
+    "seed": "sweep seed",
+    "drive": "escapement impulse M",
+    "c_theta": "pendulum friction",
+    "c_phi": "disk friction",
+    "inertia": "disk inertia J",
+    "j0": "disk inertia without metronomes",
+    "j_per_metronome": "disk inertia added per metronome",
+    "w1": "fixed weight",
+    "w2": "sliding weight",
+    "l1": "distance of the fixed weight below the pivot",
+    "radius": "disk radius",
+    "g": "gravitational acceleration",
+}
 
 
 def point_dataset(spec: PointSpec, result: xr.Dataset | None, error: str = "") -> xr.Dataset:
