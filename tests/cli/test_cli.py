@@ -85,6 +85,8 @@ def test_bad_outputs_are_refused_before_any_simulation(tmp_path, capsys, monkeyp
     out = tmp_path / "r.nc"
     assert main(["simulate", "--out", str(out), "--plot", str(tmp_path / "r.xyz")]) == 2
     assert "`--plot`" in (err := capsys.readouterr().err) and "must end in" in err and ".png" in err
+    assert main(["simulate", "--out", str(tmp_path / "r.png")]) == 2
+    assert "`--out` " in (err := capsys.readouterr().err) and "must end in .nc" in err
     a_file = tmp_path / "file"
     a_file.write_text("")
     assert main(["simulate", "--out", str(a_file / "r.nc")]) == 2

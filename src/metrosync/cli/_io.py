@@ -17,6 +17,11 @@ from pathlib import Path
 from .._files import write_netcdf
 from ..errors import ParameterError
 
+#: Suffixes of a NetCDF-4 (HDF5) dataset.
+NETCDF = (".nc", ".nc4", ".cdf", ".h5")
+#: Stands for the suffixes of `figure_suffixes` (resolved only when a figure is asked).
+FIGURE = "figure"
+
 
 def figure_suffixes() -> tuple[str, ...]:
     """File suffixes matplotlib can write (``.png``, ``.pdf``, ``.svg``, ...)."""
@@ -25,23 +30,26 @@ def figure_suffixes() -> tuple[str, ...]:
     return tuple(f".{name}" for name in FigureCanvasBase.get_supported_filetypes())
 
 
-def check_output(path: Path | None, option: str, *, suffixes: Sequence[str] | None = None) -> None:
+def check_output(
+    path: Path | None, option: str, *, suffixes: Sequence[str] | str | None = None
+) -> None:
     """Refuse an output path that cannot be written, before any work is done.
 
     path : the file to write (None: nothing asked, nothing checked).
     option : the option that gave it, for the message (``"--plot"``).
-    suffixes : the suffixes accepted (lower case, with the dot); None accepts any.
+    suffixes : the suffixes accepted (lower case, with the dot), `NETCDF`, `FIGURE`;
+        None accepts any.
     """
     if path is None:
         return
     path = Path(path)
-    if suffixes is not None and path.suffix.lower() not in suffixes:
-        shown = ", ".join(suffixes[:8]) + (", ..." if len(suffixes) > 8 else "")
-        raise ParameterError(
-            f"`{option}` {str(path)!r} must end in {shown} (the suffix picks the format)."
-        )
     if path.is_dir():
         raise ParameterError(f"`{option}` {str(path)!r} is a directory; give a file name.")
+    if suffixes == FIGURE:
+        suffixes = figure_suffixes()
+    if suffixes is not None and path.suffix.lower() not in suffixes:
+        shown = ", ".join(suffixes[:8]) + (", ..." if len(suffixes) > 8 else "")
+        raise ParameterError(f"`{option}` {str(path)!r} must end in {shown}, the format it writes.")
     folder = path.parent
     while not folder.exists():  # the missing folders will be created
         folder = folder.parent

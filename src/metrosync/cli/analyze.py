@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
-from ._io import check_output, figure_suffixes, write_outputs
+from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import HelpFormatter, add_aliases, int_list
 
 
@@ -67,8 +67,8 @@ def run(args) -> int:
     from ..lightgate import analyze
     from ..lightgate.plots import plot_analysis
 
-    check_output(args.out, "--out")
-    check_output(args.plot, "--plot", suffixes=figure_suffixes() if args.plot else None)
+    check_output(args.out, "--out", suffixes=NETCDF)
+    check_output(args.plot, "--plot", suffixes=FIGURE)
     ds = analyze(
         args.logs,
         tick=args.tick,

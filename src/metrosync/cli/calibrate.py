@@ -7,7 +7,7 @@ import warnings
 from pathlib import Path
 
 from ..errors import ParameterError
-from ._io import check_output, figure_suffixes, read_dataset
+from ._io import FIGURE, check_output, read_dataset
 from ._options import HelpFormatter
 
 #: --bpm of `c-theta --log` when none is given.
@@ -76,7 +76,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from .. import calibration as cal
 
-    check_output(args.plot, "--plot", suffixes=figure_suffixes() if args.plot else None)
+    check_output(args.plot, "--plot", suffixes=FIGURE)
     if args.quantity == "c-theta":
         est = _c_theta(args)
     elif args.quantity == "drive":

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
-from ._io import check_output, figure_suffixes, read_dataset, write_outputs
+from ._io import FIGURE, NETCDF, check_output, read_dataset, write_outputs
 from ._options import HelpFormatter, add_aliases
 
 
@@ -60,8 +60,8 @@ def run(args) -> int:
         if args.no_plot
         else args.plot or args.sweep.with_name(args.sweep.stem + "_critical.png")
     )
-    check_output(plot, "--plot", suffixes=figure_suffixes() if plot else None)
-    check_output(args.out, "--out")
+    check_output(plot, "--plot", suffixes=FIGURE)
+    check_output(args.out, "--out", suffixes=NETCDF)
     ds = _open(args.sweep, args.select)
     result = critical_frequency(ds, n_boot=args.bootstrap, seed=args.seed)
     print(f"metrosync critical: {args.sweep} ({args.bootstrap} bootstrap replicas over runs)")

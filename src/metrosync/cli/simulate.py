@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ..plots import plot_order
-from ._io import check_output, figure_suffixes, write_outputs
+from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import HelpFormatter, add_aliases, add_ensemble_options, simulate_from_args
 
 #: Options of the virtual light gate: type, default, help, and the `LightGate` field.
@@ -49,8 +49,8 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    check_output(args.out, "--out")
-    check_output(args.plot, "--plot", suffixes=figure_suffixes() if args.plot else None)
+    check_output(args.out, "--out", suffixes=NETCDF)
+    check_output(args.plot, "--plot", suffixes=FIGURE)
     if args.lightgate_dir is None:
         given = [flag for flag, (_, default, *_) in GATE_OPTIONS.items()
                  if getattr(args, flag[2:].replace("-", "_")) != default]  # fmt: skip

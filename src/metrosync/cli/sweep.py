@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import ParameterError
-from ._io import check_output
+from ._io import NETCDF, check_output
 from ._options import HelpFormatter, add_aliases
 
 #: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
@@ -99,7 +99,7 @@ def grid_from_args(args):
 def run(args) -> int:
     from ..sweeps import sweep
 
-    check_output(args.out, "--out")
+    check_output(args.out, "--out", suffixes=NETCDF)
     grid = grid_from_args(args)
     store = args.store if args.store is not None else args.out.with_suffix(".points")
     check_output(store / "log.jsonl", "--store")
