@@ -9,7 +9,8 @@ def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path):
     path = tmp_path / "sub" / "result.txt"
     write_text("old", path)
     with pytest.raises(RuntimeError), atomic_path(path) as tmp:
-        assert tmp.parent == path.parent and tmp.suffix == ".txt" and tmp.name.startswith(".")
+        assert tmp.parent == path.parent and tmp.name.startswith(".result.txt.")
+        assert not tmp.match("*.txt")  # a glob for the real files never sees it
         tmp.write_text("half")
         raise RuntimeError("crash while writing")
     assert path.read_text() == "old"

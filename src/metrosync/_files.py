@@ -8,8 +8,9 @@ whatever was at the path before untouched, and the temporary file is removed on
 any error, so a path never holds half a result. Missing parent directories are
 created.
 
-The temporary name keeps the target's suffix (``.run.<hex>.partial.gif`` for
-``run.gif``), because some writers (matplotlib, Pillow) pick the format from it.
+The temporary name is hidden and ends in ``.partial`` (``.run.nc.<hex>.partial``), so
+that no glob for the real files (``*.nc``) ever picks up one in flight. Writers that
+pick the format from the file name (Pillow, ffmpeg) ask for ``keep_suffix=True``.
 """
 
 from __future__ import annotations
@@ -22,8 +23,10 @@ from pathlib import Path
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
+def atomic_path(path: str | Path, *, keep_suffix: bool = False) -> Iterator[Path]:
     """Yield a temporary path to write; on success it replaces ``path``.
+
+    keep_suffix : end the temporary name in ``path``'s suffix (``...partial.gif``).
 
     Examples
     --------
@@ -32,7 +35,8 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex[:12]}.partial{path.suffix}")
+    suffix = path.suffix if keep_suffix else ""
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.partial{suffix}")
     try:
         yield tmp
         os.replace(tmp, path)

@@ -197,7 +197,8 @@ def animate(
     view = DiskView(recorded, start, end, size=size)
     show = sys.stderr.isatty() if progress is None else progress
     with progress_bar(total=times.size, unit="frame", enabled=show, desc="animate") as bar:
-        with atomic_path(path) as tmp, writer.saving(view.fig, str(tmp), dpi):
+        # The writers pick the format from the file name, so the temporary one keeps it.
+        with atomic_path(path, keep_suffix=True) as tmp, writer.saving(view.fig, str(tmp), dpi):
             for t in times:
                 view.draw(float(t))
                 writer.grab_frame()
