@@ -27,7 +27,9 @@ def figure_suffixes() -> tuple[str, ...]:
     """File suffixes matplotlib can write (``.png``, ``.pdf``, ``.svg``, ...)."""
     from matplotlib.backend_bases import FigureCanvasBase
 
-    return tuple(f".{name}" for name in FigureCanvasBase.get_supported_filetypes())
+    common = (".png", ".pdf", ".svg")
+    names = (f".{name}" for name in FigureCanvasBase.get_supported_filetypes())
+    return common + tuple(name for name in names if name not in common)
 
 
 def check_output(
