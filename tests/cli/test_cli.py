@@ -1,6 +1,15 @@
+"""The command line as a user meets it: help, outputs, errors, warnings."""
+
+import errno
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
 import xarray as xr
 
-from metrosync.cli import main
+from metrosync.cli import SUBCOMMANDS, main, name_options
 
 
 def test_simulate_writes_netcdf_and_plot(tmp_path, capsys):
@@ -26,3 +35,105 @@ def test_bad_input_is_a_clear_error_not_a_traceback(capsys):
     assert "`bpm` = 400.0 is outside the tunable range" in capsys.readouterr().err
     assert main(["simulate", "--set", "drive", "--duration", "1"]) == 2
     assert "NAME=VALUE" in capsys.readouterr().err
+
+
+def _help(argv, capsys) -> str:
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "--help"])
+    assert stop.value.code == 0
+    return capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [[name] for name in SUBCOMMANDS] + [["calibrate", q] for q in ("c-theta", "drive", "c-phi")],
+)
+def test_help_shows_each_default_once_and_only_real_ones(argv, capsys):
+    text = " ".join(_help(argv, capsys).split())  # undo line wrapping
+    assert "(default: None)" not in text and "(default: [])" not in text
+    assert "(default: False)" not in text
+    assert not re.search(r"\(default [^:]", text), "a default written by hand and by argparse"
+    if argv == ["simulate"]:
+        assert "--runs RUNS independent runs (default: 20)" in text
+        assert "--integrator {verlet,exact} the paper's fixed-step scheme" in text
+
+
+def test_show_commands_default_to_one_run(capsys):
+    assert "--runs RUNS independent runs (default: 1)" in " ".join(
+        _help(["listen"], capsys).split()
+    )
+
+
+def test_errors_name_the_option_that_set_the_argument(tmp_path, capsys):
+    assert main(["simulate", "--sigma", "-1", "--duration", "1"]) == 2
+    assert "`sigma_bpm` (--sigma) must be >= 0" in capsys.readouterr().err
+    assert main(["simulate", "--save-every", "0", "--duration", "1"]) == 2
+    assert "`record_every` (--save-every)" in capsys.readouterr().err
+    argv = ["simulate", "--duration", "1", "--lightgate-dir", str(tmp_path), "--gate-counter-bits"]
+    assert main([*argv, "4"]) == 2
+    assert "`counter_bits` (--gate-counter-bits)" in capsys.readouterr().err
+    assert name_options("`n` and `sigma_bpm`", {"sigma_bpm": "--sigma"}) == (
+        "`n` and `sigma_bpm` (--sigma)"
+    )
+
+
+def test_bad_outputs_are_refused_before_any_simulation(tmp_path, capsys, monkeypatch):
+    def boom(*args, **kwargs):
+        raise AssertionError("simulated although an output was bad")
+
+    monkeypatch.setattr(sys.modules["metrosync.simulate"], "simulate", boom)
+    out = tmp_path / "r.nc"
+    assert main(["simulate", "--out", str(out), "--plot", str(tmp_path / "r.xyz")]) == 2
+    assert "`--plot`" in (err := capsys.readouterr().err) and "must end in" in err and ".png" in err
+    assert main(["simulate", "--out", str(tmp_path / "r.png")]) == 2
+    assert "`--out` " in (err := capsys.readouterr().err) and "must end in .nc" in err
+    a_file = tmp_path / "file"
+    a_file.write_text("")
+    assert main(["simulate", "--out", str(a_file / "r.nc")]) == 2
+    assert "is not a directory" in capsys.readouterr().err
+    assert main(["simulate", "--out", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err
+    assert main(["simulate", "--lightgate-dir", str(a_file)]) == 2
+    assert "`--lightgate-dir`" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_a_failed_write_is_one_line_and_leaves_no_partial_file(tmp_path, capsys, monkeypatch):
+    def full_disk(self, path, *args, **kwargs):
+        Path(path).write_bytes(b"half a file")
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", full_disk)
+    log = Path(__file__).parent.parent / "data" / "clean.log"
+    assert main(["analyze", str(log), "--out", str(tmp_path / "a.nc")]) == 1
+    err = capsys.readouterr().err
+    assert "No space left on device" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_warnings_are_one_line(capsys):
+    assert main(["simulate", "--preset", "boda2013", "--n", "2", "--runs", "1",
+                 "--duration", "1"]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert "metrosync simulate: warning:" in err and "overturn" in err
+    assert "warnings.warn" not in err
+
+
+def test_a_closed_output_pipe_ends_quietly():
+    log = Path(__file__).parent.parent / "data" / "clean.log"
+    code = f"from metrosync.cli import main; raise SystemExit(main(['analyze', {str(log)!r}]))"
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)  # fmt: skip
+    child.stdout.close()  # like `metrosync analyze ... | head -0`
+    with child.stderr:
+        err = child.stderr.read()
+    assert child.wait() == 1
+    assert "Traceback" not in err and "Exception ignored" not in err and "error" not in err
+
+
+def test_options_that_would_be_ignored_are_not_silent(capsys):
+    assert main(["simulate", "--gate-jitter", "1e-4", "--duration", "1"]) == 2
+    assert "`--gate-jitter` sets up the virtual light gate" in capsys.readouterr().err
+    argv = ["simulate", "--integrator", "exact", "--backend", "numpy", "--n", "2", "--runs", "1"]
+    assert main([*argv, "--duration", "0.2"]) == 0
+    assert "`--backend numpy` applies to `--integrator verlet` only" in capsys.readouterr().err

@@ -6,8 +6,8 @@ import wave
 
 import pytest
 
+from metrosync._files import write_netcdf
 from metrosync.cli import main
-from metrosync.cli.simulate import write_netcdf
 
 SMALL = ["--n", "3", "--duration", "4", "--sigma", "0.5"]
 
@@ -38,6 +38,10 @@ def test_animate_and_page_read_a_simulation_file(recorded_ds, tmp_path):
         (["page", "{nc}", "--n", "5"], "not both"),
         (["animate", "{nc}", "--run", "3"], "`run`"),
         (["listen", "{bare}"], "no trajectories"),
+        (["listen", "{nc}", "--out", "ticks.mp3"], "must end in .wav"),
+        (["page", "{nc}", "--out", "run.txt"], "must end in .html"),
+        (["animate", "{nc}", "--out", "run.png"], "must end in .gif, .mp4"),
+        (["animate", "{nc}", "--out", "{nc}/a.gif"], "is not a directory"),
     ],
 )
 def test_errors_are_reported_with_exit_code_2(recorded_ds, tmp_path, capsys, argv, message):
@@ -49,3 +53,8 @@ def test_errors_are_reported_with_exit_code_2(recorded_ds, tmp_path, capsys, arg
     argv = [a.format(nc=nc, bare=bare) for a in argv]
     assert main(argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_a_bad_time_step_is_reported_by_simulate(tmp_path, capsys):
+    assert main(["page", *SMALL, "--dt", "0", "--out", str(tmp_path / "x.html")]) == 2
+    assert "`dt` = 0.0 s does not resolve" in capsys.readouterr().err

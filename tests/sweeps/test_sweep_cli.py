@@ -1,5 +1,7 @@
 """``metrosync sweep`` and ``metrosync critical`` from the command line."""
 
+import numpy as np
+import pytest
 import xarray as xr
 
 from metrosync.cli import main
@@ -24,6 +26,7 @@ def test_sweep_then_critical(tmp_path, capsys):
     assert (tmp_path / "s_critical.png").stat().st_size > 0
     with xr.open_dataset(tmp_path / "c.nc", engine="h5netcdf") as c:
         assert c.omega_c_peak.dims == ("n",) and c.omega_c_peak.attrs["units"] == "BPM"
+        assert [name for name in c.variables if "long_name" not in c[name].attrs] == []
 
 
 def test_grid_file_with_overrides(tmp_path, capsys):
@@ -43,5 +46,35 @@ def test_errors_are_reported_not_raised(tmp_path, capsys):
     assert "nothing to sweep" in capsys.readouterr().err
     assert main(["sweep", "--bpm", "180,190", "--set", "colour=1", "--out", out]) == 2
     assert "unknown sweep parameter 'colour'" in capsys.readouterr().err
+    assert (
+        main(["sweep", "--bpm", "180,190", "--drive", "1e-4", "--set", "M=2e-4", "--out", out]) == 2
+    )
+    assert "`drive` is given twice ('1e-4' and '2e-4'" in capsys.readouterr().err
     assert main(["critical", str(tmp_path / "missing.nc")]) == 2
     assert "cannot read sweep" in capsys.readouterr().err
+
+
+def test_ignored_or_failing_settings_are_not_silent(tmp_path, capsys):
+    out = str(tmp_path / "x.nc")
+    base = ["sweep", "--bpm", "186,190", "--runs", "1", "--duration", "2", "--no-progress"]
+    assert main([*base, "--workers", "2", "--out", out]) == 2
+    assert "`n_workers` (--workers) = 2 applies to scheduler='local' only" in (
+        capsys.readouterr().err
+    )
+    assert main([*base, "--dt", "0.5", "--out", out]) == 1  # every point fails: not a success
+    assert "2 point(s) without a result" in capsys.readouterr().out
+
+
+def test_critical_marks_estimates_at_the_end_of_the_grid(tmp_path, capsys):
+    bpm = np.arange(180.0, 190.5, 2.0)
+    rng = np.random.default_rng(0)
+    x = (bpm - 180)[None, :, None]  # r rises ever faster and scatters ever more: up to 190
+    r = 0.2 + 0.006 * x**2 + rng.normal(0, 1, (1, 6, 40)) * (0.002 + 0.01 * x)
+    path = tmp_path / "rising.nc"
+    xr.Dataset({"r_eq": (("n", "bpm", "run"), r)}, coords={"n": [7], "bpm": bpm}).to_netcdf(
+        path, engine="h5netcdf"
+    )
+    assert main(["critical", str(path), "--bootstrap", "20", "--no-plot"]) == 0
+    assert "* at an end of the bpm grid (180 .. 190 BPM)" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["critical", str(path), "--no-plot", "--plot", str(tmp_path / "c.png")])

@@ -84,3 +84,16 @@ def test_single_size_sweep_and_bad_inputs(tmp_path):
         critical_frequency(one.expand_dims(drive=[1e-5, 2e-5]))
     with pytest.raises(ParameterError, match="sweep `bpm`"):
         critical_frequency(one.rename(bpm="sigma_bpm"))
+
+
+def test_frequencies_without_any_finite_run_are_skipped_not_fatal():
+    """Short runs at low ω₀ leave r_eq NaN there (no two crossings yet)."""
+    sweep = synthetic_sweep(sizes=(16, 64))
+    sweep["r_eq"][:, :3, :] = np.nan
+    sweep["r_eq"][:, 10, 1:] = np.nan  # one lone finite run
+    res = critical_frequency(sweep, n_boot=100)
+    for method in ("peak", "rise"):
+        assert np.all(np.abs(res[f"omega_c_{method}"] - true_omega_c(res.n.values)) < 3.0)
+    sweep["r_eq"][1] = np.nan
+    with pytest.raises(ParameterError, match=r"no finite r_eq for N = \[64\]"):
+        critical_frequency(sweep, n_boot=10)

@@ -48,3 +48,9 @@ def test_misplaced_worker_counts_are_clear_errors(tmp_path):
         sweep(GRID, tmp_path, scheduler="tcp://127.0.0.1:1", n_workers=2)
     with pytest.raises(ParameterError, match="`n_workers` must be an integer >= 1"):
         sweep(GRID, tmp_path, scheduler="local", n_workers=0)
+
+
+def test_a_worker_count_without_a_local_cluster_is_refused(tmp_path):
+    with pytest.raises(ParameterError, match="runs in process"):
+        sweep(GRID, tmp_path, n_workers=2)
+    assert not (tmp_path / "points").exists()

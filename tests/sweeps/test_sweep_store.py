@@ -67,6 +67,8 @@ def test_keep_r_and_netcdf_round_trip(tmp_path):
     result = sweep({"bpm": [185, 190]}, tmp_path / "store", fixed=TINY, keep_r=True, out=out)
     ds = result.dataset
     assert ds.r.dims == ("bpm", "time", "run") and ds.time.attrs["units"] == "s"
+    assert [name for name in ds.variables if "long_name" not in ds[name].attrs] == []
+    assert ds.bpm.attrs == {"long_name": "nominal beat frequency", "units": "BPM"}
     with xr.open_dataset(out, engine="h5netcdf") as back:
         xr.testing.assert_identical(back.load(), ds)
 

@@ -32,18 +32,17 @@ class Estimate:
     details: dict = field(default_factory=dict)
 
     def summary(self) -> str:
+        """One line: the value with its unit and the details."""
         extra = ", ".join(f"{k} = {v:.4g}" if isinstance(v, float) else f"{k} = {v}"
                           for k, v in self.details.items())  # fmt: skip
         return f"{self.name} = {self.value:.6g} {self.unit}" + (f" ({extra})" if extra else "")
 
     def plot(self, path: Path | str | None = None):
         """Data and fitted curve; returns the figure, writes it to ``path`` if given."""
-        import matplotlib
+        from ..plots import finish_figure, new_figure
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(6, 4), constrained_layout=True)
+        fig = new_figure(path, figsize=(6, 4), layout="constrained")
+        ax = fig.subplots()
         ax.plot(self.x, self.y, "o", ms=4, label="data")
         ax.plot(
             self.fit_x,
@@ -56,7 +55,4 @@ class Estimate:
         ax.set_ylabel(self.ylabel)
         ax.set_title(self.title)
         ax.legend()
-        if path is not None:
-            fig.savefig(path, dpi=120)
-            plt.close(fig)
-        return fig
+        return finish_figure(fig, path)

@@ -2,12 +2,20 @@
 
 Each subcommand module exposes ``register(subparsers)``, which adds its parser and
 sets ``func`` to a handler taking the parsed arguments and returning an exit code.
+
+Exit codes: 0 success; 1 the work ran but did not fully succeed (a sweep with
+failed or missing points), a file could not be written, or the reader of the output
+went away; 2 bad input, reported in one line that names the option, the value and
+what to do (a `MetrosyncError`). Warnings print as one line each.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import os
+import re
 import sys
 import warnings
 
@@ -21,9 +29,11 @@ SUBCOMMANDS = (
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``metrosync`` parser with every subcommand registered."""
     parser = argparse.ArgumentParser(
         prog="metrosync",
         description="Simulate and measure the synchronization of metronomes on a rotating disk.",
+        epilog="`metrosync COMMAND --help` describes each command.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in SUBCOMMANDS:
@@ -31,12 +41,46 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def name_options(message: str, aliases: dict[str, str]) -> str:
+    """Add the command-line option to each library argument a message names.
+
+    >>> name_options("`sigma_bpm` must be >= 0", {"sigma_bpm": "--sigma"})
+    '`sigma_bpm` (--sigma) must be >= 0'
+    """
+
+    def named(match: re.Match) -> str:
+        option = aliases.get(match[1])
+        return f"{match[0]} ({option})" if option else match[0]
+
+    return re.sub(r"`(\w+)`", named, message)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run ``metrosync`` with ``argv`` (default: the process's); returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    warnings.simplefilter("default")
+
+    def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+        print(f"metrosync {args.command}: warning: {message}", file=sys.stderr)
+
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = show_warning
+            return int(args.func(args) or 0)
     except MetrosyncError as error:
-        print(f"metrosync {args.command}: error: {error}", file=sys.stderr)
+        message = name_options(str(error), getattr(args, "_aliases", None) or {})
+        print(f"metrosync {args.command}: error: {message}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # The reader went away (`metrosync analyze ... | head`): stop quietly, and keep
+        # the interpreter from complaining when it flushes stdout at exit.
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as error:
+        # Disk full, permissions, a file vanishing: the environment, not a bug to trace.
+        where = f" {error.filename!r}" if error.filename else ""
+        print(f"metrosync {args.command}: error:{where} {error.strerror or error}",
+              file=sys.stderr)  # fmt: skip
+        return 1

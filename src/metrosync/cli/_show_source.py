@@ -2,7 +2,8 @@
 
 A subcommand either reads a NetCDF file written by ``metrosync simulate --save-every
 K --out FILE.nc`` or simulates with the same options as ``simulate``, always keeping
-trajectories (one run by default, since one run is shown).
+trajectories (one run by default, since one run is shown). Giving both a file and
+simulation options is an error, not a silent choice.
 """
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import MetrosyncError, ParameterError
+from ..errors import ParameterError
+from ._io import read_dataset
 from ._options import add_ensemble_options, simulate_from_args
 
 
@@ -29,16 +31,14 @@ def add_source_options(parser: argparse.ArgumentParser, *, record_seconds: float
         "without it, simulate with the options below",
     )
     before = set(vars(parser.parse_args([])))
-    add_ensemble_options(parser)
-    parser.set_defaults(runs=1)
-    for action in parser._actions:  # argparse has no public way to retitle a help text
-        if action.dest == "runs":
-            action.help = "independent runs (default 1 here)"
-    ensemble = sorted(set(vars(parser.parse_args([]))) - before)
+    add_ensemble_options(parser, runs=1)
+    ensemble = sorted(
+        name for name in set(vars(parser.parse_args([]))) - before if not name.startswith("_")
+    )
     parser.set_defaults(_ensemble_defaults={k: parser.get_default(k) for k in ensemble},
                         _record_seconds=record_seconds)  # fmt: skip
     shown = parser.add_argument_group("what to show")
-    shown.add_argument("--run", type=int, default=0, help="which run of the ensemble (default 0)")
+    shown.add_argument("--run", type=int, default=0, help="which run of the ensemble")
     shown.add_argument("--start", type=float, default=None, help="start of the time window, s")
     shown.add_argument("--end", type=float, default=None, help="end of the time window, s")
 
@@ -52,7 +52,8 @@ def load_or_simulate(args):
             if getattr(args, name) != default
         ]
         if changed:
-            options = ", ".join("--" + name.replace("_", "-") for name in changed)
+            flag = args._aliases  # --set fills `changes`
+            options = ", ".join(flag.get(name, "--" + name.replace("_", "-")) for name in changed)
             raise ParameterError(
                 f"give either an input file or simulation options, not both "
                 f"(got {str(args.input)!r} and {options})."
@@ -60,20 +61,7 @@ def load_or_simulate(args):
         return read_dataset(args.input)
     if args.save_every is None:
         seconds = args._record_seconds
-        args.save_every = 1 if seconds is None else max(1, round(seconds / args.dt))
+        # A bad --dt is reported by `simulate`; it must not break this arithmetic first.
+        usable = seconds is not None and args.dt > 0 and args.dt < float("inf")
+        args.save_every = max(1, round(seconds / args.dt)) if usable else 1
     return simulate_from_args(args)
-
-
-def read_dataset(path: Path):
-    import xarray as xr
-
-    path = Path(path)
-    if not path.is_file():
-        raise MetrosyncError(f"input file {str(path)!r} does not exist.")
-    try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            return ds.load()
-    except (OSError, ValueError) as error:
-        raise MetrosyncError(
-            f"cannot read {str(path)!r} as a metrosync NetCDF file: {error}"
-        ) from None

@@ -7,9 +7,12 @@ from pathlib import Path
 
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
+from ._io import FIGURE, NETCDF, check_output, write_outputs
+from ._options import HelpFormatter, add_aliases, int_list
 
 
 def counter_bits_arg(text: str):
+    """``--counter-bits``: ``auto``, ``none`` (never wraps) or a width in bits."""
     if text == "auto":
         return "auto"
     if text == "none":
@@ -28,7 +31,7 @@ def register(subparsers) -> None:
         help="analyse light-gate logs (real or virtual)",
         description="Read light-gate logs, clean them, and measure r(t), the metronomes' "
         "frequencies and their spread. Several logs are repeated runs and are averaged.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("logs", nargs="+", type=Path, metavar="LOG", help="light-gate log files")
     g = parser.add_argument_group("reading")
@@ -39,23 +42,33 @@ def register(subparsers) -> None:
                    help="level that means 'beam interrupted'")  # fmt: skip
     g.add_argument("--strict", action="store_true", help="refuse any line that is not a record")
     c = parser.add_argument_group("cleaning and measuring")
-    c.add_argument("--channels", type=lambda s: [int(x) for x in s.split(",")], default=None,
-                   help="gates to analyse, comma-separated, 0-based (default all)")  # fmt: skip
+    c.add_argument("--channels", type=int_list, default=None, metavar="I,J,...",
+                   help="gates to analyse, comma-separated, 0-based (default: all)")  # fmt: skip
     c.add_argument("--glitch", type=float, default=DEFAULT_GLITCH, help="shortest real spell, s")
     c.add_argument("--min-asymmetry", type=float, default=DEFAULT_MIN_ASYMMETRY,
                    help="smallest (l-s)/(l+s) that tells the pass directions apart")  # fmt: skip
     c.add_argument("--grid-dt", type=float, default=0.1, help="spacing of the r(t) grid, s")
-    c.add_argument("--window", type=float, default=None,
-                   help="final window averaged for r_eq, s (default: last quarter)")  # fmt: skip
+    c.add_argument(
+        "--window",
+        type=float,
+        default=None,
+        metavar="S",
+        help="final window averaged for r_eq, s (default: the last quarter)",
+    )
     out = parser.add_argument_group("output")
     out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
-    out.add_argument("--plot", type=Path, default=None, help="write r(t) to FILE.png")
+    out.add_argument("--plot", type=Path, default=None,
+                     help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
+    add_aliases(parser, equilibrium_window="--window")
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..lightgate import analyze
+    from ..lightgate.plots import plot_analysis
 
+    check_output(args.out, "--out", suffixes=NETCDF)
+    check_output(args.plot, "--plot", suffixes=FIGURE)
     ds = analyze(
         args.logs,
         tick=args.tick,
@@ -69,20 +82,12 @@ def run(args) -> int:
         equilibrium_window=args.window,
     )
     print(summary(ds))
-    if args.out is not None:
-        from .simulate import write_netcdf
-
-        write_netcdf(ds, args.out)
-        print(f"wrote {args.out}")
-    if args.plot is not None:
-        from ..lightgate.plots import plot_analysis
-
-        plot_analysis(ds, args.plot)
-        print(f"wrote {args.plot}")
+    write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
     return 0
 
 
 def summary(ds) -> str:
+    """The printed summary: frequencies, jitter, σ, r_eq and the cleaning report."""
     a = ds.attrs
     lines = [
         f"metrosync analyze: {ds.sizes['log']} log(s), {ds.sizes['metronome']} metronomes, "

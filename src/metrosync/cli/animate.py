@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+from ._io import check_output
+from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -14,7 +15,7 @@ def register(subparsers) -> None:
         help="animate a run: the disk from above and r(t)",
         description="Render a recorded (or freshly simulated) run as a GIF, or an MP4 when "
         "ffmpeg is on PATH. Frames come from the recorded trajectories.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     add_source_options(parser, record_seconds=0.05)
     out = parser.add_argument_group("animation")
@@ -30,6 +31,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from ..show.animation import animate
 
+    check_output(args.out, "--out", suffixes=(".gif", ".mp4"))
     ds = load_or_simulate(args)
     frames = animate(
         ds, args.out, run=args.run, fps=args.fps, speedup=args.speedup,

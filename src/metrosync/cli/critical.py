@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ParameterError
+from ._io import FIGURE, NETCDF, check_output, read_dataset, write_outputs
+from ._options import HelpFormatter, add_aliases
 
 
 def register(subparsers) -> None:
@@ -17,28 +20,24 @@ def register(subparsers) -> None:
             "steepest rise of r(omega_0), with bootstrap error bars over runs, and extrapolate "
             "it to N -> infinity."
         ),
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("sweep", type=Path, help="merged sweep written by `metrosync sweep`")
     parser.add_argument("--bootstrap", type=int, default=1000, help="bootstrap replicas")
     parser.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
     parser.add_argument("--select", action="append", default=[], metavar="NAME=VALUE",
                         help="pick one value of another swept parameter (repeatable)")  # fmt: skip
-    parser.add_argument("--plot", type=Path, default=None,
+    figure = parser.add_mutually_exclusive_group()
+    figure.add_argument("--plot", type=Path, default=None,
                         help="figure path (default: SWEEP with suffix _critical.png)")  # fmt: skip
-    parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    figure.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--out", type=Path, default=None, help="write the estimates to FILE.nc")
+    add_aliases(parser, n_boot="--bootstrap")
     parser.set_defaults(func=run)
 
 
 def _open(path: Path, select: list[str]):
-    import xarray as xr
-
-    try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            ds = ds.load()
-    except (OSError, ValueError) as error:
-        raise ParameterError(f"cannot read sweep {str(path)!r}: {error}") from None
+    ds = read_dataset(path, "sweep")
     for item in select:
         name, sep, value = item.partition("=")
         if not sep or name not in ds.dims:
@@ -55,19 +54,30 @@ def _open(path: Path, select: list[str]):
 
 def run(args) -> int:
     from ..sweeps.critical import METHODS, critical_frequency, plot_critical
-    from ..sweeps.store import write_dataset
 
+    plot = (
+        None
+        if args.no_plot
+        else args.plot or args.sweep.with_name(args.sweep.stem + "_critical.png")
+    )
+    check_output(plot, "--plot", suffixes=FIGURE)
+    check_output(args.out, "--out", suffixes=NETCDF)
     ds = _open(args.sweep, args.select)
     result = critical_frequency(ds, n_boot=args.bootstrap, seed=args.seed)
     print(f"metrosync critical: {args.sweep} ({args.bootstrap} bootstrap replicas over runs)")
-    print(f"  {'N':>6}  {'omega_c (sigma_r peak)':>24}  {'omega_c (steepest rise)':>24}")
+    print(f"  {'N':>6}  {'omega_c (sigma_r peak)':>25}  {'omega_c (steepest rise)':>25}")
+    bpm = result.bpm.values
+    at_edge = False
     for n in result.n.values:
         one = result.sel(n=n)
-        cells = [
-            f"{float(one[f'omega_c_{m}']):8.2f} +- {float(one[f'omega_c_{m}_err']):5.2f} BPM"
-            for m in METHODS
-        ]
-        print(f"  {n:>6}  {cells[0]:>24}  {cells[1]:>24}")
+        cells = []
+        for m in METHODS:
+            value = float(one[f"omega_c_{m}"])
+            edge = bool(np.isclose(value, bpm[0]) or np.isclose(value, bpm[-1]))
+            at_edge |= edge
+            error = float(one[f"omega_c_{m}_err"])
+            cells.append(f"{value:8.2f} +- {error:5.2f} BPM" + ("*" if edge else " "))
+        print(f"  {n:>6}  {cells[0]:>25}  {cells[1]:>25}")
     a = result.attrs
     for m in METHODS:
         print(
@@ -75,11 +85,10 @@ def run(args) -> int:
             f"{a[f'omega_c_inf_{m}_err']:.2f} BPM, fit {a[f'fit_form_{m}']} "
             f"(a = {a[f'fit_a_{m}']:.3g}, nu = {a[f'fit_nu_{m}']:.3g})"
         )
-    if not args.no_plot:
-        path = args.plot or args.sweep.with_name(args.sweep.stem + "_critical.png")
-        plot_critical(result, path)
-        print(f"wrote {path}")
-    if args.out is not None:
-        write_dataset(result, args.out)
-        print(f"wrote {args.out}")
+    if at_edge:
+        print(
+            f"  * at an end of the bpm grid ({bpm[0]:g} .. {bpm[-1]:g} BPM): the transition "
+            f"may lie outside it; widen the sweep's --bpm range or add runs."
+        )
+    write_outputs(result, out=args.out, plot=plot, plotter=plot_critical)
     return 0

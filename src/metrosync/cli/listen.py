@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+from ._io import check_output
+from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -15,7 +16,7 @@ def register(subparsers) -> None:
         description="Write a stereo WAV with a click for every zero crossing of every "
         "pendulum (the instant a metronome ticks), panned by its place on the disk. "
         "Simulating here records every step, so clicks fall on the simulated crossings.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     add_source_options(parser, record_seconds=None)
     out = parser.add_argument_group("sound")
@@ -28,6 +29,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from ..show.sound import write_wav
 
+    check_output(args.out, "--out", suffixes=(".wav",))
     ds = load_or_simulate(args)
     track = write_wav(
         ds, args.out, run=args.run, speedup=args.speedup, start=args.start, end=args.end,

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
+from ._io import check_output
+from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -15,7 +16,7 @@ def register(subparsers) -> None:
         description="Write one HTML file (inline script, data as JSON) with the animated "
         "disk, r(t), a phase wheel, play/pause, seek and speed. It needs no server and "
         "no network.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     add_source_options(parser, record_seconds=0.05)
     out = parser.add_argument_group("page")
@@ -28,6 +29,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from ..show.page import write_page
 
+    check_output(args.out, "--out", suffixes=(".html", ".htm"))
     ds = load_or_simulate(args)
     path = write_page(ds, args.out, run=args.run, start=args.start, end=args.end,
                       max_rate=args.max_rate)  # fmt: skip

@@ -6,36 +6,59 @@ import argparse
 import time
 from pathlib import Path
 
-from ._options import add_ensemble_options, simulate_from_args
+from ..errors import ParameterError
+from ..plots import plot_order
+from ._io import FIGURE, NETCDF, check_output, write_outputs
+from ._options import HelpFormatter, add_aliases, add_ensemble_options, simulate_from_args
+
+#: Options of the virtual light gate: type, default, help, and the `LightGate` field.
+GATE_OPTIONS = {
+    "--gate-offset": (float, 0.1, "beam centre angle, rad", "offset"),
+    "--gate-width": (float, 0.05, "beam width, rad", "width"),
+    "--gate-jitter": (float, 0.0, "timing noise (std), s", "jitter"),
+    "--gate-counter-bits": (int, 16, "logger counter width, bits", "counter_bits"),
+}
 
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "simulate",
         help="simulate an ensemble of metronomes",
-        description="Simulate B independent runs of N metronomes on a free disk.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        description="Simulate B independent runs of N metronomes on a free disk, print "
+        "the equilibrium order parameter, and write the dataset, a plot of r(t) and "
+        "virtual light-gate logs when asked.",
+        formatter_class=HelpFormatter,
     )
     add_ensemble_options(parser)
     out = parser.add_argument_group("output")
     out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
-    out.add_argument("--plot", type=Path, default=None, help="write r(t) to FILE.png")
+    out.add_argument("--plot", type=Path, default=None,
+                     help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
     gate = parser.add_argument_group("virtual light gate")
     gate.add_argument(
         "--lightgate-dir",
         type=Path,
         default=None,
         metavar="DIR",
-        help="write one light-gate log per run to DIR (records every step)",
+        help="write one light-gate log per run to DIR (simulates recording every step)",
     )
-    gate.add_argument("--gate-offset", type=float, default=0.1, help="beam centre angle, rad")
-    gate.add_argument("--gate-width", type=float, default=0.05, help="beam width, rad")
-    gate.add_argument("--gate-jitter", type=float, default=0.0, help="timing noise (std), s")
-    gate.add_argument("--gate-counter-bits", type=int, default=16, help="logger counter width")
+    for flag, (kind, default, text, _) in GATE_OPTIONS.items():
+        gate.add_argument(flag, type=kind, default=default, help=text)
+    add_aliases(parser, **{name: flag for flag, (*_, name) in GATE_OPTIONS.items()})
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
+    check_output(args.out, "--out", suffixes=NETCDF)
+    check_output(args.plot, "--plot", suffixes=FIGURE)
+    if args.lightgate_dir is None:
+        given = [flag for flag, (_, default, *_) in GATE_OPTIONS.items()
+                 if getattr(args, flag[2:].replace("-", "_")) != default]  # fmt: skip
+        if given:
+            raise ParameterError(
+                f"`{given[0]}` sets up the virtual light gate; add `--lightgate-dir DIR` "
+                f"to write its logs, or drop {', '.join(given)}."
+            )
     started = time.perf_counter()
     if args.lightgate_dir is None:
         ds = simulate_from_args(args)
@@ -43,14 +66,7 @@ def run(args) -> int:
         ds = _simulate_with_gate(args)
     elapsed = time.perf_counter() - started
     print(summary(ds, elapsed))
-    if args.out is not None:
-        write_netcdf(ds, args.out)
-        print(f"wrote {args.out}")
-    if args.plot is not None:
-        from ..plots import plot_order
-
-        plot_order(ds, args.plot)
-        print(f"wrote {args.plot}")
+    write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_order)
     return 0
 
 
@@ -62,11 +78,14 @@ def _simulate_with_gate(args):
     gate = LightGate(offset=args.gate_offset, width=args.gate_width, jitter=args.gate_jitter,
                      counter_bits=args.gate_counter_bits, seed=args.seed)  # fmt: skip
     if args.n > 8:
-        from ..errors import ParameterError
-
         raise ParameterError(
             f"`--lightgate-dir`: the logger follows at most 8 gates, got --n {args.n}."
         )
+    if args.lightgate_dir.exists() and not args.lightgate_dir.is_dir():
+        raise ParameterError(
+            f"`--lightgate-dir` {str(args.lightgate_dir)!r} is a file; give a directory."
+        )
+    check_output(args.lightgate_dir / "run000.log", "--lightgate-dir")
     asked = args.save_every
     fine = simulate_from_args(argparse.Namespace(**{**vars(args), "save_every": 1}))
     paths = write_logs(fine, args.lightgate_dir, gate)
@@ -85,16 +104,8 @@ def _simulate_with_gate(args):
     return ds
 
 
-def write_netcdf(ds, path: Path) -> None:
-    """Write atomically: a crash never leaves a half-written file at ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".partial")
-    ds.to_netcdf(tmp, engine="h5netcdf")
-    tmp.replace(path)
-
-
 def summary(ds, elapsed: float) -> str:
+    """The printed summary: frequencies, r_eq ± σ_r, flagged runs, throughput."""
     a = ds.attrs
     bad = int((ds.status != 0).sum())
     masks = ds.status.attrs["flag_masks"]

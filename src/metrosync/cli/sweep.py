@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import ParameterError
+from ._io import NETCDF, check_output
+from ._options import HelpFormatter, add_aliases
 
 #: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
 GRID_OPTIONS = {
@@ -31,8 +33,10 @@ def register(subparsers) -> None:
             "with a dimension per swept parameter. Give a value (fixed) or a grid "
             "(START:STOP:STEP or a comma list) to any parameter option, and/or a TOML grid "
             "file. Finished points are kept in the store, so running the same command again "
-            "after an interruption computes only what is missing."
+            "after an interruption computes only what is missing. Exit code 1 when some "
+            "point has no result (failed, or lost with a worker)."
         ),
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("grid", nargs="?", type=Path, help="TOML grid file ([grid], [fixed])")
     g = parser.add_argument_group("parameters (VALUE or START:STOP:STEP or A,B,C)")
@@ -51,11 +55,13 @@ def register(subparsers) -> None:
     o.add_argument("--workers", type=int, default=None, help="workers of --scheduler local")
     o.add_argument("--retry-failed", action="store_true", help="recompute points stored as failed")
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers")
     parser.set_defaults(func=run)
 
 
 def grid_from_args(args):
-    from ..sweeps.grid import Grid
+    """The `Grid` from the grid file and the options (an option replaces the file's value)."""
+    from ..sweeps.grid import Grid, canonical_name
 
     axes, fixed = {}, {}
     items = [
@@ -66,10 +72,17 @@ def grid_from_args(args):
         if not sep or not spec.strip():
             raise ParameterError(f"`--set` expects NAME=SPEC, got {item!r}.")
         items.append((name.strip(), spec.strip()))
+    given: dict[str, str] = {}
     for name, spec in items:
         if spec is None:
             continue
-        name = "sigma_bpm" if name == "sigma" else name
+        name = canonical_name(name)
+        if name in given:
+            raise ParameterError(
+                f"`{name}` is given twice ({given[name]!r} and {spec!r}, by an option and "
+                f"`--set`); keep one."
+            )
+        given[name] = spec
         (axes if (":" in spec or "," in spec) else fixed)[name] = spec
     options = {"keep_r": True} if args.keep_r else {}
     if args.preset is not None:
@@ -86,8 +99,10 @@ def grid_from_args(args):
 def run(args) -> int:
     from ..sweeps import sweep
 
+    check_output(args.out, "--out", suffixes=NETCDF)
     grid = grid_from_args(args)
     store = args.store if args.store is not None else args.out.with_suffix(".points")
+    check_output(store / "log.jsonl", "--store")
     shape = dict(zip(grid.axes, grid.shape, strict=True))
     print(f"metrosync sweep: {grid.size} points, grid {shape}, store {store}")
     result = sweep(
@@ -100,4 +115,4 @@ def run(args) -> int:
         retry_failed=args.retry_failed,
     )
     print(result.summary())
-    return 0 if result.complete else 1
+    return 1 if result.failures() else 0

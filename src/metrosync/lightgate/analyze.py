@@ -11,7 +11,10 @@ experiments. The dataset holds
     frequency_bpm      (metronome)         mean frequency, averaged over logs, BPM
     frequency_bpm_runs (log, metronome)    mean frequency per log, BPM
     period_jitter      (log, metronome)    std of single periods, s
-    passes_kept, passes_dropped, lines_skipped   counts per log (and metronome)
+    passes_kept, passes_dropped, lines_skipped, counter_wraps   counts per log
+                                           (and metronome)
+    direction_ambiguous, interrupted_level (log, metronome)   what the cleaning
+                                           and the reader found about each gate
     path               (log)               the log files
 
 and attrs ``r_eq`` (mean r over the final ``equilibrium_window``, default the last
@@ -68,8 +71,8 @@ def analyze(
     channels : gates to analyse (0-based); default all.
     glitch, max_interruption, min_asymmetry : cleaning options, see `clean_channel`.
     grid_dt : spacing of the r(t) grid, s.
-    equilibrium_window : seconds at the end of the grid averaged for ``r_eq``;
-        default a quarter of the grid's span.
+    equilibrium_window : seconds at the end of the grid averaged for ``r_eq``, at most
+        the grid's span; default a quarter of it.
 
     Returns
     -------
@@ -118,11 +121,15 @@ def analyze(
     kept = np.array([[c.kept.size for c in chans] for chans in per_log])
     dropped = np.array([[sum(c.dropped.values()) for c in chans] for chans in per_log])
     ambiguous = np.array([[c.direction_ambiguous for c in chans] for chans in per_log])
+    levels = np.array([log.interrupted_level[chosen] for log in logs], dtype=np.int8)
     mean_freq = freq.mean(axis=0)
     span = grid[-1] - grid[0]
     window = span / 4 if equilibrium_window is None else float(equilibrium_window)
-    if not (0 < window):
-        raise ParameterError(f"`equilibrium_window` must be > 0 s, got {equilibrium_window!r}.")
+    if not (0 < window <= span):
+        raise ParameterError(
+            f"`equilibrium_window` must be in (0, {span:g}] s (the span of the r(t) grid), "
+            f"got {equilibrium_window!r}."
+        )
     r_eq = float(equilibrium_order(r, grid, window))
     sigma = ph.frequency_spread(mean_freq)
     reports = "\n".join(
@@ -138,11 +145,19 @@ def analyze(
                                {"units": "BPM", "long_name": "mean frequency per log"}),
         "period_jitter": (("log", "metronome"), jitter,
                           {"units": "s", "long_name": "std of single-period intervals"}),
-        "passes_kept": (("log", "metronome"), kept),
-        "passes_dropped": (("log", "metronome"), dropped),
-        "direction_ambiguous": (("log", "metronome"), ambiguous.astype(np.int8)),
-        "lines_skipped": (("log",), np.array([len(log.skipped) for log in logs])),
-        "path": (("log",), np.array([str(p) for p in paths])),
+        "passes_kept": (("log", "metronome"), kept,
+                        {"long_name": "passes kept (one per period, one direction)"}),
+        "passes_dropped": (("log", "metronome"), dropped,
+                           {"long_name": "passes and interruptions dropped by the cleaning"}),
+        "direction_ambiguous": (("log", "metronome"), ambiguous.astype(np.int8),
+                                {"long_name": "1: gate too central to tell the directions"}),
+        "interrupted_level": (("log", "metronome"), levels,
+                              {"long_name": "gate level read as 'interrupted' (-1 unknown)"}),
+        "lines_skipped": (("log",), np.array([len(log.skipped) for log in logs]),
+                          {"long_name": "lines that are not gate records"}),
+        "counter_wraps": (("log",), np.array([log.wraps for log in logs]),
+                          {"long_name": "times the logger's counter wrapped"}),
+        "path": (("log",), np.array([str(p) for p in paths]), {"long_name": "log file"}),
     }  # fmt: skip
     attrs = {
         "r_eq": r_eq,
@@ -167,8 +182,8 @@ def analyze(
                 grid,
                 {"units": "s", "long_name": "time since each log's first record"},
             ),
-            "metronome": ("metronome", np.array(chosen)),
-            "log": ("log", np.arange(len(paths))),
+            "metronome": ("metronome", np.array(chosen), {"long_name": "gate index (0-based)"}),
+            "log": ("log", np.arange(len(paths)), {"long_name": "log index, in argument order"}),
         },
         attrs=attrs,
     )

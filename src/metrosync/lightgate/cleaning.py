@@ -87,6 +87,7 @@ class ChannelPasses:
     direction_ambiguous: bool = False
 
     def summary(self) -> str:
+        """One line: passes kept, dropped by reason, flickers closed, direction flag."""
         why = ", ".join(f"{n} {r}" for r, n in self.dropped.items() if n) or "none"
         extra = f", {self.merged} flickers closed" if self.merged else ""
         flag = " [direction ambiguous: gate too central]" if self.direction_ambiguous else ""
@@ -159,6 +160,7 @@ def clean_log(log: GateLog, **options) -> list[ChannelPasses]:
 
 
 def cleaning_report(channels: list[ChannelPasses], source: str = "") -> str:
+    """Human-readable account of the cleaning of every gate of one log."""
     head = f"cleaning {source}".rstrip()
     return "\n".join([head] + [f"  gate {k}: {c.summary()}" for k, c in enumerate(channels)])
 

@@ -4,30 +4,24 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+from ..plots import finish_figure, new_figure, order_axes
 
 
 def plot_analysis(ds, path: Path | str | None = None):
-    """r(t) of each log (thin) and their mean (thick); returns the figure."""
-    fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
+    """r(t) of each log (thin) and their mean (thick); returns the figure.
+
+    ds : an `analyze` dataset, r (time) and r_runs (log, time).
+    path : write the figure there (atomically) when given.
+    """
+    fig = new_figure(path, figsize=(7, 4), layout="constrained")
+    ax = fig.subplots()
     t = ds.time.values
     for k in range(ds.sizes["log"]):
         ax.plot(t, ds.r_runs.values[k], lw=0.6, alpha=0.5, color="0.5")
     ax.plot(t, ds.r.values, lw=1.5, color="C0", label=f"r, mean of {ds.sizes['log']} log(s)")
-    window = ds.attrs["equilibrium_window"]
-    ax.axvspan(t[-1] - window, t[-1], color="0.9", zorder=0,
-               label=f"r_eq = {ds.attrs['r_eq']:.3f}")  # fmt: skip
     ax.set_title(
         f"light gate: {ds.sizes['metronome']} metronomes, σ = {ds.attrs['sigma_bpm']:.3f} BPM"
     )
-    ax.set_xlabel("t since first record (s)")
-    ax.set_ylabel("r")
-    ax.set_ylim(0, 1.02)
-    ax.legend(loc="lower right")
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    order_axes(ax, t[-1], ds.attrs["equilibrium_window"], xlabel="t since first record (s)",
+               window_label=f"r_eq = {ds.attrs['r_eq']:.3f}")  # fmt: skip
+    return finish_figure(fig, path)

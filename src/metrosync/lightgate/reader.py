@@ -101,6 +101,7 @@ class GateLog:
 
     @property
     def channels(self) -> int:
+        """Number of gates K per record."""
         return self.levels.shape[1]
 
     @property

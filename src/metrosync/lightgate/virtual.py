@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import write_text
 from ..errors import ParameterError
 from .reader import COUNTER_BITS_RANGE, DEFAULT_TICK, MAX_GATES
 
@@ -234,9 +235,5 @@ def write_logs(
     for b in range(ds.sizes["run"]):
         text = format_log(time, ds.theta.values[:, b, :], ds.theta_dot.values[:, b, :],
                           LightGate(**{**vars(gate), "seed": gate.seed + b}))  # fmt: skip
-        path = directory / f"{prefix}{b:03d}.log"
-        tmp = path.with_name(path.name + ".partial")
-        tmp.write_text(text)
-        tmp.replace(path)
-        paths.append(path)
+        paths.append(write_text(text, directory / f"{prefix}{b:03d}.log"))
     return paths

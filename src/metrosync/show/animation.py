@@ -28,6 +28,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from .._files import atomic_path
 from ..errors import ParameterError
 from ..progress import progress_bar
 from .recording import RecordedRun
@@ -120,6 +121,7 @@ class DiskView:
         self.cursor = order_ax.axvline(start, color="C3", lw=1.2)
 
     def draw(self, t: float) -> None:
+        """Move every artist to simulated time ``t`` (s)."""
         run = self.run
         times = np.array([t])
         theta = run.theta_at(times)[0]
@@ -193,15 +195,12 @@ def animate(
         )
     times = frame_times(start, end, fps, speedup)
     view = DiskView(recorded, start, end, size=size)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    # The writers pick the format from the suffix, so the temporary name keeps it.
-    tmp = path.with_name(f"{path.stem}.partial{path.suffix}")
     show = sys.stderr.isatty() if progress is None else progress
     with progress_bar(total=times.size, unit="frame", enabled=show, desc="animate") as bar:
-        with writer.saving(view.fig, str(tmp), dpi):
+        # The writers pick the format from the file name, so the temporary one keeps it.
+        with atomic_path(path, keep_suffix=True) as tmp, writer.saving(view.fig, str(tmp), dpi):
             for t in times:
                 view.draw(float(t))
                 writer.grab_frame()
                 bar.update(1)
-    tmp.replace(path)
     return int(times.size)

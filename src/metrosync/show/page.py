@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import write_text
 from ..errors import ParameterError
 from ._page_template import TEMPLATE
 from .recording import RecordedRun
@@ -85,10 +86,4 @@ def write_page(ds, path: Path | str, *, run: int = 0, **options) -> Path:
     ``options``: ``start``, ``end`` (s) and ``max_rate`` (records/s), as in
     `page_data`. The write is atomic. Returns the path.
     """
-    text = render_page(RecordedRun.from_dataset(ds, run), **options)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text(render_page(RecordedRun.from_dataset(ds, run), **options), path)

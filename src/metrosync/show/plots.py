@@ -85,13 +85,15 @@ def plot_run(ds, path: Path | str | None = None, *, run: int = 0, start=None, en
 
     Returns
     -------
-    The matplotlib figure (closed after writing when ``path`` is given).
+    The matplotlib figure: pyplot's without ``path``, a plain one written to ``path``
+    otherwise (see `metrosync.plots`).
     """
-    import matplotlib.pyplot as plt
+    from ..plots import finish_figure, new_figure
 
     recorded = RecordedRun.from_dataset(ds, run)
     start, end = recorded.window(start, end)
-    fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True, layout="constrained")
+    fig = new_figure(path, figsize=(8, 9), layout="constrained")
+    axes = fig.subplots(4, 1, sharex=True)
     for draw, ax in zip(
         (plot_angles, plot_phase_differences, plot_disk_angle, plot_run_order), axes, strict=True
     ):
@@ -103,10 +105,7 @@ def plot_run(ds, path: Path | str | None = None, *, run: int = 0, start=None, en
         f"N = {recorded.n}, {a.get('bpm', '?')} BPM, σ = {a.get('sigma_bpm', '?')} BPM, "
         f"run {recorded.run}"
     )
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    return finish_figure(fig, path)
 
 
 def _keep(run: RecordedRun, start, end) -> np.ndarray:

@@ -112,10 +112,12 @@ class RecordedRun:
 
     @property
     def n(self) -> int:
+        """Number of metronomes N."""
         return self.theta.shape[1]
 
     @property
     def record_interval(self) -> float:
+        """Time between records, s (NaN with a single record)."""
         return float(self.time[1] - self.time[0]) if self.time.size > 1 else math.nan
 
     @property

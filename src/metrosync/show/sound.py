@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import atomic_path
 from ..errors import ParameterError
 from .recording import RecordedRun
 
@@ -57,20 +58,18 @@ class ClickTrack:
 
     @property
     def duration(self) -> float:
+        """Length of the audio, s."""
         return self.samples.shape[0] / self.sample_rate
 
     def write(self, path: Path | str) -> Path:
         """Write a 16-bit PCM stereo WAV atomically; returns the path."""
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".partial")
         pcm = np.round(np.clip(self.samples, -1.0, 1.0) * 32767).astype("<i2")
-        with wave.open(str(tmp), "wb") as out:
+        with atomic_path(path) as tmp, wave.open(str(tmp), "wb") as out:
             out.setnchannels(2)
             out.setsampwidth(2)
             out.setframerate(self.sample_rate)
             out.writeframes(pcm.tobytes())
-        tmp.replace(path)
         return path
 
 

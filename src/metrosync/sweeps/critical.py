@@ -80,14 +80,23 @@ def _slope(bpm: np.ndarray, mean: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ``SLOPE_WINDOW`` points) on an even grid, else plain differences at midpoints.
 
     Differentiating noisy means amplifies the noise; the local quadratic fit tames it
-    and, being symmetric, leaves the position of a symmetric rise unbiased.
+    and, being symmetric, leaves the position of a symmetric rise unbiased. Where a
+    fit's window holds a NaN mean (no finite run there), its slope is NaN.
     """
     steps = np.diff(bpm)
     if bpm.size >= SLOPE_WINDOW and np.allclose(steps, steps[0], rtol=1e-6):
+        missing = ~np.isfinite(mean)
         slope = savgol_filter(
-            mean, SLOPE_WINDOW, 2, deriv=1, delta=steps[0], axis=-1, mode="interp"
-        )
-        return bpm, slope
+            np.where(missing, 0.0, mean), SLOPE_WINDOW, 2, deriv=1, delta=steps[0], axis=-1,
+            mode="interp",
+        )  # fmt: skip
+        # Position k uses the window centred on it; the first and last half-windows share
+        # the window at their end of the grid (mode="interp").
+        half = SLOPE_WINDOW // 2
+        centre = np.clip(np.arange(bpm.size), half, bpm.size - 1 - half)
+        windows = centre[:, None] + np.arange(-half, half + 1)[None, :]
+        touched = missing[..., windows].any(axis=-1)
+        return bpm, np.where(touched, np.nan, slope)
     return 0.5 * (bpm[1:] + bpm[:-1]), np.diff(mean, axis=-1) / steps
 
 
@@ -203,6 +212,15 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
         n_value = sweep.attrs.get("fixed_n", 0)
         r = r.expand_dims(n=[n_value])
     r = r.sortby("bpm").transpose("n", "bpm", "run")
+    empty = [
+        n.item() for n, row in zip(r.n.values, r.values, strict=True) if not np.isfinite(row).any()
+    ]
+    if empty:
+        raise ParameterError(
+            f"`sweep` has no finite r_eq for N = {empty}: every point failed, or the runs are "
+            f"too short for the crossing phase (each metronome must cross zero twice before "
+            f"the final window). Sweep a longer `duration`, or select other N."
+        )
     bpm = r.bpm.values.astype(float)
     step = float(np.min(np.diff(bpm)))
     values = r.values
@@ -235,20 +253,27 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
                 f"fit_form_{m}": fit.form,
             }
         )
-    coords = {"n": r.n.values, "bpm": ("bpm", bpm, bpm_units)}
+    coords = {
+        "n": ("n", r.n.values, {"long_name": "metronomes on the disk"}),
+        "bpm": ("bpm", bpm, {**bpm_units, "long_name": "nominal beat frequency ω₀"}),
+    }
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def plot_critical(result: xr.Dataset, path=None):
-    """r̄(ω₀) and σ_r(ω₀) for every N with ω_c marked, and ω_c against N with the fit."""
+    """r̄(ω₀) and σ_r(ω₀) for every N with ω_c marked, and ω_c against N with the fit.
+
+    result : a `critical_frequency` dataset.   path : write the figure there when given.
+    Returns the figure.
+    """
     import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from ..plots import finish_figure, new_figure
 
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), constrained_layout=True)
+    fig = new_figure(path, figsize=(14, 4.2), layout="constrained")
+    axes = fig.subplots(1, 3)
     bpm = result.bpm.values
-    colors = plt.cm.viridis(np.linspace(0, 0.9, result.sizes["n"]))
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, result.sizes["n"]))
     for color, n in zip(colors, result.n.values, strict=True):
         one = result.sel(n=n)
         axes[0].plot(bpm, one.r_mean, "o-", ms=3, color=color, label=f"N = {n}")
@@ -276,7 +301,4 @@ def plot_critical(result: xr.Dataset, path=None):
                         xycoords="axes fraction", fontsize=8, va="top")  # fmt: skip
     ax.set(xscale="log", xlabel="N", ylabel="ω_c (BPM)", title="finite-size extrapolation")
     ax.legend(loc="lower right", fontsize=8)
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    return finish_figure(fig, path)

@@ -91,6 +91,12 @@ def execute(
         )
     if n_workers is not None and (isinstance(n_workers, bool) or n_workers < 1):
         raise ParameterError(f"`n_workers` must be an integer >= 1, got {n_workers!r}.")
+    if n_workers is not None and scheduler != "local":
+        where = "in process" if scheduler is None else "on an existing cluster"
+        raise ParameterError(
+            f"`n_workers` = {n_workers} applies to scheduler='local' only, but the sweep runs "
+            f"{where}; add `scheduler='local'` (CLI: --scheduler local) or drop it."
+        )
     report = Execution()
     started = time.perf_counter()
     total = sum(spec.work for spec in specs)
@@ -141,10 +147,6 @@ def _execute_dask(specs, scheduler, n_workers, done, report) -> None:
         threads = max(1, (os.cpu_count() or 1) // workers)
         client = Client(cluster)
     else:
-        if n_workers is not None:
-            raise ParameterError(
-                "`n_workers` applies to scheduler='local' only; an existing cluster has its own."
-            )
         threads = None
         try:
             client = Client(scheduler, timeout="20s")

@@ -295,10 +295,12 @@ class Grid:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """Number of values along each swept axis, in axis order."""
         return tuple(len(values) for values in self.axes.values())
 
     @property
     def size(self) -> int:
+        """Number of grid points."""
         return math.prod(self.shape)
 
     def model_parameters(self, swept: Mapping[str, Any] | None = None):

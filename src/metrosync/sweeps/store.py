@@ -2,7 +2,7 @@
 
 Contract: a store is a directory. ``points/<key>.nc`` holds one finished point, named
 by its content hash (`PointSpec.key`), written to a temporary file and moved into
-place with `os.replace`, so a file at that name is always complete; a crash loses at
+place (`metrosync._files.atomic_path`), so a file at that name is always complete; a crash loses at
 most the points in flight. A point is finished when its file exists; a sweep started
 again skips those points, and a point whose inputs changed has another key, so a
 stale file is never read for it. ``log.jsonl`` gets one line per point computed
@@ -16,15 +16,14 @@ deterministic content, so the merge does not depend on which executor ran them.
 from __future__ import annotations
 
 import json
-import os
 import socket
-import uuid
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
+from .._files import write_netcdf
 from ..integrators._state import STATUS_MEANINGS
 from .grid import UNITS, Grid, PointSpec
 
@@ -33,6 +32,27 @@ STATUS_FAILED = 4
 #: Status value of a run that does not exist (a point with fewer runs than the largest).
 STATUS_ABSENT = -1
 FLAG_MEANINGS = {**STATUS_MEANINGS, STATUS_FAILED: "failed"}
+#: What each parameter is, for the coordinates of a merged sweep.
+LONG_NAMES = {
+    "n": "metronomes on the disk",
+    "bpm": "nominal beat frequency",
+    "sigma_bpm": "spread (std) of the natural frequencies",
+    "runs": "independent runs",
+    "duration": "simulated time",
+    "dt": "time step",
+    "seed": "sweep seed",
+    "drive": "escapement impulse M",
+    "c_theta": "pendulum friction",
+    "c_phi": "disk friction",
+    "inertia": "disk inertia J",
+    "j0": "disk inertia without metronomes",
+    "j_per_metronome": "disk inertia added per metronome",
+    "w1": "fixed weight",
+    "w2": "sliding weight",
+    "l1": "distance of the fixed weight below the pivot",
+    "radius": "disk radius",
+    "g": "gravitational acceleration",
+}
 
 
 def point_dataset(spec: PointSpec, result: xr.Dataset | None, error: str = "") -> xr.Dataset:
@@ -74,9 +94,11 @@ class PointStore:
         self.log_path = self.root / "log.jsonl"
 
     def path(self, key: str) -> Path:
+        """File of the point with content hash ``key``."""
         return self.points / f"{key}.nc"
 
     def has(self, key: str) -> bool:
+        """True when the point ``key`` is finished (its file exists)."""
         return self.path(key).is_file()
 
     def failed(self, key: str) -> bool:
@@ -86,15 +108,8 @@ class PointStore:
 
     def write(self, ds: xr.Dataset, *, seconds: float = float("nan"), host: str = "") -> Path:
         """Write one point atomically, then log it."""
-        self.points.mkdir(parents=True, exist_ok=True)
         key = ds.attrs["key"]
-        final = self.path(key)
-        tmp = self.points / f".{key}.{uuid.uuid4().hex}.partial"
-        try:
-            ds.to_netcdf(tmp, engine="h5netcdf")
-            os.replace(tmp, final)
-        finally:
-            tmp.unlink(missing_ok=True)
+        final = write_netcdf(ds, self.path(key))
         line = json.dumps(
             {"key": key, "seconds": round(seconds, 4), "host": host or socket.gethostname()}
         )
@@ -103,6 +118,7 @@ class PointStore:
         return final
 
     def read(self, key: str) -> xr.Dataset:
+        """Load the point ``key``; `OSError` if its file holds another key."""
         with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
             loaded = ds.load()
         if loaded.attrs.get("key") != key:
@@ -182,10 +198,9 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         "error": (dims, error.astype(str), {"long_name": "why the point has no result ('' = ok)"}),
     }
     coords: dict[str, Any] = {
-        name: (name, np.asarray(values), {"units": UNITS[name]} if name in UNITS else {})
-        for name, values in grid.axes.items()
+        name: (name, np.asarray(values), _describe(name)) for name, values in grid.axes.items()
     }
-    coords["run"] = np.arange(n_run)
+    coords["run"] = ("run", np.arange(n_run), {"long_name": "run of the ensemble at each point"})
     if time is not None:
         data["r"] = ((*dims, "time", "run"), r_t, {"long_name": "Kuramoto r (analytic phase)"})
         data["r_crossing"] = (
@@ -193,18 +208,18 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
             r_cross,
             {"long_name": "Kuramoto r (crossing phases)"},
         )
-        coords["time"] = ("time", time, {"units": "s"})
+        coords["time"] = ("time", time, {"units": "s", "long_name": "simulated time"})
     return xr.Dataset(data, coords=coords, attrs=grid.describe())
+
+
+def _describe(name: str) -> dict[str, str]:
+    """Attributes of the coordinate of swept parameter ``name``."""
+    attrs = {"long_name": LONG_NAMES.get(name, name)}
+    if name in UNITS:
+        attrs["units"] = UNITS[name]
+    return attrs
 
 
 def write_dataset(ds: xr.Dataset, path: str | Path) -> Path:
     """Write the merged sweep to NetCDF atomically (a crash never leaves half a file)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.partial")
-    try:
-        ds.to_netcdf(tmp, engine="h5netcdf", invalid_netcdf=False)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    return write_netcdf(ds, path)

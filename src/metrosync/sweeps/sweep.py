@@ -42,6 +42,7 @@ class SweepResult:
 
     @property
     def complete(self) -> bool:
+        """True when every point is in the store (failed points count as stored)."""
         return not bool((self.dataset.error == "missing").any())
 
     def failures(self) -> list[tuple[dict[str, Any], str]]:
@@ -59,6 +60,7 @@ class SweepResult:
         return out
 
     def summary(self) -> str:
+        """Human-readable report: points computed and reused, throughput, failures."""
         ex = self.execution
         ds = self.dataset
         lines = [
