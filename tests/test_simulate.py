@@ -94,6 +94,13 @@ def test_bad_input_names_the_argument_and_the_value(kwargs, match):
         simulate(args.pop("n"), args.pop("bpm"), **args)
 
 
+def test_undriven_default_amplitude_needs_an_explicit_start():
+    with pytest.raises(ParameterError, match=r"without drive .*Give `amplitude`"):
+        simulate(2, 192, duration=1, changes={"drive": 0.0})
+    ds = simulate(2, 192, duration=1, changes={"drive": 0.0}, amplitude=0.3)
+    assert float(ds.r.isel(time=0, run=0)) > 0
+
+
 def test_frictionless_default_amplitude_needs_an_explicit_start():
     # Drive without friction: the energy balance has no finite amplitude.
     with pytest.warns(OverturnWarning), pytest.raises(ParameterError, match="no friction"):

@@ -176,6 +176,12 @@ def build_ensemble(
         if theta_dot0 is not None:
             raise ParameterError("`theta_dot0` was given without `theta0`: give both, or neither.")
         amp = params.steady_amplitude if amplitude is None else amplitude
+        if amplitude is None and amp == 0:
+            raise ParameterError(
+                "the default start amplitude is the energy-balance amplitude 2M/(pi c_theta), "
+                "which is 0 without drive (`drive` = 0): every pendulum would start at rest. "
+                "Give `amplitude` (--amplitude) or `theta0` (--theta0)."
+            )
         if not (math.isfinite(amp) and amp >= 0):
             raise ParameterError(
                 f"`amplitude` must be a finite angle >= 0 rad, got {amp!r}"
