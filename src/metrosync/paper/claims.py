@@ -134,35 +134,34 @@ def claim_identical(ds: xr.Dataset) -> Verdict:
 
 def claim_frequency_trend(ds: xr.Dataset) -> Verdict:
     """Claim 2 from Fig. 8 (top): r_eq rises with ω₀ (weighted slope > 2 SE)."""
-    slope, se = weighted_slope(ds.bpm, ds.r_eq_mean, ds.sigma_r, _runs(ds))
-    numbers = (
-        f"r_eq (mean ± σ_r over {_runs(ds)} runs): "
-        f"{_listing(ds.bpm.values, ds.r_eq_mean.values, ds.sigma_r.values, ' BPM')}; "
-        f"slope {slope * 10:.4f} per 10 BPM ({slope / se:+.1f} SE)."
-    )
-    return Verdict(
-        2,
-        _trend_verdict(slope / se, +1),
-        numbers,
-        ds.attrs.get("study"),
-        {"slope": slope, "z": slope / se, "r_eq_mean": ds.r_eq_mean.values.tolist()},
-    )
+    return _trend_claim(2, ds, "bpm", +1, unit=" BPM", per=(10.0, "10 BPM"),
+                        r_eq_mean=ds.r_eq_mean.values.tolist())  # fmt: skip
 
 
 def claim_size_trend(ds: xr.Dataset) -> Verdict:
     """Claim 3 from Fig. 8 (bottom): r_eq falls with N (weighted slope < −2 SE)."""
-    slope, se = weighted_slope(ds.n, ds.r_eq_mean, ds.sigma_r, _runs(ds))
+    return _trend_claim(3, ds, "n", -1, suffix=" (N)", per=(1.0, "metronome"))
+
+
+def _trend_claim(claim: int, ds: xr.Dataset, x: str, sign: int, *, unit: str = "",
+                 suffix: str = "", per: tuple[float, str], **values) -> Verdict:  # fmt: skip
+    """A trend of the run-mean r_eq along coordinate ``x`` in direction ``sign``.
+
+    ``per`` = (factor, text) scales the slope as printed ("per 10 BPM"); ``values``
+    are added to the verdict's values.
+    """
+    slope, se = weighted_slope(ds[x], ds.r_eq_mean, ds.sigma_r, _runs(ds))
     numbers = (
         f"r_eq (mean ± σ_r over {_runs(ds)} runs): "
-        f"{_listing(ds.n.values, ds.r_eq_mean.values, ds.sigma_r.values)} (N); "
-        f"slope {slope:.4f} per metronome ({slope / se:+.1f} SE)."
+        f"{_listing(ds[x].values, ds.r_eq_mean.values, ds.sigma_r.values, unit)}{suffix}; "
+        f"slope {slope * per[0]:.4f} per {per[1]} ({slope / se:+.1f} SE)."
     )
     return Verdict(
-        3,
-        _trend_verdict(slope / se, -1),
+        claim,
+        _trend_verdict(slope / se, sign),
         numbers,
         ds.attrs.get("study"),
-        {"slope": slope, "z": slope / se},
+        {"slope": slope, "z": slope / se, **values},
     )
 
 

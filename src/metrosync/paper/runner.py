@@ -78,38 +78,19 @@ class StudyResult:
 
 def points_of(study: Study, mode: str) -> list[Point]:
     """Expand ``study`` into its `simulate` calls for ``mode`` ("quick" or "full")."""
-    if isinstance(study, TimeSeriesStudy):
-        stats = study.statistics(mode)
+    if isinstance(study, TimeSeriesStudy | SweepStudy):
+        if isinstance(study, TimeSeriesStudy):
+            stats = study.statistics(mode)
+            cells = [(f"case{i:02d}", c.n, c.bpm, c.sigma_bpm, {"case": i})
+                     for i, c in enumerate(study.cases)]  # fmt: skip
+        else:
+            grid = study.grid(mode)
+            stats = grid.stats
+            cells = [(f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, study.sigma_bpm, {"n": n, "bpm": bpm})
+                     for n in grid.ns for bpm in grid.bpms]  # fmt: skip
         return [
-            _ensemble_point(
-                study.name,
-                f"case{i:02d}",
-                c.n,
-                c.bpm,
-                c.sigma_bpm,
-                stats.runs,
-                stats.duration,
-                study.preset,
-                {"case": i},
-            )
-            for i, c in enumerate(study.cases)
-        ]
-    if isinstance(study, SweepStudy):
-        grid = study.grid(mode)
-        return [
-            _ensemble_point(
-                study.name,
-                f"n{n:04d}_bpm{bpm:07.2f}",
-                n,
-                bpm,
-                study.sigma_bpm,
-                grid.stats.runs,
-                grid.stats.duration,
-                study.preset,
-                {"n": n, "bpm": bpm},
-            )
-            for n in grid.ns
-            for bpm in grid.bpms
+            _ensemble_point(study.name, key, n, bpm, sigma, stats, study.preset, coords)
+            for key, n, bpm, sigma, coords in cells
         ]
     if isinstance(study, ZStudy):
         grid = study.grid(mode)
@@ -212,13 +193,13 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def _ensemble_point(study, key, n, bpm, sigma, runs, duration, preset, coords) -> Point:
+def _ensemble_point(study, key, n, bpm, sigma, stats, preset, coords) -> Point:
     kwargs = {
         "n": int(n),
         "bpm": float(bpm),
         "sigma_bpm": float(sigma),
-        "runs": int(runs),
-        "duration": float(duration),
+        "runs": int(stats.runs),
+        "duration": float(stats.duration),
         "dt": DT,
         "preset": preset,
         "seed": point_seed(study, key),
