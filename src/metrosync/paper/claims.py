@@ -321,9 +321,9 @@ def claim_estimation(ds: xr.Dataset) -> Verdict:
     flat = scan <= 0.1
     numbers = (
         f"Truth: the `{ds.attrs['preset']}` preset, {ds.attrs['bpm']:g} BPM. "
-        f"c_θ (true {float(ds.true[0]):.3g} kg m²/s) from a {ds.attrs['decay_duration']:g} s "
-        f"free decay: trajectory extrema {found('c_theta (trajectory)')}, light-gate log "
-        f"{found('c_theta (light gate)')}. "
+        f"c_θ (true {float(ds.true[0]):.3g} kg m²/s) from a free decay of "
+        f"{ds.attrs['decay_duration']:g} s: trajectory extrema "
+        f"{found('c_theta (trajectory)')}, light-gate log {found('c_theta (light gate)')}. "
         f"M (true {float(ds.true.sel(parameter='M')):.3g} N m s) from the steady amplitude "
         f"{ds.attrs['steady_amplitude_measured']:.4f} rad with the light-gate c_θ: "
         f"{found('M')}. "
