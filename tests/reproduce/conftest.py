@@ -6,6 +6,7 @@ import pytest
 
 from metrosync.paper.pipeline import reproduce
 from metrosync.paper.studies import (
+    ESTIMATION,
     FIG8_BOTTOM,
     FIG8_TOP,
     FIG10,
@@ -24,6 +25,7 @@ def tiny_studies():
         reduced(FIG10, ns=(7, 16), bpms=(170.0, 190.0, 210.0), stats=Statistics(3, 60.0)),
         reduced(FIG11, runs=2, duration=60.0),
         reduced(Z_STUDY, duration=60.0, theta2=(-0.1, 0.0, 0.1)),
+        reduced(ESTIMATION, c_phi_scan=(1e-6, 1e-5, 1.0, 10.0)),
     ]
 
 

@@ -158,9 +158,64 @@ def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
     return _save(fig, stem)
 
 
+def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
+    """§5: the three steps of the parameter estimation, against the true values.
+
+    ds : the estimation study (`metrosync.paper.estimation`): the fitted data of each
+    step and ``disk_amplitude`` (c_phi), the sensitivity curve.
+    """
+    fig, (decay, drive, disk) = plt.subplots(1, 3, figsize=(14.0, 4.4), constrained_layout=True)
+    est = ds.estimate
+    steps = (("decay", "c_theta (trajectory)", "o"), ("gate", "c_theta (light gate)", "s"))
+    for prefix, row, marker in steps:
+        label = f"{row[9:-1]}: c_θ = {float(est.sel(parameter=row)):.4g}"
+        (line,) = decay.plot(ds[f"{prefix}_x"], ds[f"{prefix}_y"], marker, ms=3, mfc="none",
+                             label=label)  # fmt: skip
+        decay.plot(ds[f"{prefix}_fit_x"], ds[f"{prefix}_fit_y"], "-", lw=1, color=line.get_color())
+    decay.set_xlabel("t (s)")
+    decay.set_ylabel("u(A) (≈ ln A)")
+    decay.set_title(f"1. free decay, drive off: true c_θ = {float(ds.true[0]):.3g} kg m²/s")
+    decay.legend(fontsize=8)
+
+    drive.plot(ds.drive_x, ds.drive_y, "o", ms=4, label="model runs of the fit")
+    measured = ds.attrs["steady_amplitude_measured"]
+    drive.axhline(measured, color="0.4", lw=0.8, label=f"measured amplitude {measured:.3f} rad")
+    drive.axvline(float(ds.true.sel(parameter="M")), color="k", ls="--", lw=0.8, label="true M")
+    drive.axvline(float(est.sel(parameter="M")), color="C3", lw=1,
+                  label=f"estimate {float(est.sel(parameter='M')):.4g} N m s")  # fmt: skip
+    drive.set_xscale("log")
+    drive.set_xlabel("M (N m s)")
+    drive.set_ylabel("steady amplitude (rad)")
+    drive.set_title("2. steady amplitude, rigid support")
+    drive.legend(fontsize=8)
+
+    disk.plot(ds.c_phi, ds.disk_amplitude * 1e3, "o-", ms=3, lw=1, label="model, true c_θ and M")
+    for row, key, style in (
+        ("c_phi (published)", "disk_amplitude_measured", "--"),
+        ("c_phi (control)", "disk_amplitude_measured_control", ":"),
+    ):
+        true = float(ds.true.sel(parameter=row))
+        disk.axvline(true, color="k", ls=style, lw=0.8, label=f"true c_φ = {true:g} ({row[7:-1]})")
+        disk.axhline(ds.attrs[key] * 1e3, color="0.5", ls=style, lw=0.8)
+    chained = float(est.sel(parameter="c_phi (published)"))
+    if np.isfinite(chained):
+        disk.axvline(chained, color="C3", lw=1, label=f"estimate for the published: {chained:.3g}")
+    disk.set_xscale("log")
+    disk.set_xlabel("c_φ (kg m²/s)")
+    disk.set_ylabel("disk amplitude (mrad)")
+    disk.set_title(
+        f"3. synchronized disk, N = {ds.attrs['n']}, {ds.attrs['disk_duration']:g} s runs"
+    )
+    disk.legend(fontsize=7, loc="lower left")
+    fig.suptitle(f"{ds.attrs['figure']}: {ds.attrs['title']} ({ds.attrs.get('mode', '')} mode)",
+                 fontsize=10)  # fmt: skip
+    return _save(fig, stem)
+
+
 #: Which function draws each study kind (by the study's class name).
 PLOTTERS = {
     "TimeSeriesStudy": plot_order_in_time,
     "SweepStudy": plot_sweep,
     "ZStudy": plot_z,
+    "EstimationStudy": plot_estimation,
 }

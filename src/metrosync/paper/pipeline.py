@@ -3,6 +3,7 @@
 Contract: ``reproduce(out, mode=...)`` writes into ``out``
 
     <study>.nc, figures/<study>.png|pdf   for every study (`studies.STUDIES`)
+    points/estimation/free_decay000.log   the estimation study's virtual light-gate log
     consistency.nc                        the parameter-consistency table
     fig9.nc, figures/fig9.png|pdf         only with ``experiment``
     points/<study>/*.nc                   finished simulate calls (resume cache)
@@ -28,7 +29,16 @@ from .experiment import compare_experiment, find_experiment, lightgate_analyze
 from .figures import PLOTTERS, plot_comparison
 from .report import write_report
 from .runner import StudyResult, points_of, run_study, write_atomic
-from .studies import FIG8_TOP, MODES, Study, SweepStudy, TimeSeriesStudy, ZStudy, get_studies
+from .studies import (
+    FIG8_TOP,
+    MODES,
+    EstimationStudy,
+    Study,
+    SweepStudy,
+    TimeSeriesStudy,
+    ZStudy,
+    get_studies,
+)
 
 NO_EXPERIMENT = (
     "no light-gate data was given. Run `metrosync reproduce --experiment DIR` with one "
@@ -98,7 +108,12 @@ def reproduce(
 
     results, figures = [], {}
     for study in chosen:
-        say(f"{study.name}: {study.figure} ({len(points_of(study, mode))} simulate calls)")
+        calls = (
+            "calibration procedure"
+            if isinstance(study, EstimationStudy)
+            else f"{len(points_of(study, mode))} simulate calls"
+        )
+        say(f"{study.name}: {study.figure} ({calls})")
         result = run_study(study, mode, out, progress=progress, log=say if mode == "full" else None)
         results.append(result)
         figures[study.name] = PLOTTERS[type(study).__name__](
@@ -143,6 +158,6 @@ def _bpms(studies: Sequence[Study], mode: str) -> list[float]:
             bpms |= {c.bpm for c in s.cases}
         elif isinstance(s, SweepStudy):
             bpms |= set(s.grid(mode).bpms)
-        elif isinstance(s, ZStudy):
+        elif isinstance(s, ZStudy | EstimationStudy):
             bpms.add(s.bpm)
     return sorted(bpms) or [192.0]

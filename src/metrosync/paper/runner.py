@@ -8,6 +8,9 @@ interrupted run (``--full`` takes hours) resumes where it stopped: a point whose
 exists with the same hash is loaded, not recomputed. The points are then assembled
 into one `xarray.Dataset` per study, written to ``out/<study>.nc``.
 
+The estimation study (`EstimationStudy`) has no points: its `simulate` calls are made
+inside `metrosync.calibration` and take seconds, so it is recomputed on every run.
+
 Seeds are a fixed function of the study and point names, so results never depend on
 the order or the number of points computed in one go.
 """
@@ -30,7 +33,8 @@ from .. import __version__
 from ..progress import progress_bar
 from ..simulate import simulate
 from .assemble import assemble, reduce_ensemble, reduce_z
-from .studies import Study, SweepStudy, TimeSeriesStudy, ZStudy
+from .estimation import run_estimation
+from .studies import EstimationStudy, Study, SweepStudy, TimeSeriesStudy, ZStudy
 
 #: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
 Z_BATCH = 12
@@ -74,38 +78,19 @@ class StudyResult:
 
 def points_of(study: Study, mode: str) -> list[Point]:
     """Expand ``study`` into its `simulate` calls for ``mode`` ("quick" or "full")."""
-    if isinstance(study, TimeSeriesStudy):
-        stats = study.statistics(mode)
+    if isinstance(study, TimeSeriesStudy | SweepStudy):
+        if isinstance(study, TimeSeriesStudy):
+            stats = study.statistics(mode)
+            cells = [(f"case{i:02d}", c.n, c.bpm, c.sigma_bpm, {"case": i})
+                     for i, c in enumerate(study.cases)]  # fmt: skip
+        else:
+            grid = study.grid(mode)
+            stats = grid.stats
+            cells = [(f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, study.sigma_bpm, {"n": n, "bpm": bpm})
+                     for n in grid.ns for bpm in grid.bpms]  # fmt: skip
         return [
-            _ensemble_point(
-                study.name,
-                f"case{i:02d}",
-                c.n,
-                c.bpm,
-                c.sigma_bpm,
-                stats.runs,
-                stats.duration,
-                study.preset,
-                {"case": i},
-            )
-            for i, c in enumerate(study.cases)
-        ]
-    if isinstance(study, SweepStudy):
-        grid = study.grid(mode)
-        return [
-            _ensemble_point(
-                study.name,
-                f"n{n:04d}_bpm{bpm:07.2f}",
-                n,
-                bpm,
-                study.sigma_bpm,
-                grid.stats.runs,
-                grid.stats.duration,
-                study.preset,
-                {"n": n, "bpm": bpm},
-            )
-            for n in grid.ns
-            for bpm in grid.bpms
+            _ensemble_point(study.name, key, n, bpm, sigma, stats, study.preset, coords)
+            for key, n, bpm, sigma, coords in cells
         ]
     if isinstance(study, ZStudy):
         grid = study.grid(mode)
@@ -133,6 +118,8 @@ def points_of(study: Study, mode: str) -> list[Point]:
                     Point(f"regime{r}_from{start:03d}", kwargs, {"regime": r, "start": start})
                 )
         return out
+    if isinstance(study, EstimationStudy):
+        return []
     raise TypeError(f"unknown study type {type(study).__name__}")
 
 
@@ -147,6 +134,9 @@ def run_study(
     """Simulate (or resume) every point of ``study``, assemble and write ``out/<name>.nc``."""
     out = Path(out)
     started = time.perf_counter()
+    if isinstance(study, EstimationStudy):
+        dataset = run_estimation(study, mode, out / "points" / study.name)
+        return _finish(study, mode, out, dataset, started, 0.0, 0.0, 0, 0)
     points = points_of(study, mode)
     cache = out / "points" / study.name
     total = sum(p.work for p in points)
@@ -167,6 +157,11 @@ def run_study(
                 elapsed = time.perf_counter() - started
                 log(f"  {study.name}: {i + 1}/{len(points)} points ({elapsed:.0f} s)")
     dataset = assemble(study, mode, [p.coords for p in points], reduced)
+    return _finish(study, mode, out, dataset, started, total, computed, cached, len(points))
+
+
+def _finish(study, mode, out, dataset, started, total, computed, cached, points) -> StudyResult:
+    """Stamp a study's dataset with what it cost, write ``out/<name>.nc``, wrap it."""
     wall = time.perf_counter() - started
     dataset.attrs.update(
         study=study.name,
@@ -179,9 +174,9 @@ def run_study(
         cached_points=cached,
         metrosync_version=__version__,
     )
-    path = out / f"{study.name}.nc"
+    path = Path(out) / f"{study.name}.nc"
     write_atomic(dataset, path)
-    return StudyResult(study, mode, dataset, path, wall, computed, total, cached, len(points))
+    return StudyResult(study, mode, dataset, path, wall, computed, total, cached, points)
 
 
 def write_atomic(ds: xr.Dataset, path: Path) -> None:
@@ -198,13 +193,13 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def _ensemble_point(study, key, n, bpm, sigma, runs, duration, preset, coords) -> Point:
+def _ensemble_point(study, key, n, bpm, sigma, stats, preset, coords) -> Point:
     kwargs = {
         "n": int(n),
         "bpm": float(bpm),
         "sigma_bpm": float(sigma),
-        "runs": int(runs),
-        "duration": float(duration),
+        "runs": int(stats.runs),
+        "duration": float(stats.duration),
         "dt": DT,
         "preset": preset,
         "seed": point_seed(study, key),
