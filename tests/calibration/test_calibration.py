@@ -75,3 +75,11 @@ def test_c_phi_is_refused_where_the_amplitude_does_not_identify_it():
     amplitude = disk_amplitude(1e-5, c_theta=5e-5, drive=6e-5)
     with pytest.raises(CalibrationError):
         fit_c_phi(amplitude, c_theta=5e-5, drive=6e-5, bracket=(1e-6, 10.0))
+
+
+def test_c_phi_from_slightly_wrong_c_theta_and_drive_is_refused_not_wrong():
+    # c_θ and M 2 % off (what the light-gate estimates give) once returned a c_φ
+    # thousands of times the truth; the sensitivity check must refuse instead.
+    amplitude = disk_amplitude(1e-5, c_theta=5e-5, drive=6e-5)
+    with pytest.raises(CalibrationError, match="hardly depends on c_phi|several c_phi|no c_phi"):
+        fit_c_phi(amplitude, c_theta=5.1e-5, drive=6.12e-5)
