@@ -44,13 +44,16 @@ def test_chunking_does_not_change_the_result(small_ensemble):
     np.testing.assert_array_equal(one.cross_re, many.cross_re)
 
 
+@pytest.mark.skipif(
+    numba.config.NUMBA_NUM_THREADS < 2, reason="numba is limited to one thread here"
+)
 def test_results_identical_for_any_thread_count():
     kwargs = dict(sigma_bpm=1.0, runs=6, duration=60, seed=5)
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
         single = simulate(7, 192, **kwargs)
-        numba.set_num_threads(max(2, threads))
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
         multi = simulate(7, 192, **kwargs)
     finally:
         numba.set_num_threads(threads)

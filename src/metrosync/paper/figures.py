@@ -11,29 +11,32 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import xarray as xr
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import xarray as xr  # noqa: E402
+from .._files import save_figure
 
 FORMATS = ("png", "pdf")
 DPI = 110
 
 
+def _figure(nrows: int = 1, ncols: int = 1, **options):
+    """A plain `Figure` (no pyplot, no backend switch) and its axes."""
+    from matplotlib.figure import Figure  # loaded when a figure is drawn, not on import
+
+    sharex = options.pop("sharex", False)
+    fig = Figure(**options)
+    return fig, fig.subplots(nrows, ncols, sharex=sharex)
+
+
+def _colors(name: str, values):
+    from matplotlib import colormaps
+
+    return colormaps[name](values)
+
+
 def _save(fig, stem: Path) -> list[Path]:
-    stem = Path(stem)
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for ext in FORMATS:
-        path = stem.with_suffix(f".{ext}")
-        tmp = path.with_name(f".{path.name}.partial")
-        fig.savefig(tmp, dpi=DPI, format=ext)
-        tmp.replace(path)
-        paths.append(path)
-    plt.close(fig)
-    return paths
+    return [save_figure(fig, Path(stem).with_suffix(f".{ext}"), dpi=DPI) for ext in FORMATS]
 
 
 def _subtitle(ds: xr.Dataset) -> str:
@@ -48,8 +51,8 @@ def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : a time-series study, with ``r_mean`` (case, time) and ``case`` labels.
     """
-    fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
-    colors = plt.cm.viridis(np.linspace(0.0, 0.9, ds.sizes["case"]))
+    fig, ax = _figure(figsize=(6.4, 4.2), constrained_layout=True)
+    colors = _colors("viridis", np.linspace(0.0, 0.9, ds.sizes["case"]))
     for color, case in zip(colors, ds.case.values, strict=True):
         ax.plot(ds.time, ds.r_mean.sel(case=case), lw=1.2, color=color, label=str(case))
     ax.set_xlabel("t (s)")
@@ -66,10 +69,8 @@ def plot_sweep(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : a sweep study, with ``r_eq_mean`` and ``sigma_r`` (n, bpm).
     """
-    fig, (top, bottom) = plt.subplots(
-        2, 1, figsize=(6.4, 7.0), sharex=True, constrained_layout=True
-    )
-    colors = plt.cm.plasma(np.linspace(0.0, 0.85, ds.sizes["n"]))
+    fig, (top, bottom) = _figure(2, 1, figsize=(6.4, 7.0), sharex=True, constrained_layout=True)
+    colors = _colors("plasma", np.linspace(0.0, 0.85, ds.sizes["n"]))
     for color, n in zip(colors, ds.n.values, strict=True):
         kw = {"color": color, "marker": "o", "ms": 3, "lw": 1.2, "label": f"N = {int(n)}"}
         top.plot(ds.bpm, ds.r_eq_mean.sel(n=n), **kw)
@@ -91,7 +92,7 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : the z-study, with ``z`` and ``status`` (regime, theta2).
     """
-    fig, ax = plt.subplots(figsize=(6.4, 5.6), layout="constrained")
+    fig, ax = _figure(figsize=(6.4, 5.6), layout="constrained")
     markers = "osD^v"
     for i, regime in enumerate(ds.regime.values):
         z = ds.z.sel(regime=regime)
@@ -135,7 +136,7 @@ def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : ``r_sim``, ``sigma_r_sim``, ``r_exp`` (bpm).
     """
-    fig, ax = plt.subplots(figsize=(4.8, 4.6), constrained_layout=True)
+    fig, ax = _figure(figsize=(4.8, 4.6), constrained_layout=True)
     ax.plot([0, 1], [0, 1], "k--", lw=0.8, label="r_sim = r_exp")
     ax.errorbar(
         ds.r_exp,
@@ -164,7 +165,7 @@ def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
     ds : the estimation study (`metrosync.paper.estimation`): the fitted data of each
     step and ``disk_amplitude`` (c_phi), the sensitivity curve.
     """
-    fig, (decay, drive, disk) = plt.subplots(1, 3, figsize=(14.0, 4.4), constrained_layout=True)
+    fig, (decay, drive, disk) = _figure(1, 3, figsize=(14.0, 4.4), constrained_layout=True)
     est = ds.estimate
     steps = (("decay", "c_theta (trajectory)", "o"), ("gate", "c_theta (light gate)", "s"))
     for prefix, row, marker in steps:
