@@ -1,7 +1,8 @@
 """How soon a second `metrosync simulate` starts computing, with a warm compile cache.
 
 Fills the cache once, then, in several fresh interpreters, times:
-  * ``import metrosync``;
+  * ``import metrosync`` and building the CLI's parser (what `metrosync simulate` does
+    before any work);
   * from there to the end of the kernel's first step (building the ensemble, checking
     the compile cache, loading the cached kernel): when computing has started;
   * a whole first ``simulate`` call of 0.1 s, including wrapping the result in xarray
@@ -20,6 +21,8 @@ PROBE = """
 import time
 t0 = time.perf_counter()
 import metrosync
+from metrosync.cli import build_parser
+build_parser().parse_args(["simulate", "--runs", "2", "--duration", "0.1"])
 t1 = time.perf_counter()
 from metrosync import build_ensemble, get_preset
 from metrosync.integrators import verlet
@@ -45,7 +48,7 @@ def main(repeats: int = 5) -> None:
         )
         rows.append([float(x) for x in out.stdout.split()])
     imp, first_step, wrap = (statistics.median(col) for col in zip(*rows, strict=True))
-    print(f"import metrosync {imp:.3f} s; first kernel step done {first_step:.3f} s later: "
+    print(f"import + CLI parser {imp:.3f} s; first kernel step done {first_step:.3f} s later: "
           f"computing starts {imp + first_step:.3f} s after launch; "
           f"a whole first simulate (incl. xarray's first use) adds {wrap:.3f} s "
           f"(median of {repeats} fresh processes)")  # fmt: skip

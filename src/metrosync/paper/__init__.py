@@ -11,7 +11,16 @@
 ``pipeline``    `reproduce`, the entry point tying them together
 """
 
-from .pipeline import Reproduction, reproduce
 from .studies import STUDIES, paper_sigma_to_bpm
 
 __all__ = ["STUDIES", "Reproduction", "paper_sigma_to_bpm", "reproduce"]
+
+
+def __getattr__(name: str):
+    # The pipeline pulls in the simulator, calibration and scipy; the CLI's parser only
+    # needs the study names, so it is loaded on first use.
+    if name in ("Reproduction", "reproduce"):
+        from . import pipeline
+
+        return getattr(pipeline, name)
+    raise AttributeError(f"module 'metrosync.paper' has no attribute {name!r}")
