@@ -67,7 +67,11 @@ def main(argv: list[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
             warnings.showwarning = show_warning
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+            # Flush here, not at exit: a reader that went away must meet the handler below
+            # whether or not the output outgrew the pipe's buffer.
+            sys.stdout.flush()
+            return code
     except MetrosyncError as error:
         message = name_options(str(error), getattr(args, "_aliases", None) or {})
         print(f"metrosync {args.command}: error: {message}", file=sys.stderr)
