@@ -13,7 +13,7 @@ import pytest
 
 from metrosync import build_ensemble, get_preset
 from metrosync.integrators import kernel_oscillators, kernel_runs, reference, verlet
-from metrosync.integrators._state import StepState
+from metrosync.integrators._state import StepState, kernel_arguments
 from metrosync.integrators.trig import REDUCTION_LIMIT, sincos
 
 
@@ -75,12 +75,8 @@ def packed_double_ops(module, fastmath, ens):
     state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                             n_records=2, trajectories=False)  # fmt: skip
     fresh = nb.njit(parallel=True, fastmath=fastmath)(module.advance.py_func)
-    s = ens.system
-    fresh(state.theta, state.theta_dot, state.phi, state.phi_dot, state.acc_theta, state.acc_phi,
-          state.p_phi, state.force_phi, state.last_up, state.status, s.mh, s.mgh, s.inertia,
-          s.c_theta, s.drive, s.omega, s.radius, s.c_phi, s.total_inertia, 0.01, 0, 10, 10, 1.5,
-          state.r, state.cross_re, state.cross_im, state.cross_count, state.traj_theta,
-          state.traj_theta_dot, state.traj_phi, state.traj_phi_dot)  # fmt: skip
+    fresh(*kernel_arguments(state, ens.system, dt=0.01, step0=0, n_steps=10, record_every=10,
+                            overturn_angle=1.5))  # fmt: skip
     asm = "\n".join(fresh.inspect_asm().values())
     return len(re.findall(r"\tv\w+pd\t[^\n]*%[yz]mm", asm))
 

@@ -48,6 +48,16 @@ def upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, gri
 
 
 @nb.njit(cache=True, inline="always")
+def save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+    """Copy run ``b``'s state into record ``k`` of the trajectory buffers."""
+    for i in range(theta.shape[1]):
+        traj_theta[b, k, i] = theta[b, i]
+        traj_theta_dot[b, k, i] = theta_dot[b, i]
+    traj_phi[b, k] = phi[b]
+    traj_phi_dot[b, k] = phi_dot[b]
+
+
+@nb.njit(cache=True, inline="always")
 def analytic_order(theta_row, theta_dot_row, omega_row):
     """r from the analytic phases Φ = atan2(−θ̇/ω, θ) of one run's metronomes."""
     n = theta_row.shape[0]

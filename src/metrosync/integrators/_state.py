@@ -13,12 +13,36 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..equations import SystemArrays, accelerations
+from ..observables.mechanics import platform_momentum
 
 # Status bits of a run (CF-style flag masks in the output file).
 STATUS_OK = 0
 STATUS_OVERTURNED = 1  # some |θ_i| passed `overturn_angle` (default π/2)
 STATUS_DIVERGED = 2  # a non-finite value appeared; the run was stopped there
 STATUS_MEANINGS = {STATUS_OVERTURNED: "overturned", STATUS_DIVERGED: "diverged"}
+
+
+#: The arrays every fixed-step kernel takes, by name and in order: state (B, N) and (B,),
+#: constants of `SystemArrays`, then records and trajectories (after the step settings).
+STATE_FIELDS = (
+    "theta", "theta_dot", "phi", "phi_dot", "acc_theta", "acc_phi", "p_phi", "force_phi",
+    "last_up", "status",
+)  # fmt: skip
+SYSTEM_FIELDS = (
+    "mh", "mgh", "inertia", "c_theta", "drive", "omega", "radius", "c_phi", "total_inertia",
+)  # fmt: skip
+RECORD_FIELDS = ("r", "cross_re", "cross_im", "cross_count")
+TRAJECTORY_FIELDS = ("traj_theta", "traj_theta_dot", "traj_phi", "traj_phi_dot")
+
+
+def kernel_arguments(state, sys, *, dt, step0, n_steps, record_every, overturn_angle) -> tuple:
+    """The positional arguments of every CPU kernel's ``advance``, in their order."""
+    return (
+        *(getattr(state, name) for name in STATE_FIELDS),
+        *(getattr(sys, name) for name in SYSTEM_FIELDS),
+        float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
+        *(getattr(state, name) for name in RECORD_FIELDS + TRAJECTORY_FIELDS),
+    )  # fmt: skip
 
 
 @dataclass
@@ -79,9 +103,7 @@ class StepState:
         # A run may diverge from its very start; it is flagged, not raised.
         with np.errstate(over="ignore", invalid="ignore"):
             acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
-            coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
-        finite_inertia = np.where(rigid, 0.0, sys.total_inertia)
-        p_phi = np.where(rigid, 0.0, finite_inertia * phi_dot + coupling)
+            p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
         finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
         return cls(

@@ -18,7 +18,14 @@ import math
 import numpy as np
 from numba import cuda, float64
 
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED, StepState
+from ._state import (
+    RECORD_FIELDS,
+    STATE_FIELDS,
+    STATUS_DIVERGED,
+    STATUS_OVERTURNED,
+    SYSTEM_FIELDS,
+    StepState,
+)
 
 #: Threads per block, a power of two; a block holds one run.
 MAX_THREADS = 256
@@ -185,16 +192,6 @@ def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status):
     if tid == 0:
         r[b, k] = math.sqrt(red[0, 0] ** 2 + red[1, 0] ** 2) / n
     cuda.syncthreads()
-
-
-STATE_FIELDS = (
-    "theta", "theta_dot", "phi", "phi_dot", "acc_theta", "acc_phi", "p_phi", "force_phi",
-    "last_up", "status",
-)  # fmt: skip
-SYSTEM_FIELDS = (
-    "mh", "mgh", "inertia", "c_theta", "drive", "omega", "radius", "c_phi", "total_inertia",
-)  # fmt: skip
-RECORD_FIELDS = ("r", "cross_re", "cross_im", "cross_count")
 
 
 def advance_state(

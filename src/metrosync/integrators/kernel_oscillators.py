@@ -17,7 +17,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._kernel_parts import analytic_order, upward_crossing
+from ._kernel_parts import analytic_order, save_state, upward_crossing
 from ._state import STATUS_DIVERGED, STATUS_OVERTURNED
 from .trig import REDUCTION_LIMIT, sincos
 
@@ -53,7 +53,7 @@ def advance(
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
             r[b, 0] = analytic_order(theta[b], theta_dot[b], omega[b])
             if save:
-                _save(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                save_state(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
@@ -126,7 +126,7 @@ def advance(
                 k = (s + 1) // record_every
                 r[b, k] = analytic_order(theta[b], theta_dot[b], omega[b])
                 if save:
-                    _save(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                    save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
 
 
 @nb.njit(cache=True)
@@ -148,12 +148,3 @@ def _libm_pass(b, n, th_new, dt, kick_dt, theta, theta_dot, acc_theta, mh, mgh, 
         rest[i] = res
         q[i] = qi
     return sum_num, sum_den
-
-
-@nb.njit(cache=True, inline="always")
-def _save(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
-    for i in range(theta.shape[1]):
-        traj_theta[b, k, i] = theta[b, i]
-        traj_theta_dot[b, k, i] = theta_dot[b, i]
-    traj_phi[b, k] = phi[b]
-    traj_phi_dot[b, k] = phi_dot[b]

@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from ._kernel_parts import upward_crossing
+from ._kernel_parts import analytic_order, save_state, upward_crossing
 from ._state import STATUS_DIVERGED, STATUS_OVERTURNED
 
 
@@ -100,21 +100,7 @@ def advance(
 @nb.njit(cache=True, inline="always")
 def _record(b, k, theta, theta_dot, phi, phi_dot, omega, r, save,
             traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip
-    """Store r from the analytic phase Φ = atan2(−θ̇/ω, θ) and, if asked, the state."""
-    n = theta.shape[1]
-    re = 0.0
-    im = 0.0
-    for i in range(n):
-        x = theta[b, i]
-        y = -theta_dot[b, i] / omega[b, i]
-        rho = math.sqrt(x * x + y * y)
-        if rho > 0.0:
-            re += x / rho
-            im += y / rho
-    r[b, k] = math.sqrt(re * re + im * im) / n
+    """Store r from the analytic phase and, if asked, the state."""
+    r[b, k] = analytic_order(theta[b], theta_dot[b], omega[b])
     if save:
-        for i in range(n):
-            traj_theta[b, k, i] = theta[b, i]
-            traj_theta_dot[b, k, i] = theta_dot[b, i]
-        traj_phi[b, k] = phi[b]
-        traj_phi_dot[b, k] = phi_dot[b]
+        save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from . import kernel_oscillators, kernel_runs, kernel_scalar
 from ._cache import heal_compile_cache
-from ._state import StepState
+from ._state import StepState, kernel_arguments
 
 #: Kernels by memory layout (see each module's docstring).
 KERNELS = {
@@ -57,11 +57,13 @@ def advance_state(
     heal_compile_cache()
     kernel = KERNELS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
     kernel(
-        state.theta, state.theta_dot, state.phi, state.phi_dot, state.acc_theta, state.acc_phi,
-        state.p_phi, state.force_phi, state.last_up, state.status,
-        sys.mh, sys.mgh, sys.inertia, sys.c_theta, sys.drive, sys.omega,
-        sys.radius, sys.c_phi, sys.total_inertia,
-        float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
-        state.r, state.cross_re, state.cross_im, state.cross_count,
-        state.traj_theta, state.traj_theta_dot, state.traj_phi, state.traj_phi_dot,
-    )  # fmt: skip
+        *kernel_arguments(
+            state,
+            sys,
+            dt=dt,
+            step0=step0,
+            n_steps=n_steps,
+            record_every=record_every,
+            overturn_angle=overturn_angle,
+        )
+    )
