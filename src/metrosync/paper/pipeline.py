@@ -22,13 +22,14 @@ from pathlib import Path
 import xarray as xr
 
 from .. import __version__
+from .._files import write_netcdf
 from ..errors import ParameterError
 from .claims import Verdict, all_verdicts
 from .consistency import consistency_table
 from .experiment import compare_experiment, find_experiment, lightgate_analyze
 from .figures import PLOTTERS, plot_comparison
 from .report import write_report
-from .runner import StudyResult, points_of, run_study, write_atomic
+from .runner import StudyResult, points_of, run_study
 from .studies import (
     FIG8_TOP,
     MODES,
@@ -104,7 +105,7 @@ def reproduce(
 
     say("parameter consistency table")
     consistency = consistency_table(_bpms(chosen, mode))
-    write_atomic(consistency, out / "consistency.nc")
+    write_netcdf(consistency, out / "consistency.nc")
 
     results, figures = [], {}
     for study in chosen:
@@ -135,7 +136,7 @@ def reproduce(
         if sim is None:
             sim = run_study(FIG8_TOP, mode, out, progress=progress).dataset
         rep.comparison = compare_experiment(Path(experiment), sim)
-        write_atomic(rep.comparison, out / "fig9.nc")
+        write_netcdf(rep.comparison, out / "fig9.nc")
         figures["fig9"] = plot_comparison(rep.comparison, out / "figures" / "fig9")
         rep.comparison_note = f"Simulated r from the `{FIG8_TOP.name}` study ({mode} mode)."
     rep.verdicts = all_verdicts(rep.datasets)

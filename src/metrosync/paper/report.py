@@ -14,6 +14,7 @@ import os
 import platform
 from pathlib import Path
 
+from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
@@ -80,10 +81,7 @@ def write_report(path: Path, rep) -> Path:
         if pngs:
             s += ["", f"  ![{name}]({_rel(pngs[0], base)})", ""]
     s.append("")
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text("\n".join(s), encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_text("\n".join(s), path)
 
 
 def _experiment_section(rep, base: Path) -> list[str]:

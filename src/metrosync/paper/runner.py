@@ -30,6 +30,7 @@ import numpy as np
 import xarray as xr
 
 from .. import __version__
+from .._files import write_netcdf
 from ..progress import progress_bar
 from ..simulate import simulate
 from .assemble import assemble, reduce_ensemble, reduce_z
@@ -147,7 +148,7 @@ def run_study(
             ds = _load_cached(path, point.digest)
             if ds is None:
                 ds = _compute(study, point)
-                write_atomic(ds, path)
+                write_netcdf(ds, path)
                 computed += point.work
             else:
                 cached += 1
@@ -175,17 +176,8 @@ def _finish(study, mode, out, dataset, started, total, computed, cached, points)
         metrosync_version=__version__,
     )
     path = Path(out) / f"{study.name}.nc"
-    write_atomic(dataset, path)
+    write_netcdf(dataset, path)
     return StudyResult(study, mode, dataset, path, wall, computed, total, cached, points)
-
-
-def write_atomic(ds: xr.Dataset, path: Path) -> None:
-    """Write NetCDF through a temporary file, so ``path`` is never half-written."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".partial")
-    ds.to_netcdf(tmp, engine="h5netcdf")
-    tmp.replace(path)
 
 
 def point_seed(study: str, key: str) -> int:
