@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint bench clean
+.PHONY: run test lint bench clean system-deps
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -18,7 +18,12 @@ $(STAMP): pyproject.toml | $(BIN)/python
 run: $(STAMP)
 	$(BIN)/metrosync reproduce --quick --out results
 
-test: $(STAMP)
+# System packages some tests use (Chromium, the AVR toolchain, simavr): installed when
+# missing and possible, never fatal; tests without them skip and say which is missing.
+system-deps:
+	@./tools/system-deps
+
+test: $(STAMP) system-deps
 	$(BIN)/python -m pytest
 
 lint: $(STAMP)

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
+
 import pytest
 
 import metrosync
+from system_packages import require
 
 
 @pytest.fixture(scope="session")
@@ -21,3 +24,23 @@ def pair_ds():
         None, None, frequencies_bpm=[188.0, 196.0], theta0=[0.3, -0.2], theta_dot0=[0.0, 1.0],
         duration=12.0, record_every=1, trajectories=True,
     )  # fmt: skip
+
+
+# -- headless Chromium, for the pages' end-to-end tests ------------------------------
+
+
+@pytest.fixture(scope="session")
+def chromium_executable():
+    """Debian's chromium; the test skips (naming the package) when it is missing."""
+    require("chromium")
+    return shutil.which("chromium")
+
+
+@pytest.fixture
+def browser(chromium_executable, tmp_path):
+    from cdp import Browser
+
+    profile = tmp_path / "profile"
+    profile.mkdir()
+    with Browser(chromium_executable, profile) as b:  # closing kills its process group
+        yield b

@@ -5,8 +5,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shutil
-import subprocess
 import time
 
 import numpy as np
@@ -63,37 +61,6 @@ def test_bad_max_rate_is_refused(recorded_ds):
 
 
 # -- end to end, in headless Chromium ------------------------------------------------
-
-
-@pytest.fixture(scope="session")
-def chromium_executable():
-    """Debian's chromium, installed with apt-get when missing (needs root)."""
-    found = shutil.which("chromium")
-    if found:
-        return found
-    if os.geteuid() != 0:
-        pytest.skip("chromium is not installed and installing it needs root (apt-get)")
-    if shutil.which("apt-get") is None:
-        pytest.skip("chromium is not installed and apt-get is not available")
-    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    for command in (["apt-get", "update"], ["apt-get", "install", "-y", "chromium"]):
-        done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=900)
-        if done.returncode != 0 and command[1] == "install":
-            pytest.skip(f"could not install chromium: {done.stderr.strip()[-300:]}")
-    found = shutil.which("chromium")
-    if not found:
-        pytest.skip("apt-get installed chromium but it is not on PATH")
-    return found
-
-
-@pytest.fixture
-def browser(chromium_executable, tmp_path):
-    from cdp import Browser
-
-    profile = tmp_path / "profile"
-    profile.mkdir()
-    with Browser(chromium_executable, profile) as b:  # closing kills its process group
-        yield b
 
 
 def test_page_plays_in_headless_chromium(recorded_ds, tmp_path, browser):
