@@ -9,8 +9,7 @@ One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
 imported on first use, so that ``import metrosync`` stays quick.
 """
 
-__version__ = "0.1.0"
-
+from ._version import __version__
 from .ensemble import Ensemble, build_ensemble  # noqa: E402
 from .errors import MetrosyncError, OverturnWarning, ParameterError  # noqa: E402
 from .lightgate import analyze  # noqa: E402

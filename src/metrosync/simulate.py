@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from . import __version__
+from ._version import __version__
 from .ensemble import Ensemble, build_ensemble, check_time_step
 from .errors import ParameterError
 from .integrators import INTEGRATORS

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .. import __version__
+from .._version import __version__
 from ..errors import AnalysisError, ChannelCountError, ParameterError
 from ..observables.order import equilibrium_order
 from . import phases as ph

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import xarray as xr
 
-from .. import __version__
 from .._files import write_netcdf
+from .._version import __version__
 from ..errors import ParameterError
 from .claims import Verdict, all_verdicts
 from .consistency import consistency_table

@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .. import __version__
 from .._files import write_netcdf
+from .._version import __version__
 from ..progress import progress_bar
 from ..simulate import simulate
 from .assemble import assemble, reduce_ensemble, reduce_z

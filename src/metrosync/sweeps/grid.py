@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..errors import ParameterError, describe
 from ..model import MetronomeDesign, Platform, get_preset
 
