@@ -31,10 +31,11 @@ from .errors import ParameterError
 from .integrators import INTEGRATORS
 from .integrators import reference as numpy_backend
 from .integrators import verlet as numba_backend
-from .integrators._state import STATUS_MEANINGS, Records, StepState, records_of
+from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
 from .progress import progress_bar
+from .status import STATUS_MEANINGS
 
 BACKENDS = {"numba": numba_backend, "numpy": numpy_backend, "gpu": None}  # gpu: imported on use
 #: Oscillator-steps per chunk between progress updates.

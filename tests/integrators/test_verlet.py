@@ -8,7 +8,8 @@ import pytest
 
 from metrosync import build_ensemble, get_preset, simulate
 from metrosync.integrators import reference, verlet
-from metrosync.integrators._state import STATUS_DIVERGED, STATUS_OVERTURNED, StepState
+from metrosync.integrators._state import StepState
+from metrosync.status import STATUS_DIVERGED, STATUS_OVERTURNED
 
 
 def run_backend(backend, ensemble, steps, *, dt=0.01, record_every=10, chunks=1):

@@ -5,8 +5,8 @@ import pytest
 import xarray as xr
 
 from metrosync import sweep
+from metrosync.status import STATUS_ABSENT, STATUS_FAILED
 from metrosync.sweeps import Grid, PointStore, merge
-from metrosync.sweeps.store import STATUS_ABSENT, STATUS_FAILED
 
 TINY = {"runs": 3, "duration": 5.0, "sigma": 0.5}
 

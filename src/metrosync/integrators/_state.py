@@ -14,13 +14,7 @@ import numpy as np
 
 from ..equations import SystemArrays, accelerations
 from ..observables.mechanics import platform_momentum
-
-# Status bits of a run (CF-style flag masks in the output file).
-STATUS_OK = 0
-STATUS_OVERTURNED = 1  # some |θ_i| passed `overturn_angle` (default π/2)
-STATUS_DIVERGED = 2  # a non-finite value appeared; the run was stopped there
-STATUS_MEANINGS = {STATUS_OVERTURNED: "overturned", STATUS_DIVERGED: "diverged"}
-
+from ..status import STATUS_DIVERGED, STATUS_OK
 
 #: The arrays every fixed-step kernel takes, by name and in order: state (B, N) and (B,),
 #: constants of `SystemArrays`, then records and trajectories (after the step settings).

@@ -22,7 +22,8 @@ from scipy.optimize import brentq
 
 from ..equations import SystemArrays, accelerations
 from ..observables.order import analytic_phase, crossing_order, order_parameter
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED, Records
+from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
+from ._state import Records
 
 RTOL = 1e-11
 ATOL = 1e-12

@@ -17,8 +17,8 @@ import math
 import numba as nb
 import numpy as np
 
+from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import analytic_order, save_state, upward_crossing
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED
 from .trig import REDUCTION_LIMIT, sincos
 
 FASTMATH = {"reassoc", "contract"}

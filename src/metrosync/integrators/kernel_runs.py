@@ -16,8 +16,8 @@ import math
 import numba as nb
 import numpy as np
 
+from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import analytic_order, upward_crossing
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED
 from .trig import REDUCTION_LIMIT, sincos
 
 #: Runs per block: 8 doubles fill an AVX-512 register (two AVX2 registers).

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..equations import SystemArrays, accelerations
-from ._state import STATUS_DIVERGED, STATUS_OVERTURNED, StepState
+from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
+from ._state import StepState
 
 
 def advance_state(

@@ -24,14 +24,10 @@ import numpy as np
 import xarray as xr
 
 from .._files import write_netcdf
-from ..integrators._state import STATUS_MEANINGS
+from ..status import STATUS_ABSENT, STATUS_FAILED
+from ..status import SWEEP_FLAG_MEANINGS as FLAG_MEANINGS
 from .grid import UNITS, Grid, PointSpec
 
-#: Status of every run of a point whose simulation raised (no result).
-STATUS_FAILED = 4
-#: Status value of a run that does not exist (a point with fewer runs than the largest).
-STATUS_ABSENT = -1
-FLAG_MEANINGS = {**STATUS_MEANINGS, STATUS_FAILED: "failed"}
 #: What each parameter is, for the coordinates of a merged sweep.
 LONG_NAMES = {
     "n": "metronomes on the disk",
