@@ -11,7 +11,7 @@
   const graphics = {};
   for (const id of ["disk", "wheel", "side", "order"]) graphics[id] = $(id).getContext("2d");
 
-  let playing = false, last = null, frames = 0, fps = 0, fpsFrames = 0, fpsSince = null;
+  let playing = false, last = null, clock = 0, frames = 0, fps = 0, fpsFrames = 0, fpsSince = null;
   let achieved = 0, achievedSim = 0, achievedWall = 0;
 
   // Sliders over several decades are logarithmic; position 0 may stand for zero.
@@ -105,11 +105,13 @@
   $("restart").addEventListener("click", () => {
     session.restart(Math.floor(Math.random() * 4294967296));
     last = null;
+    clock = 0;
   });
 
   function setPlaying(on) {
     playing = on;
     last = null;
+    clock = session.t;
     $("play").textContent = on ? "Pause" : "Play";
     if (on) clicks.start();
   }
@@ -155,12 +157,16 @@
       // A long pause (a hidden tab) must not be caught up all at once.
       const wall = last === null ? 0 : Math.min(now - last, 100) / 1000;
       last = now;
-      const before = session.t, target = before + wall * speed;
+      // `clock` is where simulated time should be; steps follow it whole, so that no
+      // fraction of a step is lost or gained from frame to frame.
+      const before = session.t;
+      clock = Math.max(clock, before) + wall * speed;
       const budget = performance.now() + 12;
       const chunk = Math.max(1, Math.ceil(0.02 / session.dt));
       let ticks = [];
-      while (session.t + 0.5 * session.dt < target && performance.now() < budget) {
-        const steps = Math.min(chunk, Math.round((target - session.t) / session.dt));
+      while (session.t + session.dt <= clock + 1e-9) {
+        if (performance.now() > budget) { clock = session.t; break; }  // behind: drop it
+        const steps = Math.min(chunk, Math.floor((clock - session.t) / session.dt + 1e-9));
         session.advance(Math.max(1, steps));
         ticks = ticks.concat(session.ticks);
         if (session.state.status & Physics.STATUS_DIVERGED) break;

@@ -54,7 +54,7 @@ const View = (function () {
     const w = g.canvas.width, h = g.canvas.height, n = session.state.n;
     const c = session.constants, k = Math.min(count, n), cell = w / k;
     const top = 1.15 * Math.max(...Array.from(session.system.l2), c.l1) + 0.01;
-    const scale = 0.62 * h / (top + c.l1);
+    const scale = 0.55 * h / (top + c.l1);
     clear(g);
     for (let j = 0; j < k; j++) {
       const i = Math.floor(j * n / k), th = session.state.theta[i];
