@@ -271,7 +271,16 @@ def test_playground_smoke(browser, tmp_path):
     wait_for(browser, "window.metrosync.session.t > 90")
     r_free = browser.evaluate("window.metrosync.r")
     assert r_start < 0.7 and r_free > 0.95, (r_start, r_free)
-    assert browser.evaluate("window.metrosync.clicks.scheduled") > 0  # every tick was heard
+    # Every tick is a click (the audio starts with the press of Play, before any tick).
+    ticks, heard = browser.evaluate(
+        "[window.metrosync.session.tickCount, window.metrosync.clicks.scheduled]"
+    )
+    assert ticks > 7 * 2 * 90 and heard == ticks
+    set_control(browser, "mute", True)
+    heard = browser.evaluate("window.metrosync.clicks.scheduled")
+    browser.pump(0.3)
+    assert browser.evaluate("window.metrosync.clicks.scheduled") == heard
+    set_control(browser, "mute", False)
     # Held, from new random phases: no coupling, so r stays where it starts. (It wobbles
     # as the swings settle from the small-angle start amplitude: in 200 runs of
     # `simulate` with the disk held, by 0.056 at most.)
@@ -350,3 +359,33 @@ def test_every_asset_ships_in_the_wheel():
     assert {*SCRIPTS, "page.html"} <= {p.name for p in ASSETS.iterdir()}
     for name in files:
         assert any(fnmatch.fnmatch(name, g) for g in globs), name
+
+
+# -- what the README's "In the classroom" promises, in the model the page runs --------
+
+
+def test_raising_sigma_breaks_the_synchrony():
+    """N = 7 at 192 BPM: r_eq ≈ 0.95 at σ = 0.5 BPM, below 0.6 at σ = 2 BPM."""
+    runs = {s: metrosync.simulate(7, 192.0, sigma_bpm=s, runs=20, duration=300.0, seed=1)
+            for s in (0.5, 2.0)}  # fmt: skip
+    r_eq = {s: float(ds.r_eq.mean()) for s, ds in runs.items()}
+    assert r_eq[0.5] > 0.9 and r_eq[2.0] < 0.6, r_eq
+
+
+@pytest.mark.parametrize(("offset", "together"), [(1.0, True), (8.0, False)])
+def test_two_groups_lock_within_and_together_only_when_close(offset, together):
+    """Every other metronome `offset` BPM higher (the page's "2 groups"): each group
+    falls into step; the two lock together at 1 BPM apart but not at 8."""
+    freqs = 192.0 + offset * (np.arange(10) % 2)
+    ds = metrosync.simulate(None, None, frequencies_bpm=freqs, duration=300.0, seed=2,
+                            record_every=10, trajectories=True).isel(run=0)  # fmt: skip
+    last = slice(-500, None)  # the final 50 s
+    theta, theta_dot = ds.theta.values[last], ds.theta_dot.values[last]
+    unit = np.exp(1j * np.arctan2(-theta_dot / (np.pi * freqs / 60), theta))
+    within = [np.abs(unit[:, g::2].mean(axis=1)).min() for g in (0, 1)]
+    overall = np.abs(unit.mean(axis=1))
+    assert min(within) > 0.98, within
+    if together:
+        assert overall.min() > 0.9
+    else:  # the groups drift past each other: r swings between them
+        assert overall.min() < 0.3 and overall.max() > 0.9

@@ -40,7 +40,8 @@ class Clicks {
   // ticks: [i, t] with t in simulated seconds between tFrom and the present; they are
   // played spread over the next frame, at the speed the simulation ran.
   play(ticks, tFrom, speed, n, phi) {
-    if (!this.context || this.muted || this.context.state !== "running" || !ticks.length) return;
+    // A context still starting ("suspended") queues the clicks and plays them once it runs.
+    if (!this.context || this.muted || this.context.state === "closed" || !ticks.length) return;
     const ctx = this.context, now = ctx.currentTime + this.lead;
     // At high speed and large N there are thousands of ticks a second; play a sample
     // of them, louder, rather than flood the audio thread.

@@ -41,6 +41,7 @@ class Session {
     this.markers = [];     // [t, label]: when a setting changed
     this.lastUp = [];      // per metronome: the last two upward crossing times
     this.ticks = [];       // crossings of the last advance: [i, t]
+    this.tickCount = 0;    // crossings since the page opened
     this.usePreset(s.preset, false);
     this.restart(this.seed);
   }
@@ -145,6 +146,7 @@ class Session {
     this.ticks.length = 0;
     const onTick = (i, t, up) => {
       this.ticks.push([i, t]);
+      this.tickCount++;
       if (up) { this.lastUp[i][0] = this.lastUp[i][1]; this.lastUp[i][1] = t; }
     };
     for (let k = 0; k < steps; k++) {
