@@ -323,6 +323,22 @@ def test_controls_take_effect_and_continue_from_the_state(browser, tmp_path):
     assert browser.console_errors() == []
 
 
+def test_locked_metronomes_tick_at_one_rate(browser, tmp_path):
+    """σ = 0.5 BPM, N = 7: once locked, the measured tick rates agree far better than
+    the natural frequencies do; on a held disk they keep their spread."""
+    open_offline(browser, write_playground(tmp_path / "play.html", n=7, sigma_bpm=0.5, seed=1))
+    session = "window.metrosync.session"
+    spreads = {}
+    for held in (False, True):
+        set_control(browser, "hold", held)
+        browser.evaluate(f"{session}.restart(7)")
+        browser.evaluate(f"{session}.advance(20000)")  # 200 s
+        rates = browser.evaluate(f"{session}.tickRates()")
+        assert rates["count"] == 7 and 170 < rates["mean"] < 200
+        spreads[held] = rates["spread"] / browser.evaluate(f"{session}.naturalSpread()")
+    assert spreads[False] < 0.5 and spreads[True] > 0.7, spreads
+
+
 def test_frame_rate_with_100_metronomes_at_10x(browser, tmp_path, record_property, capsys):
     """The page's own frame counter at N = 100, 10× real time (a figure, not a pass/fail)."""
     open_offline(browser, write_playground(tmp_path / "play.html", n=100, sigma_bpm=0.5))

@@ -67,13 +67,14 @@ const Physics = (function () {
   }
 
   // Solved equations of motion, eqs. (eqm1)-(eqm2); writes θ̈ into thdd, returns φ̈.
-  // cos θ is left in cosOut for the momentum that follows.
-  function accelerations(sys, th, thd, phd, kick, thdd, cosOut) {
+  // cos θ is left in cosOut for the momentum that follows; sinOut is scratch.
+  function accelerations(sys, th, thd, phd, kick, thdd, cosOut, sinOut) {
     const n = sys.n, radius = sys.radius;
     let sum1 = 0.0, sumKick = 0.0, sumAbc = 0.0, sumD = 0.0;
     for (let i = 0; i < n; i++) {
       const s = Math.sin(th[i]), co = Math.cos(th[i]);
       cosOut[i] = co;
+      sinOut[i] = s;
       const mhOverI = sys.mh[i] / sys.inertia[i];
       const a = radius * mhOverI * sys.mgh[i] * s * co;
       const b = radius * mhOverI * sys.cTheta[i] * thd[i] * co;
@@ -86,8 +87,7 @@ const Physics = (function () {
     }
     const phdd = (radius * sum1 - sys.cPhi * phd - sumKick + sumAbc) / (sys.totalInertia - sumD);
     for (let i = 0; i < n; i++) {
-      const s = Math.sin(th[i]);
-      thdd[i] = (kick[i] - radius * sys.mh[i] * phdd * cosOut[i] - sys.mgh[i] * s
+      thdd[i] = (kick[i] - radius * sys.mh[i] * phdd * cosOut[i] - sys.mgh[i] * sinOut[i]
         - sys.cTheta[i] * thd[i]) / sys.inertia[i];
     }
     return phdd;
@@ -112,9 +112,10 @@ const Physics = (function () {
       status: 0, step: 0,
       // scratch
       thNew: new Float64Array(n), velPred: new Float64Array(n), kick: new Float64Array(n),
-      thdd: new Float64Array(n), cos: new Float64Array(n),
+      thdd: new Float64Array(n), cos: new Float64Array(n), sin: new Float64Array(n),
     };
-    st.accPhi = accelerations(sys, st.theta, st.thetaDot, st.phiDot, st.kick, st.accTheta, st.cos);
+    st.accPhi = accelerations(sys, st.theta, st.thetaDot, st.phiDot, st.kick, st.accTheta, st.cos,
+      st.sin);
     st.pPhi = momentum(sys, st.theta, st.thetaDot, st.phiDot);
     st.forcePhi = -sys.cPhi * st.phiDot;
     if (!Number.isFinite(st.accPhi)) st.status |= STATUS_DIVERGED;
@@ -139,7 +140,7 @@ const Physics = (function () {
       if (Math.abs(thNew[i]) > overturnAngle) overturned = true;
     }
     if (overturned) st.status |= STATUS_OVERTURNED;
-    const phdd = accelerations(sys, thNew, vel, phdPred, kick, st.thdd, st.cos);
+    const phdd = accelerations(sys, thNew, vel, phdPred, kick, st.thdd, st.cos, st.sin);
     if (!Number.isFinite(phdd)) {
       st.status |= STATUS_DIVERGED;
       return false;

@@ -39,7 +39,8 @@ class Session {
     this.history = [];     // [t, r] every recordInterval of simulated time
     this.recordInterval = 0.1;
     this.markers = [];     // [t, label]: when a setting changed
-    this.lastUp = [];      // per metronome: the last two upward crossing times
+    this.lastUp = [];      // per metronome: its last few upward crossing times
+    this.ratePeriods = 4;  // tick rates average over this many periods
     this.ticks = [];       // crossings of the last advance: [i, t]
     this.tickCount = 0;    // crossings since the page opened
     this.usePreset(s.preset, false);
@@ -107,7 +108,7 @@ class Session {
     this.t = 0.0;
     this.history = [];
     this.markers = [];
-    this.lastUp = Array.from({ length: n }, () => [NaN, NaN]);
+    this.lastUp = Array.from({ length: n }, () => []);
     this.record();
   }
 
@@ -132,7 +133,7 @@ class Session {
         thetaDot.push(-amp * this.system.omega[i] * Math.sin(p));
       }
     }
-    while (this.lastUp.length < n) this.lastUp.push([NaN, NaN]);
+    while (this.lastUp.length < n) this.lastUp.push([]);
     this.lastUp.length = n;
     const st = Physics.startState(this.system, theta, thetaDot, old.phi, old.phiDot);
     st.step = old.step;
@@ -147,7 +148,11 @@ class Session {
     const onTick = (i, t, up) => {
       this.ticks.push([i, t]);
       this.tickCount++;
-      if (up) { this.lastUp[i][0] = this.lastUp[i][1]; this.lastUp[i][1] = t; }
+      if (up) {
+        const times = this.lastUp[i];
+        times.push(t);
+        if (times.length > this.ratePeriods + 1) times.shift();
+      }
     };
     for (let k = 0; k < steps; k++) {
       if (!Physics.step(this.state, this.system, this.dt, this.overturnAngle, onTick)) break;
@@ -163,11 +168,14 @@ class Session {
     if (this.history.length > 6000) this.history.splice(0, this.history.length - 6000);
   }
 
-  // Tick rates (ticks per minute, two per period) from the last full period of each
-  // metronome that has one; their mean and standard deviation.
+  // Tick rates (ticks per minute, two per period) over the last few full periods of
+  // each metronome that has one; their mean and standard deviation.
   tickRates() {
     const rates = [];
-    for (const [a, b] of this.lastUp) if (b > a) rates.push(120.0 / (b - a));
+    for (const times of this.lastUp) {
+      const k = times.length - 1;
+      if (k >= 1) rates.push(120.0 * k / (times[k] - times[0]));
+    }
     if (!rates.length) return { count: 0, mean: NaN, spread: NaN };
     const mean = rates.reduce((s, v) => s + v, 0) / rates.length;
     const variance = rates.reduce((s, v) => s + (v - mean) * (v - mean), 0) / rates.length;
