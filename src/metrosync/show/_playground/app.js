@@ -67,6 +67,7 @@
     $("drive-out").textContent = sci(s.drive);
     $("cphi-out").textContent = sci(s.cPhi);
     $("inertia-out").textContent = s.j.toPrecision(3);
+    if (s.jLaw) inertia.set(s.j);  // the law moves J with N
   }
 
   for (const name of Object.keys(config.presets)) {
@@ -117,7 +118,9 @@
   }
   $("play").addEventListener("click", () => setPlaying(!playing));
   document.addEventListener("keydown", (e) => {
-    if (e.code === "Space" && !["SELECT", "INPUT", "BUTTON"].includes(e.target.tagName)) {
+    // Buttons, boxes and menus answer the space bar themselves; sliders do not.
+    const own = ["SELECT", "BUTTON"].includes(e.target.tagName) || e.target.type === "checkbox";
+    if (e.code === "Space" && !own) {
       e.preventDefault();
       setPlaying(!playing);
     }
