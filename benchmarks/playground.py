@@ -2,8 +2,10 @@
 
 For each (N, speed) it writes the page, presses Play, lets it warm up for a second,
 then counts the frames the page drew (``window.metrosync.frames``) and the simulated
-time it covered over ``--seconds`` of wall time. Headless Chromium draws at most 60
-frames a second; software rendering (no GPU) is what a projector's laptop may have.
+time it covered over ``--seconds`` of wall time; before that, the time one step of
+the simulation takes in the browser (2000 steps, timed by the page). Headless
+Chromium draws at most 60 frames a second; software rendering (no GPU) is what a
+projector's laptop may have.
 
     python benchmarks/playground.py                          # N = 7, 100 at 1x, 10x, 50x
     python benchmarks/playground.py --cases 100x10 --seconds 10
@@ -57,6 +59,10 @@ def set_control(browser: Browser, element_id: str, value) -> None:
 
 def measure(browser: Browser, folder: Path, n: int, speed: int, seconds: float):
     open_page(browser, write_playground(folder / f"play-{n}-{speed}.html", n=n, sigma_bpm=0.5))
+    step_us = browser.evaluate(
+        "(() => { const t = performance.now(); window.metrosync.session.advance(2000);"
+        " return (performance.now() - t) * 1000 / 2000; })()"
+    )
     press(browser, "play")
     set_control(browser, "speed", speed)
     browser.pump(1.0)
@@ -65,7 +71,7 @@ def measure(browser: Browser, folder: Path, n: int, speed: int, seconds: float):
     browser.pump(seconds)
     f1, t1, w1 = browser.evaluate(probe)
     wall = (w1 - w0) / 1000
-    return (f1 - f0) / wall, (t1 - t0) / wall
+    return (f1 - f0) / wall, (t1 - t0) / wall, step_us
 
 
 def lesson(browser: Browser, folder: Path, out: Path) -> None:
@@ -106,12 +112,12 @@ def main() -> int:
             if args.screenshot is not None:
                 lesson(browser, folder, args.screenshot)
                 return 0
-            print(f"{'N':>4} {'speed':>6} {'frames/s':>9} {'simulated':>10}   "
+            print(f"{'N':>4} {'speed':>6} {'frames/s':>9} {'simulated':>10} {'us/step':>8}   "
                   f"({time.strftime('%Y-%m-%d')}, headless Chromium)")  # fmt: skip
             for case in args.cases:
                 n, speed = (int(x) for x in case.lower().split("x"))
-                fps, achieved = measure(browser, folder, n, speed, args.seconds)
-                print(f"{n:>4} {speed:>5}x {fps:>9.1f} {achieved:>9.1f}x")
+                fps, achieved, step_us = measure(browser, folder, n, speed, args.seconds)
+                print(f"{n:>4} {speed:>5}x {fps:>9.1f} {achieved:>9.1f}x {step_us:>8.1f}")
     return 0
 
 
