@@ -101,10 +101,13 @@ const View = (function () {
     g.fillText(end.toFixed(0) + " s", w - pad.r - 44, h - 6);
     g.fillText("r(t)", w / 2 - 10, h - 6);
     g.strokeStyle = "#bbb"; g.fillStyle = "#777";
+    let previous = -Infinity, row = 0;
     for (const [t, label] of session.markers) {
       if (t < start) continue;
+      row = x(t) - previous < 70 ? (row + 1) % 8 : 0;  // close labels step down
+      previous = x(t);
       g.beginPath(); g.moveTo(x(t), pad.t); g.lineTo(x(t), h - pad.b); g.stroke();
-      g.fillText(label, x(t) + 3, pad.t + 12);
+      g.fillText(label, x(t) + 3, pad.t + 12 + 12 * row);
     }
     const hist = session.history;
     let first = hist.length;
