@@ -5,7 +5,8 @@ Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
 `sweep` (parameter grids), `reproduce` (the paper's studies), and `animate`,
-`write_wav`, `write_page`, `plot_run` (seeing and hearing a run). The last group is
+`write_wav`, `write_page`, `plot_run` (seeing and hearing a run), and
+`write_playground` (the model live in a browser). These last five are
 imported on first use, so that ``import metrosync`` stays quick.
 """
 
@@ -30,6 +31,7 @@ _LAZY = {
     "animate": "show",
     "plot_run": "show",
     "write_page": "show",
+    "write_playground": "show",
     "write_wav": "show",
     "sweep": "sweeps",
     "reproduce": "paper",

@@ -1,11 +1,13 @@
 """See and hear a simulated run: animation, click track, interactive page, plots.
 
 Every view reads the trajectories that `metrosync.simulate(..., trajectories=True)`
-recorded, through `RecordedRun`; none of them simulates again.
+recorded, through `RecordedRun`; none of them simulates again. The exception is
+`write_playground`, a page that runs the model live in the browser.
 """
 
 from .animation import animate
 from .page import write_page
+from .playground import write_playground
 from .plots import plot_run
 from .recording import NoTrajectoriesError, RecordedRun
 from .sound import ClickTrack, click_track, crossing_times, write_wav
@@ -19,5 +21,6 @@ __all__ = [
     "crossing_times",
     "plot_run",
     "write_page",
+    "write_playground",
     "write_wav",
 ]

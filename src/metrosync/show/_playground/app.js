@@ -1,0 +1,208 @@
+// The page: controls wired to the live Session, the animation loop, the numbers, and
+// window.metrosync (run, the frame counter, the session) for scripts and tests.
+"use strict";
+
+(function () {
+  const config = JSON.parse(document.getElementById("config").textContent);
+  const limits = config.limits;
+  const $ = (id) => document.getElementById(id);
+  const session = new Session(config);
+  const clicks = new Clicks();
+  const graphics = {};
+  for (const id of ["disk", "wheel", "side", "order"]) graphics[id] = $(id).getContext("2d");
+
+  let playing = false, last = null, clock = 0, frames = 0, fps = 0, fpsFrames = 0, fpsSince = null;
+  let achieved = 0, achievedSim = 0, achievedWall = 0;
+
+  // Sliders over several decades are logarithmic; position 0 may stand for zero.
+  function logSlider(id, [low, high], allowZero) {
+    const el = $(id), top = Number(el.max);
+    return {
+      get() {
+        const u = Number(el.value);
+        if (allowZero && u === 0) return 0;
+        const frac = allowZero ? (u - 1) / (top - 1) : u / top;
+        return low * Math.pow(high / low, frac);
+      },
+      set(value) {
+        if (allowZero && value <= 0) { el.value = 0; return; }
+        const frac = Math.log(Math.min(high, Math.max(low, value)) / low) / Math.log(high / low);
+        el.value = Math.round(allowZero ? 1 + frac * (top - 1) : frac * top);
+      },
+    };
+  }
+  const drive = logSlider("drive", limits.drive, true);
+  const cphi = logSlider("cphi", limits.c_phi, true);
+  const inertia = logSlider("inertia", limits.inertia, false);
+  const sci = (v) => (v === 0 ? "0" : v.toExponential(1));
+
+  function setRange(id, [low, high], value) {
+    const el = $(id);
+    el.min = low; el.max = high; el.value = value;
+  }
+
+  // Put the session's settings into the controls (at load, and after a preset change).
+  function showSettings() {
+    const s = session.settings;
+    $("preset").value = s.preset;
+    setRange("speed", limits.speed, $("speed").value);
+    setRange("n", limits.n, s.n);
+    setRange("bpm", session.preset.bpm_range, s.bpm);
+    setRange("sigma", limits.sigma_bpm, s.sigma);
+    setRange("offset", limits.group_offset_bpm, s.offset);
+    $("groups").checked = s.groups === 2;
+    $("hold").checked = s.hold;
+    $("jlaw").checked = s.jLaw;
+    drive.set(s.drive); cphi.set(s.cPhi); inertia.set(s.j);
+    showValues();
+  }
+
+  function showValues() {
+    const s = session.settings;
+    $("speed-out").textContent = $("speed").value + "×";
+    $("n-out").textContent = s.n;
+    $("bpm-out").textContent = s.bpm.toFixed(1);
+    $("sigma-out").textContent = s.sigma.toFixed(2);
+    $("offset-out").textContent = (s.offset >= 0 ? "+" : "") + s.offset.toFixed(1);
+    $("drive-out").textContent = sci(s.drive);
+    $("cphi-out").textContent = sci(s.cPhi);
+    $("inertia-out").textContent = s.j.toPrecision(3);
+    if (s.jLaw) inertia.set(s.j);  // the law moves J with N
+  }
+
+  for (const name of Object.keys(config.presets)) {
+    const option = document.createElement("option");
+    option.value = name;
+    option.textContent = name;
+    option.title = config.presets[name].description;
+    $("preset").appendChild(option);
+  }
+
+  // Every control changes a setting, then the run continues from where it is.
+  function onChange(id, apply, label) {
+    $(id).addEventListener("input", () => {
+      apply($(id));
+      session.rebuild(label());
+      showValues();
+    });
+  }
+  const s = session.settings;
+  onChange("n", (el) => { s.n = Number(el.value); }, () => "N=" + s.n);
+  onChange("bpm", (el) => { s.bpm = Number(el.value); }, () => s.bpm.toFixed(1) + " BPM");
+  onChange("sigma", (el) => { s.sigma = Number(el.value); }, () => "σ=" + s.sigma.toFixed(2));
+  onChange("groups", (el) => { s.groups = el.checked ? 2 : 1; },
+    () => (s.groups === 2 ? "2 groups" : "1 group"));
+  onChange("offset", (el) => { s.offset = Number(el.value); },
+    () => "Δ=" + s.offset.toFixed(1));
+  onChange("drive", () => { s.drive = drive.get(); }, () => "M=" + sci(s.drive));
+  onChange("cphi", () => { s.cPhi = cphi.get(); }, () => "cφ=" + sci(s.cPhi));
+  onChange("inertia", () => { s.j = inertia.get(); s.jLaw = false; $("jlaw").checked = false; },
+    () => "J=" + s.j.toPrecision(2));
+  onChange("jlaw", (el) => { s.jLaw = el.checked; }, () => (s.jLaw ? "J(N)" : "J fixed"));
+  onChange("hold", (el) => { s.hold = el.checked; }, () => (s.hold ? "held" : "free"));
+  $("preset").addEventListener("input", () => { session.usePreset($("preset").value); showSettings(); });
+  $("speed").addEventListener("input", showValues);
+  $("mute").addEventListener("input", () => { clicks.muted = $("mute").checked; });
+  $("restart").addEventListener("click", () => {
+    session.restart(Math.floor(Math.random() * 4294967296));
+    last = null;
+    clock = 0;
+  });
+
+  function setPlaying(on) {
+    playing = on;
+    last = null;
+    clock = session.t;
+    $("play").textContent = on ? "Pause" : "Play";
+    if (on) clicks.start();
+  }
+  $("play").addEventListener("click", () => setPlaying(!playing));
+  document.addEventListener("keydown", (e) => {
+    // Buttons, boxes and menus answer the space bar themselves; sliders do not.
+    const own = ["SELECT", "BUTTON"].includes(e.target.tagName) || e.target.type === "checkbox";
+    if (e.code === "Space" && !own) {
+      e.preventDefault();
+      setPlaying(!playing);
+    }
+  });
+
+  const phases = new Float64Array(limits.n[1]);
+  function showNumbers(o) {
+    const rates = session.tickRates(), n = session.state.n, st = session.state;
+    $("numbers").innerHTML =
+      "<span>r</span><b id='r-value'>" + o.r.toFixed(3) + "</b>"
+      + "<span>time</span><span>" + session.t.toFixed(1) + " s</span>"
+      + "<span>tick rate</span><span>" + (rates.count ? rates.mean.toFixed(2) + " /min" : "–")
+      + "</span><span>spread of rates</span><span>"
+      + (rates.count ? rates.spread.toFixed(3) + " /min" : "–") + "</span>"
+      + "<span>natural spread</span><span>" + session.naturalSpread().toFixed(3) + " BPM</span>"
+      + "<span>running at</span><span>" + (playing ? achieved.toFixed(1) + "×" : "paused")
+      + "</span><span>frames/s</span><span id='fps'>" + fps.toFixed(0) + "</span>";
+    const notes = [];
+    if (st.status & Physics.STATUS_DIVERGED) notes.push("the run diverged: press Restart.");
+    if (st.status & Physics.STATUS_OVERTURNED) notes.push("a pendulum swung past the horizontal.");
+    if (session.clipped) notes.push(session.clipped + " of " + n + " frequencies clipped to the "
+      + "tunable range.");
+    $("status").textContent = notes.join(" ");
+  }
+
+  function frame(now) {
+    frames++;
+    fpsFrames++;
+    if (fpsSince === null) fpsSince = now;
+    if (now - fpsSince >= 1000) {
+      fps = fpsFrames * 1000 / (now - fpsSince);
+      fpsFrames = 0;
+      fpsSince = now;
+    }
+    if (playing) {
+      const speed = Number($("speed").value);
+      // A long pause (a hidden tab) must not be caught up all at once.
+      const wall = last === null ? 0 : Math.min(now - last, 100) / 1000;
+      last = now;
+      // `clock` is where simulated time should be; steps follow it whole, so that no
+      // fraction of a step is lost or gained from frame to frame.
+      const before = session.t;
+      clock = Math.max(clock, before) + wall * speed;
+      const budget = performance.now() + 12;
+      const chunk = Math.max(1, Math.ceil(0.02 / session.dt));
+      let ticks = [];
+      while (session.t + session.dt <= clock + 1e-9) {
+        if (performance.now() > budget) { clock = session.t; break; }  // behind: drop it
+        const steps = Math.min(chunk, Math.floor((clock - session.t) / session.dt + 1e-9));
+        session.advance(Math.max(1, steps));
+        ticks = ticks.concat(session.ticks);
+        if (session.state.status & Physics.STATUS_DIVERGED) break;
+      }
+      clicks.play(ticks, before, speed, session.state.n, session.state.phi);
+      achievedSim += session.t - before;
+      achievedWall += wall;
+      if (achievedWall >= 0.5) {
+        achieved = achievedSim / achievedWall;
+        achievedSim = 0; achievedWall = 0;
+      }
+    }
+    const o = Physics.order(session.state, session.system, phases);
+    View.disk(graphics.disk, session, phases, session.settings.hold);
+    View.wheel(graphics.wheel, phases, session.state.n, o.r, o.psi);
+    View.side(graphics.side, session, phases, 4);
+    const speed = Number($("speed").value);
+    View.order(graphics.order, session, speed <= 5 ? 60 : 12 * speed);
+    showNumbers(o);
+    requestAnimationFrame(frame);
+  }
+
+  showSettings();
+  window.metrosync = {
+    version: config.version,
+    config,
+    session,
+    clicks,
+    run: (params, steps) => runTrajectories(config, params, steps),
+    get frames() { return frames; },
+    get fps() { return fps; },
+    get playing() { return playing; },
+    get r() { return Physics.order(session.state, session.system).r; },
+  };
+  requestAnimationFrame(frame);
+})();

@@ -1,0 +1,197 @@
+"""A playground: the model running live in a browser, in one self-contained HTML file.
+
+Unlike `write_page`, which plays back a run computed beforehand, the playground
+simulates while it is watched. Its JavaScript (``_playground/*.js``, package data)
+is a twin of the NumPy reference integrator: the same equations, eqs. (eqm1)–(eqm2),
+the same velocity-Verlet-type step with the ±M/dt escapement, the same tuning of L2
+from a BPM. Every number of the model (each preset's metronome design and platform,
+the tunable BPM range, the time step) comes from this package as JSON embedded in
+the page; the JavaScript holds formulas only. ``window.metrosync.run(params, steps)``
+returns trajectories, so that tests can compare the browser's physics with
+`metrosync.simulate(..., backend="numpy")`.
+
+The page loads nothing: CSS and scripts are inline, the sound is synthesised, and it
+opens from the file system with no server and no network. Controls: N, nominal BPM,
+σ, two frequency groups, the drive M, the disk's inertia and friction, holding the
+disk, restart, pause and speed (1×–50×). The control ranges are `LIMITS`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from collections.abc import Mapping
+from importlib import resources
+from pathlib import Path
+
+from .._files import write_text
+from .._version import __version__
+from ..errors import ParameterError, describe
+from ..model import PRESETS, ModelParameters, get_preset
+
+#: The page's scripts, in the order they run (each uses those before it).
+SCRIPTS = ("physics.js", "session.js", "view.js", "audio.js", "app.js")
+
+#: Ranges of the page's controls: N, σ (BPM), speed (× real time), the second group's
+#: offset (BPM), and the log-scale sliders for M (N m s), c_φ (kg m²/s) and J (kg m²).
+#: M and c_φ also reach 0.
+LIMITS = {
+    "n": (1, 100),
+    "sigma_bpm": (0.0, 10.0),
+    "speed": (1, 50),
+    "group_offset_bpm": (-20.0, 20.0),
+    "drive": (1e-6, 1e-3),
+    "c_phi": (1e-7, 1e-1),
+    "inertia": (1e-3, 1e2),
+}
+#: The finest time step offered: finer ones cannot keep up with 50× real time at N = 100.
+MIN_DT = 1e-3
+#: A period must span at least this many steps (as `metrosync.ensemble.check_time_step`).
+MIN_STEPS_PER_PERIOD = 10
+#: |θ| beyond which the page reports an overturned pendulum, rad (as `simulate`).
+OVERTURN_ANGLE = math.pi / 2
+
+
+def preset_data(params: ModelParameters) -> dict:
+    """A preset as the page uses it: its constants by the package's names (SI units),
+    the tunable BPM range, and its description. A pinned disk (J = ∞) is sent as the
+    J(N) law plus ``held``, since JSON has no infinity."""
+    constants = {**vars(params.metronome), **vars(params.platform)}
+    constants["l2_bounds"] = list(constants["l2_bounds"])
+    held = params.platform.rigid
+    if held:
+        constants["inertia"] = None
+    low, high = params.metronome.bpm_range()
+    return {
+        "description": params.description,
+        "constants": constants,
+        "bpm_range": [low, high],
+        "held": held,
+    }
+
+
+def playground_config(
+    *,
+    preset: str | ModelParameters = "default",
+    changes: Mapping[str, float] | None = None,
+    n: int = 7,
+    bpm: float = 192.0,
+    sigma_bpm: float = 0.0,
+    dt: float = 0.01,
+    seed: int = 0,
+) -> dict:
+    """The JSON-ready configuration the page embeds (see the module docstring).
+
+    Parameters
+    ----------
+    preset : the preset the page starts with (every named preset is offered as well).
+    changes : model parameters changed by name, as in `simulate`.
+    n, bpm, sigma_bpm : the start's number of metronomes, nominal BPM and spread.
+    dt : the time step, s.
+    seed : seed of the first start's random phases and frequencies (Restart draws anew).
+    """
+    params = get_preset(preset, warn=False)
+    if changes:
+        params = params.with_changes(**changes)
+    _check_ranges(params)
+    get_preset(params)  # warns if its pendulums overturn, once the values are known to fit
+    presets = {name: preset_data(get_preset(name, warn=False)) for name in PRESETS}
+    presets[params.name] = preset_data(params)
+    start = presets[params.name]
+    n = _check_count(n)
+    low, high = start["bpm_range"]
+    if not (isinstance(bpm, int | float) and math.isfinite(bpm) and low <= bpm <= high):
+        raise ParameterError(
+            f"`bpm` = {describe(bpm)} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+            f"of preset {params.name!r}; choose a BPM in range."
+        )
+    lo, hi = LIMITS["sigma_bpm"]
+    if not (isinstance(sigma_bpm, int | float) and lo <= sigma_bpm <= hi):
+        raise ParameterError(
+            f"`sigma_bpm` = {describe(sigma_bpm)} is outside the page's range [{lo:g}, {hi:g}] "
+            f"BPM; choose a spread in range."
+        )
+    # The page lets BPM go up to the top of the tunable range: dt must resolve it there.
+    finest = min(60.0 / p["bpm_range"][1] * 2 for p in presets.values()) / MIN_STEPS_PER_PERIOD
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and MIN_DT <= dt <= finest):
+        raise ParameterError(
+            f"`dt` = {describe(dt)} s is outside [{MIN_DT:g}, {finest:.4g}] s: coarser steps do "
+            f"not resolve the fastest tunable metronome ({MIN_STEPS_PER_PERIOD} steps a period), "
+            f"finer ones cannot run at 50× real time in a browser. The paper uses 0.01 s."
+        )
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
+        raise ParameterError(f"`seed` must be an integer in [0, 2**32), got {describe(seed)}.")
+    return {
+        "version": __version__,
+        "dt": float(dt),
+        "overturn_angle": OVERTURN_ANGLE,
+        "presets": presets,
+        "start": {
+            "preset": params.name,
+            "n": n,
+            "bpm": float(bpm),
+            "sigma_bpm": float(sigma_bpm),
+            "seed": seed,
+            "hold": start["held"],
+        },
+        "limits": {k: list(v) for k, v in LIMITS.items()},
+    }
+
+
+def render_playground(**options) -> str:
+    """The page's HTML text; ``options`` as for `playground_config`."""
+    config = playground_config(**options)
+    # "</" inside a script element would end it early; JSON allows "<\/" for it.
+    payload = json.dumps(config, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    script = "\n".join(_asset(name) for name in SCRIPTS)
+    values = {
+        "CONFIG": payload,
+        "SCRIPT": script,
+        "VERSION": __version__,
+        "DT": f"{config['dt']:g}",
+    }
+    # One pass, so that text in one value is never taken for another placeholder.
+    return re.sub(r"@(CONFIG|SCRIPT|VERSION|DT)@", lambda m: values[m[1]], _asset("page.html"))
+
+
+def write_playground(path: Path | str, **options) -> Path:
+    """Write the playground page to ``path`` (atomically) and return the path.
+
+    ``options``: ``preset``, ``changes``, ``n``, ``bpm``, ``sigma_bpm``, ``dt`` and
+    ``seed``, the page's starting point (see `playground_config`); every one can be
+    changed on the page.
+    """
+    return write_text(render_playground(**options), path)
+
+
+def _asset(name: str) -> str:
+    return resources.files(__package__).joinpath("_playground", name).read_text(encoding="utf-8")
+
+
+def _check_count(n) -> int:
+    lo, hi = LIMITS["n"]
+    if isinstance(n, bool) or not isinstance(n, int) or not lo <= n <= hi:
+        raise ParameterError(
+            f"`n` must be a whole number of metronomes in [{lo}, {hi}], got {describe(n)}."
+        )
+    return n
+
+
+def _check_ranges(params: ModelParameters) -> None:
+    """Refuse a parameter the page's sliders could not show (and would silently move)."""
+    if params.metronome.w2 == 0:
+        raise ParameterError(
+            "`w2` = 0: the playground tunes each metronome by its sliding weight, and there "
+            "is none; give `w2` > 0 kg."
+        )
+    values = {"drive": params.metronome.drive, "c_phi": params.platform.c_phi}
+    if params.platform.inertia is not None and not params.platform.rigid:
+        values["inertia"] = params.platform.inertia
+    for name, value in values.items():
+        lo, hi = LIMITS[name]
+        if value != 0 and not lo <= value <= hi:
+            raise ParameterError(
+                f"`{name}` = {value!r} is outside the playground's slider range "
+                f"[{lo:g}, {hi:g}]{'' if name == 'inertia' else ' (or 0)'}; choose a value in it."
+            )
