@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+import xarray as xr
 
 from metrosync.cli import build_parser, main
 
@@ -35,3 +36,30 @@ def test_one_study_end_to_end(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "claim 3:" in printed and "claim 2: not assessed" in printed
     assert (tmp_path / "REPORT.md").exists() and (tmp_path / "figures" / "fig8_bottom.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--scheduler", "foo"], "`scheduler` must be None"),
+        (["--workers", "2"], "`n_workers` (--workers) = 2 applies to scheduler='local' only"),
+        (["--scheduler", "local", "--workers", "0"], "`n_workers` (--workers) must be"),
+    ],
+)
+def test_executor_options_are_checked_before_any_work(tmp_path, capsys, options, message):
+    code = main(["reproduce", "--out", str(tmp_path / "out"), *options])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow
+def test_a_local_cluster_gives_the_in_process_numbers(tmp_path):
+    from metrosync.paper.runner import run_study
+    from metrosync.paper.studies import FIG8_BOTTOM, reduced
+
+    study = reduced(FIG8_BOTTOM, runs=2, duration=20.0)
+    here = run_study(study, "quick", tmp_path / "here")
+    there = run_study(study, "quick", tmp_path / "there", scheduler="local", n_workers=2)
+    xr.testing.assert_identical(here.dataset.r_eq, there.dataset.r_eq)
+    assert there.cached_points == 0 and there.points == 6
