@@ -124,3 +124,30 @@ def test_long_runs_report_progress_point_by_point(tmp_path):
     run_study(SMALL, "quick", tmp_path, log=lines.append)
     assert len(lines) == 6
     assert lines[-1].startswith("  fig8_bottom: 6/6 points")
+
+
+def test_an_interrupted_study_keeps_its_points_and_resumes(tmp_path, monkeypatch):
+    from metrosync.paper.pipeline import kept_points
+    from metrosync.sweeps import executors
+
+    real, calls = executors.run_point, []
+
+    def interrupted_after_three(spec, threads=None):
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        calls.append(spec.key)
+        return real(spec, threads)
+
+    monkeypatch.setattr(executors, "run_point", interrupted_after_three)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(SMALL, "quick", tmp_path)
+    assert kept_points(tmp_path, "quick", [SMALL]) == (3, 6)
+    monkeypatch.undo()
+    resumed = run_study(SMALL, "quick", tmp_path)
+    specs = points_of(SMALL, "quick")
+    assert resumed.cached_points == 3
+    assert resumed.computed_work == sum(spec.work for spec in specs[3:])
+    assert PointStore(tmp_path).logged_keys()[:3] == calls  # nothing computed twice
+    assert len(set(PointStore(tmp_path).logged_keys())) == 6
+    fresh = run_study(SMALL, "quick", tmp_path / "fresh")
+    xr.testing.assert_identical(resumed.dataset.r_eq, fresh.dataset.r_eq)

@@ -168,7 +168,8 @@ def run_study(
         return _finish(study, mode, out, dataset, started, 0.0, 0.0, [], 0, wall)
     specs = points_of(study, mode)
     store = PointStore(out)
-    todo = [spec for spec in specs if not _finished(store, spec)]
+    loaded = {spec.key: ds for spec in specs if (ds := _stored(store, spec)) is not None}
+    todo = [spec for spec in specs if spec.key not in loaded]
     done_before = len(specs) - len(todo)
 
     finished = done_before
@@ -197,7 +198,8 @@ def run_study(
             f"with their Dask workers ({next(iter(execution.lost.values()))}); the others are "
             f"kept in {store.points}: run the same command again to compute the rest."
         )
-    reduced = [store.read(spec.key) for spec in specs]
+    loaded.update({spec.key: store.read(spec.key) for spec in todo})
+    reduced = [loaded[spec.key] for spec in specs]
     computed_now = {spec.key for spec in todo}
     cached = [point_label(study, s) for s in specs if s.key not in computed_now]
     compute = sum(float(ds.attrs.get("compute_seconds", np.nan)) for ds in reduced)
@@ -209,14 +211,15 @@ def run_study(
     )  # fmt: skip
 
 
-def _finished(store: PointStore, spec: PointSpec) -> bool:
-    """True when the store holds a usable result for ``spec``."""
+def _stored(store: PointStore, spec: PointSpec) -> xr.Dataset | None:
+    """The stored result of ``spec``, or None when there is no usable one."""
     if not store.has(spec.key):
-        return False
+        return None
     try:
-        return not store.failed(spec.key)  # a failed point is tried again
+        ds = store.read(spec.key)
     except (OSError, ValueError):
-        return False  # unreadable leftovers are recomputed, never trusted
+        return None  # unreadable leftovers are recomputed, never trusted
+    return None if ds.attrs.get("error") else ds  # a failed point is tried again
 
 
 def _finish(study, mode, out, dataset, started, total, computed, cached, points, compute):
