@@ -9,7 +9,7 @@ from ._options import add_aliases
 
 
 def register(subparsers) -> None:
-    from ..paper.studies import STUDIES
+    from ..paper.studies import MEASURED_COST, STUDIES
 
     parser = subparsers.add_parser(
         "reproduce",
@@ -26,14 +26,15 @@ def register(subparsers) -> None:
         dest="mode",
         action="store_const",
         const="quick",
-        help="reduced statistics, a few minutes (the default)",
+        help=f"reduced statistics (the default); {MEASURED_COST['quick']}",
     )
     mode.add_argument(
         "--full",
         dest="mode",
         action="store_const",
         const="full",
-        help="the paper's statistics (100 runs a point), hours",
+        help=f"the paper's statistics (100 runs a point); {MEASURED_COST['full']}. "
+        "REPORT.md estimates it for the machine it runs on",
     )
     parser.set_defaults(mode="quick")
     parser.add_argument(

@@ -20,7 +20,14 @@ from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
-from .studies import ESTIMATION, FIG10_SIGMA, TABLE1_SIGMA, TABLE2_SIGMA, paper_sigma_to_bpm
+from .studies import (
+    ESTIMATION,
+    FIG10_SIGMA,
+    MEASURED_COST,
+    TABLE1_SIGMA,
+    TABLE2_SIGMA,
+    paper_sigma_to_bpm,
+)
 
 
 def verdict_table(verdicts: list[Verdict], figures: dict[str, list[Path]], base: Path) -> str:
@@ -195,7 +202,10 @@ def _timing_section(rep) -> list[str]:
         "",
         f"Estimated `--full` total: about {_duration(total_est)} on this machine"
         + (f" (no estimate for {', '.join(missing)})" if missing else "")
-        + ". It scales with cores; results are identical for any thread count.",
+        + ". It scales with cores; results are identical for any thread count. For "
+        "comparison, on the 2-core x86-64 development machine (`python "
+        f"benchmarks/reproduce.py [--full]`): `--quick` {MEASURED_COST['quick']}; "
+        f"`--full` {MEASURED_COST['full']}.",
         "",
     ]
     s += _cached_lines(rep)

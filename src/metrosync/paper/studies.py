@@ -36,6 +36,16 @@ FIG10_SIGMA = 8.0
 
 MODES = ("quick", "full")
 
+#: What each mode cost, measured with `python benchmarks/reproduce.py [--full]` on the
+#: 2-core x86-64 development machine. `reproduce --help`, the README and REPORT.md all
+#: quote these words (a test checks that they agree); REPORT.md adds its own timings.
+MEASURED_COST = {
+    "quick": "about 27 s of CPU time: under a minute on 2 idle cores, "
+    "80-90 s measured with the 2 cores shared (load average 9)",
+    "full": "12 min 40 s and 13 min 17 s measured on 2 shared cores "
+    "(1.2 cores' worth of CPU), nearly all of it Fig. 10",
+}
+
 
 def paper_sigma_to_bpm(value):
     """Convert a σ printed in the paper's Tables 1–2 to BPM (MODEL-NOTES §4).
