@@ -11,7 +11,7 @@ Adding a study is a declarative change: append an instance to `STUDIES` (and, fo
 new kind of study, teach the runner and `figures` about its type).
 
 Units: BPM (ω = π·BPM/60), seconds, radians. The σ columns of the paper's Tables 1
-and 2 are converted by `paper_sigma_to_bpm` (MODEL-NOTES §4).
+and 2 are converted by `paper_sigma_to_bpm` (docs/model.md §6.4).
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ MEASURED_COST = {
 
 
 def paper_sigma_to_bpm(value):
-    """Convert a σ printed in the paper's Tables 1–2 to BPM (MODEL-NOTES §4).
+    """Convert a σ printed in the paper's Tables 1–2 to BPM (docs/model.md §6.4).
 
     The tables print σ ≈ 8 in units of "BPM·10⁻⁷", far too small to desynchronize
     anything if taken literally. We read ``value × 10⁻⁷`` as beats per 64 µs clock
