@@ -197,8 +197,9 @@ def _timing_section(rep) -> list[str]:
         "",
         "*compute* is the time each point took when it was computed, stored with the point, "
         "so it counts reused points too; *throughput* is oscillator-steps per compute "
-        "second; *wall now* is what this invocation took. The `--full` estimate scales each "
-        "study's throughput to its `--full` oscillator-steps.",
+        "second (the first point a process computes also carries loading, or compiling, "
+        "the kernels); *wall now* is what this invocation took. The `--full` estimate "
+        "scales each study's throughput to its `--full` oscillator-steps.",
         "",
         f"Estimated `--full` total: about {_duration(total_est)} on this machine"
         + (f" (no estimate for {', '.join(missing)})" if missing else "")
