@@ -29,7 +29,7 @@ def test_frequency_jitter_and_sigma():
     assert np.isclose(ph.mean_frequency_bpm(kept, np.ones(kept.size - 1)), 192.0)
     assert ph.period_jitter(kept, np.ones(kept.size - 1)) < 1e-12
     assert np.isclose(ph.frequency_spread([191.0, 192.0, 193.0]), 1.0)
-    # 0.75 BPM is the paper's 8e-7 per 64 µs tick (MODEL-NOTES §4)
+    # 0.75 BPM is the paper's 8e-7 per 64 µs tick (docs/model.md §6.4)
     assert np.isclose(ph.bpm_to_beats_per_tick(0.75, 64e-6), 8e-7)
 
 

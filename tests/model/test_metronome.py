@@ -39,7 +39,7 @@ def test_tuning_is_vectorised_and_monotone():
 
 
 def test_paper_l2_range_maps_to_185_to_227_bpm():
-    # MODEL-NOTES §2: the published L2 range does not tune 160–208 BPM in this model.
+    # docs/model.md §6.2: the published L2 range does not tune 160–208 BPM in this model.
     d = MetronomeDesign()
     assert d.with_l2(0.049).natural_bpm == pytest.approx(185, abs=1)
     assert d.with_l2(0.019).natural_bpm == pytest.approx(227, abs=1)

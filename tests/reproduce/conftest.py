@@ -33,3 +33,9 @@ def tiny_studies():
 def tiny(tmp_path_factory):
     out = tmp_path_factory.mktemp("tiny-reproduction")
     return reproduce(out, studies=tiny_studies())
+
+
+@pytest.fixture
+def studies():
+    """The studies of the `tiny` reproduction."""
+    return tiny_studies()

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import re
+import shutil
+
+import pytest
 import xarray as xr
 
 from metrosync import reproduce as exported
-from metrosync.paper.pipeline import reproduce
+from metrosync.paper.pipeline import kept_points, plan, reproduce
 
 
 def test_the_package_exports_the_entry_point():
@@ -33,3 +37,34 @@ def test_report_lists_every_claim_discrepancy_and_timing(tiny):
     assert "Estimated `--full` total" in text
     for result in tiny.results:
         assert f"| {result.study.name} |" in text
+
+
+def full_estimate_hours(text: str) -> float:
+    match = re.search(r"Estimated `--full` total: about ([\d.]+) (s|min|h)\b", text)
+    assert match, text
+    return float(match[1]) / {"s": 3600, "min": 60, "h": 1}[match[2]]
+
+
+def test_a_cached_rerun_reports_the_cost_of_its_points_and_names_them(tiny, studies, tmp_path):
+    out = tmp_path / "again"
+    shutil.copytree(tiny.out, out)
+    again = reproduce(out, studies=studies)
+    assert all(r.cached_points == r.points for r in again.results)
+    text = again.report.read_text()
+    timing = text[text.index("## Wall time") : text.index("## Figures")]
+    assert "nan" not in timing.lower()
+    for r in again.results:
+        if r.points:
+            assert f"- `{r.study.name}`: all {r.points} points" in timing
+            assert r.throughput == pytest.approx(
+                next(t for t in tiny.results if t.study.name == r.study.name).throughput
+            )
+    first = full_estimate_hours(tiny.report.read_text())
+    assert first > 0 and full_estimate_hours(text) == pytest.approx(first, rel=0.2)
+    assert "No point was reused" in tiny.report.read_text()
+
+
+def test_plan_and_kept_points_count_what_an_interrupted_run_left(tiny, studies):
+    kept, total = kept_points(tiny.out, "quick", studies)
+    assert kept == total == len(plan("quick", studies)) > 0
+    assert kept_points(tiny.out, "full", studies)[0] == 0  # other statistics, other keys

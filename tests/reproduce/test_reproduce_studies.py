@@ -22,7 +22,7 @@ from metrosync.paper.studies import (
 
 
 def test_sigma_conversion_matches_model_notes():
-    # MODEL-NOTES §4: 8e-7 beats per 64 µs tick is 0.75 BPM.
+    # docs/model.md §6.4: 8e-7 beats per 64 µs tick is 0.75 BPM.
     assert paper_sigma_to_bpm(8.0) == pytest.approx(0.75, rel=1e-12)
     assert paper_sigma_to_bpm(8.5) == pytest.approx(8.5e-7 / 64e-6 * 60)
     np.testing.assert_allclose(paper_sigma_to_bpm([0.0, 16.0]), [0.0, 1.5])

@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from metrosync import ParameterError
-from metrosync.sweeps import grid as grid_module
+from metrosync.sweeps import points as points_module
 from metrosync.sweeps.grid import Grid, parse_values
 
 
@@ -107,7 +107,7 @@ def test_every_input_changes_the_key_and_nothing_else_does():
 
 def test_key_includes_the_package_version(monkeypatch):
     before = keys(Grid(axes={"bpm": [185]}))
-    monkeypatch.setattr(grid_module, "__version__", "999.0")
+    monkeypatch.setattr(points_module, "__version__", "999.0")
     assert keys(Grid(axes={"bpm": [185]})) != before
 
 

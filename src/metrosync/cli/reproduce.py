@@ -5,16 +5,20 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ._options import add_aliases
+
 
 def register(subparsers) -> None:
-    from ..paper.studies import STUDIES
+    from ..paper.studies import MEASURED_COST, STUDIES
 
     parser = subparsers.add_parser(
         "reproduce",
         help="reproduce the paper's figures and check its claims",
         description="Run the paper's simulation studies, write NetCDF data, PNG/PDF figures "
         "and REPORT.md with a verdict on each claim. Finished simulations are kept under "
-        "OUT/points/, so an interrupted run resumes.",
+        "OUT/points/, keyed by their fully resolved parameters, the metrosync version and "
+        "the simulation code, so an interrupted run resumes and a changed model is "
+        "recomputed. Exit code 1 when a simulation failed or was lost with a worker.",
     )
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument(
@@ -22,14 +26,15 @@ def register(subparsers) -> None:
         dest="mode",
         action="store_const",
         const="quick",
-        help="reduced statistics, a few minutes (the default)",
+        help=f"reduced statistics (the default); {MEASURED_COST['quick']}",
     )
     mode.add_argument(
         "--full",
         dest="mode",
         action="store_const",
         const="full",
-        help="the paper's statistics (100 runs a point), hours",
+        help=f"the paper's statistics (100 runs a point); {MEASURED_COST['full']}. "
+        "REPORT.md estimates it for the machine it runs on",
     )
     parser.set_defaults(mode="quick")
     parser.add_argument(
@@ -51,25 +56,41 @@ def register(subparsers) -> None:
         help="run only these studies",
     )
     parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="local|tcp://HOST:PORT",
+        help="run the simulations on a Dask LocalCluster or an existing Dask scheduler "
+        "(as `metrosync sweep`; default: in process)",
+    )
+    parser.add_argument("--workers", type=int, default=None, help="workers of --scheduler local")
+    parser.add_argument(
         "--no-progress",
         dest="progress",
         action="store_false",
         help="no progress bars (they show when stderr is a terminal)",
     )
+    add_aliases(parser, n_workers="--workers")
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..paper import reproduce
+    from ..paper.runner import StudyIncomplete
 
-    rep = reproduce(
-        args.out,
-        mode=args.mode,
-        studies=args.only,
-        experiment=args.experiment,
-        progress=args.progress and sys.stderr.isatty(),
-        log=lambda line: print(line, flush=True),
-    )
+    try:
+        rep = reproduce(
+            args.out,
+            mode=args.mode,
+            studies=args.only,
+            experiment=args.experiment,
+            progress=args.progress and sys.stderr.isatty(),
+            log=lambda line: print(line, flush=True),
+            scheduler=args.scheduler,
+            n_workers=args.workers,
+        )
+    except StudyIncomplete as error:  # the work ran; what finished is kept
+        print(f"metrosync reproduce: error: {error}", file=sys.stderr)
+        return 1
     width = max(len(v.verdict) for v in rep.verdicts)
     print(f"\nverdicts ({rep.mode} mode, {rep.wall_s:.0f} s):")
     for v in rep.verdicts:

@@ -19,7 +19,7 @@ Without kicks the scheme is second order; kicks quantise the impulse to the step
 ensemble statistics converge to the ``exact`` integrator at first order in dt.
 
 The same step also records, for each run, the analytic-phase order parameter and the
-running sums of the crossing-interpolated phase (MODEL-NOTES "Observables").
+running sums of the crossing-interpolated phase (docs/model.md §7).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 The disk's own moment of inertia ``J`` includes the metronome boxes. The paper gives
 only its range, J ∈ [0.0729, 0.25515] kg m², for 0 to 7 metronomes. We adopt the
-linear law that matches both ends (MODEL-NOTES §3),
+linear law that matches both ends (docs/model.md §6.6),
 
     J(N) = J0 + N·j,   J0 = 0.0729 kg m² (1 kg × R²),   j = (0.25515 − 0.0729)/7,
 

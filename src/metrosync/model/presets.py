@@ -1,4 +1,4 @@
-"""Named parameter sets (MODEL-NOTES §5).
+"""Named parameter sets (docs/model.md §4 and §6.5).
 
 ``boda2013``  exactly as published: M = 6×10⁻⁴ N m s. Its energy-balance amplitude,
               2M/(π c_θ) ≈ 7.6 rad, means the pendulums go over the top; loading it warns.

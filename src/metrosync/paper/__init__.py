@@ -1,8 +1,9 @@
 """Reproduce the paper's simulation figures and claims, with an honest report.
 
 ``studies``     the studies, declared as data (grids, statistics per mode)
-``runner``      runs a study through `metrosync.simulate`, resumably, into NetCDF
-``assemble``    reduces each simulate result and joins a study's points
+``runner``      runs a study's `metrosync.simulate` calls on the sweep machinery
+                (`metrosync.sweeps`: one point store, resumable, any executor)
+``assemble``    joins a study's stored points into its dataset
 ``figures``     one plotting function per figure (PNG + PDF)
 ``claims``      verdicts on the paper's claims from the study data
 ``consistency`` the parameter-consistency table

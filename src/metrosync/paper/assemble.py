@@ -1,10 +1,10 @@
-"""Reduce each `simulate` result to what a study keeps, and assemble a study's dataset.
+"""Assemble a study's dataset from its stored points.
 
-Contract: `reduce_ensemble` and `reduce_z` turn one `simulate` dataset into the small
-per-point dataset that is cached (run-mean r(t), per-run equilibrium r and status; or
-z per run); `assemble` joins a study's points into one dataset on the study's own
-coordinates (``case``; ``n`` × ``bpm``; ``regime`` × ``theta2``) with the run
-statistics (mean r_eq and σ_r) and the attributes shared by every point.
+Contract: each point of a study is stored reduced (`metrosync.sweeps.keep`: run-mean
+r(t), per-run equilibrium r and status; or z per run); `assemble` joins a study's
+points into one dataset on the study's own coordinates (``case``; ``n`` × ``bpm``;
+``regime`` × ``theta2``) with the run statistics (mean r_eq and σ_r) and the
+attributes shared by every point.
 """
 
 from __future__ import annotations
@@ -12,70 +12,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..observables import ensemble_statistics, z_order
+from ..observables import ensemble_statistics
 from .studies import Study, SweepStudy, TimeSeriesStudy, ZStudy
-
-
-def reduce_ensemble(ds: xr.Dataset) -> xr.Dataset:
-    """Keep what the figures and the report need: run-mean r(t) and per-run r_eq."""
-    r_cross = ds.r_crossing.values
-    finite = np.isfinite(r_cross)
-    count = finite.sum(axis=1)
-    # Near the ends only some runs have a crossing phase; averaging over whichever runs
-    # happen to have one would draw spikes, so the mean is drawn only where every run
-    # that ever has a phase (all but overturned or diverged ones) contributes.
-    active = finite.any(axis=0)
-    enough = finite[:, active].all(axis=1) & active.any()
-    with np.errstate(invalid="ignore", divide="ignore"):
-        r_mean = np.where(enough, np.where(finite, r_cross, 0.0).sum(axis=1) / count, np.nan)
-    freq = ds.frequency_bpm.values
-    spread = freq.std(axis=1, ddof=1) if freq.shape[1] > 1 else np.zeros(freq.shape[0])
-    return xr.Dataset(
-        {
-            "r_mean": ("time", r_mean, {"long_name": "run-mean r, crossing-interpolated phase"}),
-            "r_analytic_mean": (
-                "time",
-                ds.r.mean("run").values,
-                {"long_name": "run-mean r, analytic phase"},
-            ),
-            "r_eq": ds.r_eq,
-            "r_eq_analytic": ds.r_eq_analytic,
-            "status": ds.status,
-            "sigma_realized": (
-                "run",
-                spread,
-                {"units": "BPM", "long_name": "std of the drawn natural frequencies"},
-            ),
-        },
-        coords={"time": ds.time, "run": ds.run},
-    )
-
-
-def reduce_z(ds: xr.Dataset) -> xr.Dataset:
-    """z per run over the whole run (the paper's average) and over its last quarter."""
-    t = ds.time.values
-    theta = ds.theta.values
-    late = t >= t[-1] * 0.75
-    z_all, z_late, amp = [], [], []
-    for b in range(theta.shape[1]):
-        z_all.append(z_order(t, theta[:, b, 0], theta[:, b, 1]))
-        z_late.append(z_order(t, theta[:, b, 0], theta[:, b, 1], start=t[-1] * 0.75))
-        amp.append(float(np.abs(theta[late, b, :]).max()))
-    theta2 = ds.theta.values[0, :, 1]
-    return xr.Dataset(
-        {
-            "z": ("run", np.array(z_all), {"long_name": "z over the whole run"}),
-            "z_late": ("run", np.array(z_late), {"long_name": "z over the last quarter"}),
-            "amplitude_late": (
-                "run",
-                np.array(amp),
-                {"units": "rad", "long_name": "max |θ| over the last quarter"},
-            ),
-            "status": ds.status,
-            "theta2_0": ("run", theta2, {"units": "rad"}),
-        },
-        coords={"run": ds.run},
-    )
 
 
 def assemble(study: Study, mode: str, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
@@ -106,7 +44,11 @@ def assemble(study: Study, mode: str, coords: list[dict], parts: list[xr.Dataset
         ds = _assemble_z(study, coords, parts)
     # Attributes that vary between points live in coordinates and variables instead.
     varying = {
-        "point_digest",
+        "key",
+        "error",
+        "compute_seconds",
+        "osc_steps",
+        "host",
         "n",
         "bpm",
         "sigma_bpm",

@@ -1,4 +1,4 @@
-"""Verdicts on the paper's claims (MODEL-NOTES "What the paper claims"), from study data.
+"""Verdicts on the paper's claims (`CLAIM_TEXT`), from study data.
 
 Contract: each ``claim_*`` function takes the assembled dataset(s) of its study and
 returns a `Verdict`: the claim, one of `VERDICTS`, the measured numbers as text, and

@@ -3,8 +3,8 @@
 Contract: `consistency_table(bpms)` returns an `xarray.Dataset` with, for each preset,
 the energy-balance steady amplitude 2M/(π c_θ), whether that overturns (> π/2), the
 amplitude and overturn flag *measured* by simulating one metronome on the disk through
-`metrosync.simulate`, and the slider position L2 each nominal BPM maps to (MODEL-NOTES
-§2), next to the paper's quoted L2 range. `markdown_table` renders it for REPORT.md.
+`metrosync.simulate`, and the slider position L2 each nominal BPM maps to (docs/model.md
+§6.2), next to the paper's quoted L2 range. `markdown_table` renders it for REPORT.md.
 """
 
 from __future__ import annotations

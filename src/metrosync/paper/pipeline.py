@@ -6,10 +6,13 @@ Contract: ``reproduce(out, mode=...)`` writes into ``out``
     points/estimation/free_decay000.log   the estimation study's virtual light-gate log
     consistency.nc                        the parameter-consistency table
     fig9.nc, figures/fig9.png|pdf         only with ``experiment``
-    points/<study>/*.nc                   finished simulate calls (resume cache)
+    points/<key>.nc, log.jsonl            the point store (`metrosync.sweeps.PointStore`)
     REPORT.md                             verdicts, numbers, interpretations, timings
 
-and returns a `Reproduction`. Re-running with the same ``out`` reuses finished points.
+and returns a `Reproduction`. Re-running with the same ``out`` reuses the points whose
+key (resolved parameters, package version, simulation sources) is unchanged and
+recomputes the others. `plan` lists every point of a reproduction and `kept_points`
+counts those already in the store (for a message after an interruption).
 """
 
 from __future__ import annotations
@@ -24,6 +27,9 @@ import xarray as xr
 from .._files import write_netcdf
 from .._version import __version__
 from ..errors import ParameterError
+from ..sweeps import PointStore
+from ..sweeps.executors import check_scheduler
+from ..sweeps.points import PointSpec
 from .claims import Verdict, all_verdicts
 from .consistency import consistency_table
 from .experiment import compare_experiment, find_experiment, lightgate_analyze
@@ -77,17 +83,23 @@ def reproduce(
     experiment: Path | str | None = None,
     progress: bool = False,
     log: Callable[[str], None] | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
 ) -> Reproduction:
     """Reproduce the paper's simulation figures and check its claims.
 
     Parameters
     ----------
     out : output folder (created).
-    mode : ``"quick"`` (reduced statistics, minutes) or ``"full"`` (the paper's, hours).
+    mode : ``"quick"`` (reduced statistics) or ``"full"`` (the paper's, 100 runs a
+        point; the README gives the measured times of both).
     studies : study names or `Study` objects; default every study in `STUDIES`.
     experiment : folder of light-gate logs, one sub-folder per ω₀ named by its BPM;
         adds Fig. 9. Checked before anything runs.
     progress : show progress bars.   log : called with one line per finished step.
+    scheduler, n_workers : where the points run, as for `metrosync.sweep`: None (in
+        process), ``"local"`` (a Dask LocalCluster of ``n_workers``) or
+        ``"tcp://HOST:PORT"``. Checked before anything runs.
 
     Returns
     -------
@@ -98,6 +110,7 @@ def reproduce(
     started = time.perf_counter()
     out = Path(out)
     chosen = _resolve(studies)
+    check_scheduler(scheduler, n_workers)
     if experiment is not None:
         find_experiment(Path(experiment))
         lightgate_analyze()
@@ -115,7 +128,10 @@ def reproduce(
             else f"{len(points_of(study, mode))} simulate calls"
         )
         say(f"{study.name}: {study.figure} ({calls})")
-        result = run_study(study, mode, out, progress=progress, log=say if mode == "full" else None)
+        result = run_study(
+            study, mode, out, progress=progress, log=say if mode == "full" else None,
+            scheduler=scheduler, n_workers=n_workers,
+        )  # fmt: skip
         results.append(result)
         figures[study.name] = PLOTTERS[type(study).__name__](
             result.dataset, out / "figures" / study.name
@@ -134,7 +150,9 @@ def reproduce(
     if experiment is not None:
         sim = rep.datasets.get(FIG8_TOP.name)
         if sim is None:
-            sim = run_study(FIG8_TOP, mode, out, progress=progress).dataset
+            sim = run_study(
+                FIG8_TOP, mode, out, progress=progress, scheduler=scheduler, n_workers=n_workers
+            ).dataset
         rep.comparison = compare_experiment(Path(experiment), sim)
         write_netcdf(rep.comparison, out / "fig9.nc")
         figures["fig9"] = plot_comparison(rep.comparison, out / "figures" / "fig9")
@@ -144,6 +162,21 @@ def reproduce(
     rep.report = write_report(out / "REPORT.md", rep)
     say(f"wrote {rep.report}")
     return rep
+
+
+def plan(mode: str = "quick", studies: Sequence[str | Study] | None = None) -> list[PointSpec]:
+    """Every point a reproduction in ``mode`` computes or reuses, in run order."""
+    if mode not in MODES:
+        raise ParameterError(f"unknown `mode` {mode!r}; choose one of {list(MODES)}.")
+    return [spec for study in _resolve(studies) for spec in points_of(study, mode)]
+
+
+def kept_points(
+    out: Path | str, mode: str = "quick", studies: Sequence[str | Study] | None = None
+) -> tuple[int, int]:
+    """(points of the reproduction already in the store of ``out``, points in all)."""
+    specs = plan(mode, studies)
+    return PointStore(out).kept(spec.key for spec in specs), len(specs)
 
 
 def _resolve(studies) -> tuple[Study, ...]:

@@ -4,12 +4,14 @@ Contract: `write_report(path, reproduction)` renders a `Reproduction` (from
 `metrosync.paper.pipeline`) as Markdown: a verdict table, one section per claim
 with the measured numbers, the discrepancies between the paper and this model stated
 openly (σ units, M, L2 range, J(N), phase definition, durations), the
-parameter-consistency table, the wall time of every study with an estimate of the
-``--full`` run, and links to every figure. `verdict_table` is reused by the README.
+parameter-consistency table, the cost of every study (from the compute time stored
+with each point, reused or not) with an estimate of the ``--full`` run and the list of
+reused points, and links to every figure. `verdict_table` is reused by the README.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import platform
 from pathlib import Path
@@ -18,7 +20,14 @@ from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
-from .studies import ESTIMATION, FIG10_SIGMA, TABLE1_SIGMA, TABLE2_SIGMA, paper_sigma_to_bpm
+from .studies import (
+    ESTIMATION,
+    FIG10_SIGMA,
+    MEASURED_COST,
+    TABLE1_SIGMA,
+    TABLE2_SIGMA,
+    paper_sigma_to_bpm,
+)
 
 
 def verdict_table(verdicts: list[Verdict], figures: dict[str, list[Path]], base: Path) -> str:
@@ -159,35 +168,86 @@ def _timing_section(rep) -> list[str]:
     s = [
         "## Wall time",
         "",
-        "| study | points | cached | runs × duration | oscillator-steps | wall (s) "
-        "| throughput (steps/s) | estimated `--full` (s) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| study | points | cached | runs × duration | oscillator-steps | compute (s) "
+        "| throughput (steps/s) | wall now (s) | estimated `--full` (s) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    total_est = 0.0
+    total_est, missing = 0.0, []
     for r in rep.results:
         ds = r.dataset
-        rate = r.computed_work / r.wall_s if r.computed_work and r.wall_s > 0 else float("nan")
-        est = rep.full_work.get(r.study.name, float("nan")) / rate
-        total_est += est if est == est else 0.0
-        runs = ds.sizes.get("run", ds.sizes.get("theta2", 0))
-        dur = ds.attrs.get("duration", float("nan"))
         if not r.total_work:  # the estimation study: seconds, recomputed every run
-            s.append(f"| {r.study.name} | — | — | — | — | {r.wall_s:.1f} | — | — |")
+            s.append(f"| {r.study.name} | — | — | — | — | {r.wall_s:.1f} | — | {r.wall_s:.1f} "
+                     f"| {r.wall_s:.0f} |")  # fmt: skip
+            total_est += r.wall_s
             continue
+        rate = r.throughput
+        est = rep.full_work.get(r.study.name, math.nan) / rate
+        if math.isfinite(est):
+            total_est += est
+        else:
+            missing.append(r.study.name)
+        runs = ds.sizes.get("run", ds.sizes.get("theta2", 0))
+        dur = ds.attrs.get("duration", math.nan)
         s.append(
             f"| {r.study.name} | {r.points} | {r.cached_points} | {runs} × {dur:g} s "
-            f"| {r.total_work:.3g} | {r.wall_s:.1f} | {rate:.3g} | {est:.0f} |"
+            f"| {r.total_work:.3g} | {r.compute_s:.1f} | {rate:.3g} | {r.wall_s:.1f} "
+            f"| {_seconds(est)} |"
         )
     s += [
         "",
-        f"Estimated `--full` total: about {total_est / 3600:.1f} h on this machine, from the "
-        "throughput measured here (it scales with cores; results are identical for any "
-        "thread count). `--full` keeps every finished point under `points/` and resumes; "
-        "a point is keyed by its `simulate` arguments, not by the metrosync version, so "
-        "delete `points/` after upgrading.",
+        "*compute* is the time each point took when it was computed, stored with the point, "
+        "so it counts reused points too; *throughput* is oscillator-steps per compute "
+        "second (the first point a process computes also carries loading, or compiling, "
+        "the kernels); *wall now* is what this invocation took. The `--full` estimate "
+        "scales each study's throughput to its `--full` oscillator-steps.",
+        "",
+        f"Estimated `--full` total: about {_duration(total_est)} on this machine"
+        + (f" (no estimate for {', '.join(missing)})" if missing else "")
+        + ". It scales with cores; results are identical for any thread count. For "
+        "comparison, on the 2-core x86-64 development machine (`python "
+        f"benchmarks/reproduce.py [--full]`): `--quick` {MEASURED_COST['quick']}; "
+        f"`--full` {MEASURED_COST['full']}.",
+        "",
+    ]
+    s += _cached_lines(rep)
+    s += [
+        "Every finished point is kept in `points/`, keyed by its fully resolved model "
+        "parameters, the metrosync version and the source of the simulation code: a "
+        "rerun reuses a point only when it would compute the same result, and an "
+        "interrupted run resumes.",
         "",
     ]
     return s
+
+
+def _cached_lines(rep) -> list[str]:
+    """Which points this invocation reused from the store, study by study."""
+    reused = [r for r in rep.results if r.cached_points]
+    if not reused:
+        return ["No point was reused: every simulation ran in this invocation.", ""]
+    lines = ["Points reused from `points/` (computed by an earlier invocation):", ""]
+    for r in reused:
+        if r.cached_points == r.points:
+            lines.append(f"- `{r.study.name}`: all {r.points} points")
+            continue
+        shown = "; ".join(r.cached[:8]) + (
+            f"; … {len(r.cached) - 8} more" if len(r.cached) > 8 else ""
+        )
+        lines.append(f"- `{r.study.name}`: {r.cached_points} of {r.points} points ({shown})")
+    return lines + [""]
+
+
+def _seconds(value: float) -> str:
+    return f"{value:.0f}" if math.isfinite(value) else "—"
+
+
+def _duration(seconds: float) -> str:
+    """Seconds as a readable duration (``45 s``, ``13 min``, ``2.4 h``)."""
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 2 * 3600:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _rel(path: Path, base: Path) -> str:

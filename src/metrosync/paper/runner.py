@@ -1,26 +1,33 @@
-"""Run a declared study through the public `metrosync.simulate` and assemble its data.
+"""Run a declared study on the sweep machinery and assemble its data.
 
 Contract: `run_study(study, mode, out)` expands a study (`metrosync.paper.studies`)
-into *points*, one `simulate` call each, with the exact keyword arguments a user would
-pass. Each point's reduced result is written atomically to
-``out/points/<study>/<key>.nc`` together with a hash of its arguments, so an
-interrupted run (``--full`` takes hours) resumes where it stopped: a point whose file
-exists with the same hash is loaded, not recomputed. The points are then assembled
-into one `xarray.Dataset` per study, written to ``out/<study>.nc``.
+into *points*, one public `metrosync.simulate` call each, with the exact keyword
+arguments a user would pass (`points_of`), and runs them with the sweep machinery
+(`metrosync.sweeps`): the points are keyed by `metrosync.sweeps.points` (the fully
+resolved model parameters, the package version and the simulation's sources, never a
+preset's name), computed by `metrosync.sweeps.executors.execute` in process or on
+Dask, and each written atomically to the one point store of the output folder,
+``out/points/<key>.nc`` (`metrosync.sweeps.PointStore` rooted at ``out``). An
+interrupted run (``--full`` takes a quarter of an hour or more) resumes where it
+stopped; a point whose parameters or simulation code changed is recomputed, never
+reused. The points are then assembled into one `xarray.Dataset` per study, written to
+``out/<study>.nc``.
+
+Each stored point holds what it cost (compute seconds and oscillator-steps), so a
+study's throughput, and from it the estimate of a ``--full`` run, comes from every
+point, reused or not (`StudyResult.throughput`).
 
 The estimation study (`EstimationStudy`) has no points: its `simulate` calls are made
 inside `metrosync.calibration` and take seconds, so it is recomputed on every run.
 
 Seeds are a fixed function of the study and point names, so results never depend on
-the order or the number of points computed in one go.
+the order or the number of points computed in one go, nor on the executor.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
+import math
 import time
-import warnings
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -31,9 +38,11 @@ import xarray as xr
 
 from .._files import write_netcdf
 from .._version import __version__
-from ..progress import progress_bar
-from ..simulate import simulate
-from .assemble import assemble, reduce_ensemble, reduce_z
+from ..errors import MetrosyncError
+from ..sweeps import PointStore
+from ..sweeps.executors import execute
+from ..sweeps.points import PointSpec, make_point
+from .assemble import assemble
 from .estimation import run_estimation
 from .studies import EstimationStudy, Study, SweepStudy, TimeSeriesStudy, ZStudy
 
@@ -42,29 +51,19 @@ Z_BATCH = 12
 DT = 0.01
 
 
-@dataclass(frozen=True)
-class Point:
-    """One `simulate` call: ``kwargs`` are passed verbatim; ``work`` = runs·N·steps."""
-
-    key: str
-    kwargs: dict
-    coords: dict
-
-    @property
-    def work(self) -> float:
-        k = self.kwargs
-        runs = k.get("runs", 1)
-        return float(runs * k["n"] * round(k["duration"] / k.get("dt", DT)))
-
-    @property
-    def digest(self) -> str:
-        text = json.dumps(self.kwargs, sort_keys=True, default=_jsonable)
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
+class StudyIncomplete(MetrosyncError):
+    """A point of a study failed or was lost with its worker; the others are kept."""
 
 
 @dataclass(frozen=True)
 class StudyResult:
-    """A study's assembled data and what it cost in this invocation."""
+    """A study's assembled data and what it cost.
+
+    wall_s : wall time of this invocation.   computed_work : oscillator-steps computed
+    now.   total_work : oscillator-steps of all its points.   cached_points, points :
+    points reused from the store, and in all.   compute_s : compute seconds stored with
+    its points, reused or not.   cached : labels of the reused points.
+    """
 
     study: Study
     mode: str
@@ -75,9 +74,18 @@ class StudyResult:
     total_work: float
     cached_points: int
     points: int
+    compute_s: float = math.nan
+    cached: tuple[str, ...] = ()
+
+    @property
+    def throughput(self) -> float:
+        """Oscillator-steps per compute second over every point (NaN without points)."""
+        if self.total_work > 0 and self.compute_s > 0:
+            return self.total_work / self.compute_s
+        return math.nan
 
 
-def points_of(study: Study, mode: str) -> list[Point]:
+def points_of(study: Study, mode: str) -> list[PointSpec]:
     """Expand ``study`` into its `simulate` calls for ``mode`` ("quick" or "full")."""
     if isinstance(study, TimeSeriesStudy | SweepStudy):
         if isinstance(study, TimeSeriesStudy):
@@ -90,8 +98,8 @@ def points_of(study: Study, mode: str) -> list[Point]:
             cells = [(f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, study.sigma_bpm, {"n": n, "bpm": bpm})
                      for n in grid.ns for bpm in grid.bpms]  # fmt: skip
         return [
-            _ensemble_point(study.name, key, n, bpm, sigma, stats, study.preset, coords)
-            for key, n, bpm, sigma, coords in cells
+            _ensemble_point(study.name, i, key, n, bpm, sigma, stats, study.preset, coords)
+            for i, (key, n, bpm, sigma, coords) in enumerate(cells)
         ]
     if isinstance(study, ZStudy):
         grid = study.grid(mode)
@@ -115,13 +123,25 @@ def points_of(study: Study, mode: str) -> list[Point]:
                     "record_every": grid.record_every,
                     "seed": 0,
                 }
-                out.append(
-                    Point(f"regime{r}_from{start:03d}", kwargs, {"regime": r, "start": start})
-                )
+                where = {"regime": r, "start": start}
+                out.append(make_point(kwargs, keep="z", index=(len(out),), coords=where))
         return out
     if isinstance(study, EstimationStudy):
         return []
     raise TypeError(f"unknown study type {type(study).__name__}")
+
+
+def point_label(study: Study, spec: PointSpec) -> str:
+    """A short human name of one point of ``study`` (for reports)."""
+    c = spec.coords
+    if isinstance(study, TimeSeriesStudy):
+        return study.cases[c["case"]].label
+    if isinstance(study, SweepStudy):
+        return f"N = {c['n']}, ω₀ = {c['bpm']:g} BPM"
+    if isinstance(study, ZStudy):
+        runs = spec.kwargs["runs"]
+        return f"regime {c['regime']}, θ₂(0) #{c['start']}–{c['start'] + runs - 1}"
+    return spec.key[:12]
 
 
 def run_study(
@@ -131,37 +151,78 @@ def run_study(
     *,
     progress: bool = False,
     log: Callable[[str], None] | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
 ) -> StudyResult:
-    """Simulate (or resume) every point of ``study``, assemble and write ``out/<name>.nc``."""
+    """Simulate (or resume) every point of ``study``, assemble and write ``out/<name>.nc``.
+
+    ``scheduler`` and ``n_workers`` choose the executor, as for `metrosync.sweep`.
+    Raises `StudyIncomplete` when a point fails or is lost with a Dask worker (the
+    points that finished stay in the store; running again computes only the rest).
+    """
     out = Path(out)
     started = time.perf_counter()
     if isinstance(study, EstimationStudy):
         dataset = run_estimation(study, mode, out / "points" / study.name)
-        return _finish(study, mode, out, dataset, started, 0.0, 0.0, 0, 0)
-    points = points_of(study, mode)
-    cache = out / "points" / study.name
-    total = sum(p.work for p in points)
-    reduced, computed, cached = [], 0.0, 0
-    with progress_bar(total=total, unit="osc-step", enabled=progress, desc=study.name) as bar:
-        for i, point in enumerate(points):
-            path = cache / f"{point.key}.nc"
-            ds = _load_cached(path, point.digest)
-            if ds is None:
-                ds = _compute(study, point)
-                write_netcdf(ds, path)
-                computed += point.work
-            else:
-                cached += 1
-            reduced.append(ds)
-            bar.update(point.work)
-            if log is not None and len(points) > 1:
-                elapsed = time.perf_counter() - started
-                log(f"  {study.name}: {i + 1}/{len(points)} points ({elapsed:.0f} s)")
-    dataset = assemble(study, mode, [p.coords for p in points], reduced)
-    return _finish(study, mode, out, dataset, started, total, computed, cached, len(points))
+        wall = time.perf_counter() - started
+        return _finish(study, mode, out, dataset, started, 0.0, 0.0, [], 0, wall)
+    specs = points_of(study, mode)
+    store = PointStore(out)
+    loaded = {spec.key: ds for spec in specs if (ds := _stored(store, spec)) is not None}
+    todo = [spec for spec in specs if spec.key not in loaded]
+    done_before = len(specs) - len(todo)
+
+    finished = done_before
+
+    def tell(_spec: PointSpec) -> None:
+        nonlocal finished
+        finished += 1
+        if log is not None and len(specs) > 1:
+            elapsed = time.perf_counter() - started
+            log(f"  {study.name}: {finished}/{len(specs)} points ({elapsed:.0f} s)")
+
+    execution = execute(
+        todo, store, scheduler=scheduler, n_workers=n_workers, progress=progress,
+        desc=study.name, on_done=tell,
+    )  # fmt: skip
+    if execution.failed:
+        key, message = next(iter(execution.failed.items()))
+        spec = next(s for s in specs if s.key == key)
+        raise StudyIncomplete(
+            f"study {study.name!r}: the simulation of point {point_label(study, spec)!r} "
+            f"failed: {message}"
+        )
+    if execution.lost:
+        raise StudyIncomplete(
+            f"study {study.name!r}: {len(execution.lost)} of {len(specs)} points were lost "
+            f"with their Dask workers ({next(iter(execution.lost.values()))}); the others are "
+            f"kept in {store.points}: run the same command again to compute the rest."
+        )
+    loaded.update({spec.key: store.read(spec.key) for spec in todo})
+    reduced = [loaded[spec.key] for spec in specs]
+    computed_now = {spec.key for spec in todo}
+    cached = [point_label(study, s) for s in specs if s.key not in computed_now]
+    compute = sum(float(ds.attrs.get("compute_seconds", np.nan)) for ds in reduced)
+    total = float(sum(spec.work for spec in specs))
+    dataset = assemble(study, mode, [spec.coords for spec in specs], reduced)
+    return _finish(
+        study, mode, out, dataset, started, total, float(execution.work), cached, len(specs),
+        compute,
+    )  # fmt: skip
 
 
-def _finish(study, mode, out, dataset, started, total, computed, cached, points) -> StudyResult:
+def _stored(store: PointStore, spec: PointSpec) -> xr.Dataset | None:
+    """The stored result of ``spec``, or None when there is no usable one."""
+    if not store.has(spec.key):
+        return None
+    try:
+        ds = store.read(spec.key)
+    except (OSError, ValueError):
+        return None  # unreadable leftovers are recomputed, never trusted
+    return None if ds.attrs.get("error") else ds  # a failed point is tried again
+
+
+def _finish(study, mode, out, dataset, started, total, computed, cached, points, compute):
     """Stamp a study's dataset with what it cost, write ``out/<name>.nc``, wrap it."""
     wall = time.perf_counter() - started
     dataset.attrs.update(
@@ -170,14 +231,18 @@ def _finish(study, mode, out, dataset, started, total, computed, cached, points)
         title=study.title,
         mode=mode,
         wall_time_s=wall,
+        compute_time_s=compute,
         work_osc_steps=total,
         computed_osc_steps=computed,
-        cached_points=cached,
+        cached_points=len(cached),
         metrosync_version=__version__,
     )
     path = Path(out) / f"{study.name}.nc"
     write_netcdf(dataset, path)
-    return StudyResult(study, mode, dataset, path, wall, computed, total, cached, points)
+    return StudyResult(
+        study, mode, dataset, path, wall, computed, total, len(cached), points, compute,
+        tuple(cached),
+    )  # fmt: skip
 
 
 def point_seed(study: str, key: str) -> int:
@@ -185,7 +250,7 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def _ensemble_point(study, key, n, bpm, sigma, stats, preset, coords) -> Point:
+def _ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords) -> PointSpec:
     kwargs = {
         "n": int(n),
         "bpm": float(bpm),
@@ -196,42 +261,4 @@ def _ensemble_point(study, key, n, bpm, sigma, stats, preset, coords) -> Point:
         "preset": preset,
         "seed": point_seed(study, key),
     }
-    return Point(key, kwargs, coords)
-
-
-def _load_cached(path: Path, digest: str) -> xr.Dataset | None:
-    if not path.exists():
-        return None
-    try:
-        ds = xr.load_dataset(path, engine="h5netcdf")
-    except (OSError, ValueError):
-        return None  # unreadable leftovers are recomputed, never trusted
-    return ds if ds.attrs.get("point_digest") == digest else None
-
-
-def _simulate(point: Point) -> tuple[xr.Dataset, list[str]]:
-    """Call `simulate` with the point's arguments; collect (not lose) its warnings."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        ds = simulate(**point.kwargs, progress=False)
-    return ds, sorted({str(w.message) for w in caught})
-
-
-def _compute(study: Study, point: Point) -> xr.Dataset:
-    ds, messages = _simulate(point)
-    reduced = reduce_z(ds) if isinstance(study, ZStudy) else reduce_ensemble(ds)
-    reduced.attrs.update(_scalar_attrs(ds.attrs))
-    reduced.attrs.update(point_digest=point.digest, warnings=" | ".join(messages) or "none")
-    return reduced
-
-
-def _scalar_attrs(attrs: dict) -> dict:
-    return {k: v for k, v in attrs.items() if isinstance(v, str | int | float | np.number | list)}
-
-
-def _jsonable(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"cannot hash {type(value).__name__}")
+    return make_point(kwargs, keep="run_mean_r", index=(i,), coords=coords)

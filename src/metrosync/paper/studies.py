@@ -11,7 +11,7 @@ Adding a study is a declarative change: append an instance to `STUDIES` (and, fo
 new kind of study, teach the runner and `figures` about its type).
 
 Units: BPM (ω = π·BPM/60), seconds, radians. The σ columns of the paper's Tables 1
-and 2 are converted by `paper_sigma_to_bpm` (MODEL-NOTES §4).
+and 2 are converted by `paper_sigma_to_bpm` (docs/model.md §6.4).
 """
 
 from __future__ import annotations
@@ -36,9 +36,19 @@ FIG10_SIGMA = 8.0
 
 MODES = ("quick", "full")
 
+#: What each mode cost, measured with `python benchmarks/reproduce.py [--full]` on the
+#: 2-core x86-64 development machine. `reproduce --help`, the README and REPORT.md all
+#: quote these words (a test checks that they agree); REPORT.md adds its own timings.
+MEASURED_COST = {
+    "quick": "about 27 s of CPU time: under a minute on 2 idle cores, "
+    "80-90 s measured with the 2 cores shared (load average 9)",
+    "full": "12 min 40 s and 13 min 17 s measured on 2 shared cores "
+    "(1.2 cores' worth of CPU), nearly all of it Fig. 10",
+}
+
 
 def paper_sigma_to_bpm(value):
-    """Convert a σ printed in the paper's Tables 1–2 to BPM (MODEL-NOTES §4).
+    """Convert a σ printed in the paper's Tables 1–2 to BPM (docs/model.md §6.4).
 
     The tables print σ ≈ 8 in units of "BPM·10⁻⁷", far too small to desynchronize
     anything if taken literally. We read ``value × 10⁻⁷`` as beats per 64 µs clock

@@ -1,6 +1,8 @@
 """Parameter sweeps: grids, a resumable point store, executors, and ω_c analysis.
 
-``grid``       swept axes, fixed settings, per-point seeds and content hashes
+``grid``       swept axes, fixed settings and per-point seeds
+``points``     one point: its `simulate` call, what it keeps, and its content key
+``keep``       what a point stores of its result (also for `metrosync.reproduce`)
 ``store``      one atomically written file per finished point; the merged dataset
 ``executors``  in process, Dask LocalCluster, or an existing Dask cluster
 ``sweep``      the `sweep` entry point

@@ -14,6 +14,9 @@ workers). Each point is one `metrosync.simulate` call, a pure function of its
 
 A point whose simulation raises is stored as failed (with the message) and the sweep
 goes on; a point lost with its worker is not stored, so the next run computes it.
+Warnings of a point's simulation are kept in its file (``warnings`` attribute), not
+printed: a worker's output would be lost, and the caller decides what to report.
+`check_scheduler` validates the executor options before any work, for every caller.
 """
 
 from __future__ import annotations
@@ -23,14 +26,15 @@ import os
 import socket
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from tqdm import tqdm
 
-from ..errors import OverturnWarning, ParameterError
-from .grid import PointSpec
-from .store import PointStore, point_dataset
+from ..errors import ParameterError
+from .keep import kept_dataset
+from .points import PointSpec
+from .store import PointStore
 
 
 @dataclass
@@ -64,26 +68,18 @@ def run_point(spec: PointSpec, threads: int | None = None):
 
         numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     started = time.perf_counter()
-    try:
-        with warnings.catch_warnings():
-            # The sweep warns once up front; overturned runs are flagged in `status`.
-            warnings.simplefilter("ignore", OverturnWarning)
-            result = simulate(**spec.kwargs, trajectories=False, progress=False)
-        ds = point_dataset(spec, result)
-    except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
-        ds = point_dataset(spec, None, f"{type(error).__name__}: {error}")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            ds = kept_dataset(spec, simulate(**spec.kwargs, progress=False))
+        except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
+            ds = kept_dataset(spec, None, f"{type(error).__name__}: {error}")
+    ds.attrs["warnings"] = " | ".join(sorted({str(w.message) for w in caught})) or "none"
     return ds, time.perf_counter() - started, socket.gethostname()
 
 
-def execute(
-    specs: Sequence[PointSpec],
-    store: PointStore,
-    *,
-    scheduler: str | None = None,
-    n_workers: int | None = None,
-    progress: bool = False,
-) -> Execution:
-    """Compute ``specs`` with the chosen executor, storing each point when it is done."""
+def check_scheduler(scheduler: str | None, n_workers: int | None) -> None:
+    """Refuse an unknown ``scheduler`` or a ``n_workers`` it cannot use, before any work."""
     if scheduler is not None and scheduler != "local" and not scheduler.startswith("tcp://"):
         raise ParameterError(
             "`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', "
@@ -97,23 +93,44 @@ def execute(
             f"`n_workers` = {n_workers} applies to scheduler='local' only, but the sweep runs "
             f"{where}; add `scheduler='local'` (CLI: --scheduler local) or drop it."
         )
+
+
+def execute(
+    specs: Sequence[PointSpec],
+    store: PointStore,
+    *,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    progress: bool = False,
+    desc: str = "sweep",
+    on_done: Callable[[PointSpec], None] | None = None,
+) -> Execution:
+    """Compute ``specs`` with the chosen executor, storing each point when it is done.
+
+    ``desc`` labels the progress bar; ``on_done(spec)`` is called after each point is
+    stored (e.g. to log progress).
+    """
+    check_scheduler(scheduler, n_workers)
     report = Execution()
     started = time.perf_counter()
     total = sum(spec.work for spec in specs)
     with tqdm(
-        total=total, unit="osc-step", unit_scale=True, desc="sweep", disable=not progress,
+        total=total, unit="osc-step", unit_scale=True, desc=desc, disable=not progress,
         dynamic_ncols=True, leave=False,
     ) as bar:  # fmt: skip
 
         def done(spec: PointSpec, ds, seconds: float, host: str) -> None:
-            store.write(ds, seconds=seconds, host=host)
+            failed = bool(ds.attrs["error"])
+            store.write(ds, seconds=seconds, host=host, work=0 if failed else spec.work)
             report.computed.append(spec.key)
-            if ds.attrs["error"]:
+            if failed:
                 report.failed[spec.key] = ds.attrs["error"]
             else:
                 report.work += spec.work
             bar.update(spec.work)
             bar.set_postfix_str(f"{len(report.computed)}/{len(specs)} points", refresh=False)
+            if on_done is not None:
+                on_done(spec)
 
         try:
             if scheduler is None:

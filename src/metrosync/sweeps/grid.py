@@ -2,10 +2,11 @@
 
 Contract: a `Grid` holds the swept axes (name -> tuple of values, in order) and the
 fixed settings. Every point of the Cartesian product becomes a `PointSpec`: the full
-keyword arguments of one `metrosync.simulate` call plus a content hash. The hash
-covers every input that can change the result (all ensemble settings, the fully
-resolved model parameters, the point's seed, what is kept, and the package version),
-so a stored point is reused only when it would be recomputed bit for bit.
+keyword arguments of one `metrosync.simulate` call plus a content key
+(`metrosync.sweeps.points`). The key covers every input that can change the result
+(all ensemble settings, the fully resolved model parameters, the point's seed, what
+is kept, the package version and the simulation's sources), so a stored point is
+reused only when it would be recomputed bit for bit.
 
 Values come from TOML (`Grid.from_toml`) or from text (`parse_values`):
 ``150:220:2.5`` is an inclusive range with a step, ``7,16,32`` a list, ``192`` a
@@ -18,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import json
 import math
 import tomllib
 from collections.abc import Iterator, Mapping
@@ -31,6 +31,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import ParameterError, describe
 from ..model import MetronomeDesign, Platform, get_preset
+from .points import PointSpec, canonical_json, make_point
 
 #: Ensemble settings of `simulate`, with their type and default in a sweep.
 ENSEMBLE_SETTINGS: dict[str, tuple[type, Any]] = {
@@ -180,23 +181,6 @@ def parse_values(name: str, spec: Any) -> tuple:
 
 
 @dataclass(frozen=True)
-class PointSpec:
-    """One grid point: where it sits, what it runs, and its content hash.
-
-    index : position along each axis.   coords : swept name -> value.
-    kwargs : the complete keyword arguments of `metrosync.simulate`.
-    keep_r : keep r(t) per run.   key : content hash (hex).   work : oscillator-steps.
-    """
-
-    index: tuple[int, ...]
-    coords: dict[str, Any]
-    kwargs: dict[str, Any]
-    keep_r: bool
-    key: str
-    work: int
-
-
-@dataclass(frozen=True)
 class Grid:
     """Swept axes and fixed settings of a sweep.
 
@@ -335,18 +319,8 @@ class Grid:
             "record_every": self.record_every,
             "equilibrium_window": self.equilibrium_window,
         }
-        resolved = self.model_parameters(coords).as_dict()
-        resolved.pop("preset")  # the name changes with `changes`; the values are what count
-        key_input = {
-            "simulate": kwargs,
-            "model": resolved,
-            "keep_r": self.keep_r,
-            "metrosync_version": __version__,
-        }
-        key = hashlib.sha256(_canonical_json(key_input).encode()).hexdigest()
-        steps = round(values["duration"] / values["dt"])
-        work = values["runs"] * values["n"] * steps
-        return PointSpec(index, coords, kwargs, self.keep_r, key, work)
+        keep = "r_eq+r" if self.keep_r else "r_eq"
+        return make_point(kwargs, keep=keep, index=index, coords=coords)
 
     def describe(self) -> dict[str, Any]:
         """Every setting as file attributes (NetCDF-safe types)."""
@@ -369,13 +343,9 @@ class Grid:
 
 def point_seed(sweep_seed: int, values: Mapping[str, Any]) -> int:
     """A 63-bit seed for one point, a pure function of the sweep seed and its values."""
-    digest = hashlib.sha256(_canonical_json(dict(values)).encode()).digest()
+    digest = hashlib.sha256(canonical_json(dict(values)).encode()).digest()
     entropy = [int(sweep_seed), int.from_bytes(digest[:16], "little")]
     return int(np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0] >> np.uint64(1))
-
-
-def _canonical_json(obj: Any) -> str:
-    return json.dumps(obj, sort_keys=True, default=repr, allow_nan=True)
 
 
 def _attr(value: Any) -> Any:

@@ -1,16 +1,20 @@
 """The point store: one file per finished grid point, and the merged sweep.
 
 Contract: a store is a directory. ``points/<key>.nc`` holds one finished point, named
-by its content hash (`PointSpec.key`), written to a temporary file and moved into
-place (`metrosync._files.atomic_path`), so a file at that name is always complete; a crash loses at
-most the points in flight. A point is finished when its file exists; a sweep started
-again skips those points, and a point whose inputs changed has another key, so a
-stale file is never read for it. ``log.jsonl`` gets one line per point computed
-(key, seconds, host), appended after the file is in place.
+by its content key (`metrosync.sweeps.points`), written to a temporary file and moved
+into place (`metrosync._files.atomic_path`), so a file at that name is always
+complete; a crash loses at most the points in flight. A point is finished when its
+file exists; a run started again skips those points, and a point whose inputs or
+code changed has another key, so a stale file is never read for it. Each file also
+records what the point cost, ``compute_seconds`` and ``osc_steps`` (oscillator-steps)
+with the ``host`` that computed it, so the cost of a run can be estimated from
+reused points too. ``log.jsonl`` gets one line per point computed (key, seconds,
+host), appended after the file is in place.
 
 `merge` gathers the points of a grid into one `xarray.Dataset` with one dimension per
-swept parameter (plus ``run``, and ``time`` when r(t) is kept). Point files hold only
-deterministic content, so the merge does not depend on which executor ran them.
+swept parameter (plus ``run``, and ``time`` when r(t) is kept). Apart from the cost
+attributes, which the merge leaves out, point files hold only deterministic content,
+so the merge does not depend on which executor ran them.
 """
 
 from __future__ import annotations
@@ -24,9 +28,9 @@ import numpy as np
 import xarray as xr
 
 from .._files import write_netcdf
-from ..status import STATUS_ABSENT, STATUS_FAILED
+from ..status import STATUS_ABSENT
 from ..status import SWEEP_FLAG_MEANINGS as FLAG_MEANINGS
-from .grid import UNITS, Grid, PointSpec
+from .grid import UNITS, Grid
 
 #: What each parameter is, for the coordinates of a merged sweep.
 LONG_NAMES = {
@@ -51,36 +55,6 @@ LONG_NAMES = {
 }
 
 
-def point_dataset(spec: PointSpec, result: xr.Dataset | None, error: str = "") -> xr.Dataset:
-    """What is kept of one point: per-run r_eq and status, and optionally r(t).
-
-    ``result`` is the `simulate` output, or None with ``error`` saying why it failed.
-    """
-    runs = spec.kwargs["runs"]
-    attrs = {"key": spec.key, "seed": spec.kwargs["seed"], "error": error}
-    if result is None:
-        nan = np.full(runs, np.nan)
-        data = {
-            "r_eq": ("run", nan),
-            "r_eq_analytic": ("run", nan.copy()),
-            "status": ("run", np.full(runs, STATUS_FAILED, dtype=np.int8)),
-        }
-        attrs.update(r_eq_mean=np.nan, r_eq_std=np.nan)
-        return xr.Dataset(data, attrs=attrs)
-    data = {
-        "r_eq": ("run", result.r_eq.values),
-        "r_eq_analytic": ("run", result.r_eq_analytic.values),
-        "status": ("run", result.status.values.astype(np.int8)),
-    }
-    coords = {}
-    if spec.keep_r:
-        data["r"] = (("time", "run"), result.r.values)
-        data["r_crossing"] = (("time", "run"), result.r_crossing.values)
-        coords["time"] = result.time.values
-    attrs.update(r_eq_mean=result.attrs["r_eq_mean"], r_eq_std=result.attrs["r_eq_std"])
-    return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
 class PointStore:
     """A directory of finished points (see the module docstring)."""
 
@@ -102,13 +76,24 @@ class PointStore:
         with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
             return bool(ds.attrs.get("error", ""))
 
-    def write(self, ds: xr.Dataset, *, seconds: float = float("nan"), host: str = "") -> Path:
-        """Write one point atomically, then log it."""
+    def write(
+        self,
+        ds: xr.Dataset,
+        *,
+        seconds: float = float("nan"),
+        host: str = "",
+        work: int | None = None,
+    ) -> Path:
+        """Write one point atomically with what it cost, then log it.
+
+        ``seconds`` : compute time of the point.   ``host`` : the machine that ran it.
+        ``work`` : oscillator-steps simulated (0 for a failed point; default 0).
+        """
         key = ds.attrs["key"]
+        host = host or socket.gethostname()
+        ds = ds.assign_attrs(compute_seconds=float(seconds), osc_steps=int(work or 0), host=host)
         final = write_netcdf(ds, self.path(key))
-        line = json.dumps(
-            {"key": key, "seconds": round(seconds, 4), "host": host or socket.gethostname()}
-        )
+        line = json.dumps({"key": key, "seconds": round(seconds, 4), "host": host})
         with open(self.log_path, "a") as log:
             log.write(line + "\n")
         return final
@@ -120,6 +105,16 @@ class PointStore:
         if loaded.attrs.get("key") != key:
             raise OSError(f"point file {self.path(key)} holds key {loaded.attrs.get('key')!r}")
         return loaded
+
+    def cost(self, key: str) -> tuple[float, int]:
+        """(compute seconds, oscillator-steps) stored with the point ``key``."""
+        with xr.open_dataset(self.path(key), engine="h5netcdf") as ds:
+            attrs = ds.attrs
+            return float(attrs.get("compute_seconds", np.nan)), int(attrs.get("osc_steps", 0))
+
+    def kept(self, keys) -> int:
+        """How many of ``keys`` are finished (for "k of n points kept" messages)."""
+        return sum(self.has(key) for key in keys)
 
     def logged_keys(self) -> list[str]:
         """Keys of every computation logged, in order (a key twice = computed twice)."""
