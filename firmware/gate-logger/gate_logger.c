@@ -24,11 +24,14 @@
  *                                                    line per change of any gate: gate 1
  *                                                    first, 1 = pin high, the counter in
  *                                                    ticks (decimal);
- *               "# overflow: 12 changes lost"        where changes were lost because the
- *                                                    buffer was full, at their place.
+ *               "# overflow: 12 records lost"        where records (changes of one or more
+ *                                                    gates) were lost because the buffer
+ *                                                    was full, at their place, followed
+ *                                                    by a record of the levels as they
+ *                                                    were when there was room again.
  *   Buffering changes queue in a ring of RING_EVENTS (128) records drained by the UART,
  *             so a burst waits instead of being lost; only a ring that fills drops
- *             changes, and the overflow line then says how many.
+ *             records, and the overflow line then says how many.
  *
  * START_TICKS (default 0) starts the counter elsewhere: only the tests set it, to reach
  * the 32-bit wrap in seconds instead of 76 hours.
@@ -84,7 +87,7 @@
 enum { KIND_CHANGE, KIND_OVERFLOW };
 
 typedef struct {
-    uint32_t value; /* ticks of a change, or the count of changes lost */
+    uint32_t value; /* ticks of a change, or the count of records lost */
     uint8_t levels;
     uint8_t kind;
 } record_t;
@@ -98,7 +101,7 @@ static volatile uint8_t head, tail; /* free-running; head - tail records queued 
 static uint8_t reported;            /* levels of the last change queued */
 static uint8_t holding;             /* gates inside their hold-off */
 static uint16_t since[8];           /* low 16 bits of the tick each hold-off began */
-static uint32_t lost;               /* changes dropped since the last overflow record */
+static uint32_t lost;               /* records dropped since the last overflow record */
 
 /* The line being sent, drained byte by byte by the UART interrupt. */
 static char line[96];
@@ -131,7 +134,7 @@ static void put(uint8_t kind, uint8_t levels, uint32_t value)
 }
 
 /* Queue a change; interrupts must be off. After a loss the overflow record goes first,
-   so it needs two free places and sits in the stream where the changes were lost. */
+   so it needs two free places and sits in the stream where the records were lost. */
 static void push(uint8_t levels, uint32_t ticks)
 {
     uint8_t used = (uint8_t)(head - tail);
@@ -212,7 +215,7 @@ static void format(const record_t *r)
     if (r->kind == KIND_OVERFLOW) {
         n = append(n, "# overflow: ");
         n = append(n, digits);
-        n = append(n, " changes lost");
+        n = append(n, " records lost");
     } else {
         for (uint8_t k = 0; k < CHANNELS; k++) {
             if (k)
@@ -229,11 +232,14 @@ static void setup(void)
 {
     /* The clock first: it starts the time base everything else is measured on. */
     TCCR1A = 0;
-    TCNT1 = (uint16_t)(START_TICKS & 0xFFFFu);
-    ticks_high = (uint16_t)(START_TICKS >> 16);
     TIFR1 = _BV(TOV1);
     TIMSK1 = _BV(TOIE1);
     TCCR1B = _BV(CS12) | _BV(CS10); /* clk / 1024 */
+#if START_TICKS
+    /* After the start: simavr forgets a count written to a stopped timer. */
+    TCNT1 = (uint16_t)(START_TICKS & 0xFFFFu);
+    ticks_high = (uint16_t)(START_TICKS >> 16);
+#endif
 
     DDRD &= (uint8_t)~PORTD_GATES; /* inputs with pull-ups */
     PORTD |= PORTD_GATES;
@@ -270,8 +276,13 @@ int main(void)
     for (;;) {
         cli();
         sample(); /* ends hold-offs, and reports a level a hold-off hid */
-        if (lost && head == tail)
-            put(KIND_OVERFLOW, 0, lost), lost = 0;
+        if (lost && (uint8_t)(RING_EVENTS - (uint8_t)(head - tail)) >= 2) {
+            /* Room again: say what was lost, and give the levels as they are now, so the
+               stream is right again even if no gate changes for a while. */
+            put(KIND_OVERFLOW, 0, lost);
+            lost = 0;
+            put(KIND_CHANGE, reported, now_ticks());
+        }
         uint8_t busy = line_pos < line_len;
         if (!busy && head != tail) {
             record_t r = ring[tail & (RING_EVENTS - 1)];
@@ -281,7 +292,11 @@ int main(void)
             continue;
         }
         if (holding) {
-            sei(); /* a hold-off is running: keep looking until it ends */
+            /* A hold-off is running: keep looking until it ends, with interrupts open
+               for a few cycles each time round (simavr takes one only two instructions
+               after sei, the chip after one). */
+            sei();
+            __asm__ __volatile__("nop\n\tnop\n\tnop" ::: "memory");
             continue;
         }
         /* Nothing to do until a gate, the timer or the UART interrupts. sei takes effect

@@ -23,6 +23,9 @@ HARNESS_C = Path(__file__).with_name("harness.c")
 F_CPU = 16_000_000
 CYCLES_PER_TICK = 1024
 TICK = CYCLES_PER_TICK / F_CPU
+#: START_TICKS of the test builds that reach the counter's wraps in seconds.
+NEAR_32_BIT_WRAP = 0xFFFFF000  # 4096 ticks (0.262 s) before 2**32
+NEAR_16_BIT_WRAP = 0x0000F000  # 4096 ticks before the hardware counter's first overflow
 
 
 def build_firmware(build_dir: Path, *, channels: int = 8, **defines) -> Path:

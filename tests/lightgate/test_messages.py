@@ -19,7 +19,7 @@ BODY = "0-0-0 0\n1-0-0 10\n0-0-0 20\n0-1-0 800\n0-0-0 810\n"
 def test_messages_are_recognised():
     h = parse_message(HEADER)
     assert h == LoggerHeader("1.0", 3, 64e-6, 32, 115200, {"holdoff_ticks": "4"})
-    assert parse_message("# overflow: 12 changes lost\r") == Overflow(12)
+    assert parse_message("# overflow: 12 records lost\r") == Overflow(12)
     assert parse_message(format_gap(12.3456, "/dev/ttyACM0")) == Gap(12.346)
     for other in ("# hello", "0-0 1", "Welcome to minicom", "", "# overflow: many"):
         assert parse_message(other) is None
@@ -55,10 +55,10 @@ def test_header_conflicts_are_errors_that_say_what_to_give():
 
 
 def test_overflow_is_counted_and_reported():
-    lost = "# overflow: 7 changes lost\n0-0-1 900\n# overflow: 2 changes lost\n"
+    lost = "# overflow: 7 records lost\n0-0-1 900\n# overflow: 2 records lost\n"
     log = parse_log(f"{HEADER}\n{BODY}{lost}")
-    assert log.events_lost == 9
-    assert "LOST 9 gate changes" in log.report()
+    assert log.records_lost == 9
+    assert "LOST 9 records" in log.report()
 
 
 def test_restart_after_a_marked_gap_continues_the_time_line():

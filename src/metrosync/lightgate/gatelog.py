@@ -42,7 +42,8 @@ class GateLog:
     n_lines : lines in the capture (a final line end does not start a new line).
     source : file name or ``"<text>"``.
     header : the logger's start-up line (the first one), or None.
-    events_lost : gate changes the logger reported lost (buffer overflow).
+    records_lost : records the logger reported lost (its buffer overflowed); each would
+        have shown a change of one or more gates.
     restarts : line of the first record after each restart of the logger.
     """
 
@@ -57,7 +58,7 @@ class GateLog:
     n_lines: int
     source: str = "<text>"
     header: LoggerHeader | None = None
-    events_lost: int = 0
+    records_lost: int = 0
     restarts: tuple[int, ...] = ()
 
     @property
@@ -88,8 +89,8 @@ class GateLog:
             h = self.header
             lines.append(f"  logger: gate-logger {h.version}, {h.channels} gates, "
                          f"{h.tick * 1e6:g} us tick, {h.counter_bits}-bit counter")  # fmt: skip
-        if self.events_lost:
-            lines.append(f"  LOST {self.events_lost} gate changes: the logger's buffer overflowed")
+        if self.records_lost:
+            lines.append(f"  LOST {self.records_lost} records: the logger's buffer overflowed")
         if self.restarts:
             shown = ", ".join(map(str, self.restarts))
             lines.append(

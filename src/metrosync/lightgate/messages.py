@@ -14,7 +14,7 @@ program shows it and the record pattern never matches it.
   counter began again.
 * The overflow line, where the logger's buffer was full and gate changes were lost::
 
-      # overflow: 12 changes lost
+      # overflow: 12 records lost
 
 * The gap line, written by ``metrosync record --reconnect`` where the port vanished and
   came back: the wall-clock time from the last line before the loss to the first line
@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 from ..errors import LogFormatError
 
 _HEADER = re.compile(r"^\s*#\s*metrosync gate-logger\s+(\S+)((?:\s+\w+=\S*)*)\s*$")
-_OVERFLOW = re.compile(r"^\s*#\s*overflow:\s*(\d+) changes? lost\s*$")
+_OVERFLOW = re.compile(r"^\s*#\s*overflow:\s*(\d+) records? lost\s*$")
 _GAP = re.compile(r"^\s*#\s*metrosync record: gap of ([0-9.]+(?:e[+-]?\d+)?) s\b.*$")
 _NEEDED = ("channels", "tick_us", "counter_bits")
 
@@ -57,7 +57,7 @@ class LoggerHeader:
 
 @dataclass(frozen=True)
 class Overflow:
-    """The logger lost ``count`` gate changes here (its buffer was full)."""
+    """The logger lost ``count`` records here (its buffer was full)."""
 
     count: int
 

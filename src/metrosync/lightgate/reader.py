@@ -21,7 +21,7 @@ a terminal program are messy, so the reader
 
 * reads the lines the gate-logger firmware and `metrosync record` add (`messages`):
   the logger's start-up header (its tick must agree with ``tick``, and its counter
-  width is used when ``counter_bits="auto"``), its overflow lines (``events_lost``),
+  width is used when ``counter_bits="auto"``), its overflow lines (``records_lost``),
   and a restart of the logger (a header after the first record, where its counter
   began again): the records after it continue the time line after the wall-clock
   gap that `record` marked before it. These lines are listed in ``skipped`` too (with
@@ -220,7 +220,7 @@ def assemble(
         n_lines=len(lines),
         source=source,
         header=header,
-        events_lost=lost,
+        records_lost=lost,
         restarts=tuple(int(numbers[i]) for i in starts),
     )
 
