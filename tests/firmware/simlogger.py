@@ -42,7 +42,7 @@ def build_firmware(build_dir: Path, *, channels: int = 8, **defines) -> Path:
 def build_harness(build_dir: Path) -> Path:
     """Compile the simavr harness; returns the program."""
     exe = Path(build_dir) / "harness"
-    subprocess.run(["cc", "-O2", "-Wall", "-o", str(exe), str(HARNESS_C), "-lsimavr"],
+    subprocess.run(["gcc", "-O2", "-Wall", "-o", str(exe), str(HARNESS_C), "-lsimavr"],
                    check=True, capture_output=True)  # fmt: skip
     return exe
 
