@@ -202,7 +202,9 @@ def assemble(
         bits = _agree_with_header(header, records, tick, bits, source)
 
     numbers = np.array([r[0] for r in records], dtype=np.int64)
-    levels = np.array([[int(c) for c in r[1]] for r in records], dtype=np.uint8)
+    k = len(records[0][1])
+    levels = (np.frombuffer("".join(r[1] for r in records).encode("ascii"), dtype=np.uint8)
+              - ord("0")).reshape(len(records), k)  # fmt: skip
     raw = [r[2] for r in records]
     starts = [i for i, r in enumerate(records) if r[3] is not None and i > 0]
     ticks, used_bits, wraps = unwrap_segments(raw, numbers, bits, source, starts,
