@@ -43,6 +43,9 @@ def follow(args, analyze_options: dict) -> int:
             pass
         follower.poll(final=True)
         panel.tick(time.monotonic() - last, force=True)
+    if not path.exists():
+        raise ParameterError(f"{str(path)!r} does not exist: nothing was written to it while "
+                             f"it was followed, so there is nothing to analyse.")  # fmt: skip
     ds = analyze_logs([follower.log()], counter_bits=reading["counter_bits"],
                       polarity=reading["polarity"], **analyze_options)  # fmt: skip
     print(summary(ds))
