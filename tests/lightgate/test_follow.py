@@ -108,3 +108,13 @@ def test_analyze_follow_refuses_several_logs(capsys):
     clean = str(DATA / "clean.log")
     assert main(["analyze", clean, clean, "--follow"]) == 2
     assert "`--follow` follows one LOG, got 2" in capsys.readouterr().err
+
+
+def test_a_follower_that_keeps_recent_lines_only_reads_them_with_the_header():
+    follower = LogFollower(keep=30)
+    for line in LIVE.splitlines(keepends=True):
+        follower.feed(line)
+    assert len(follower.lines) <= 60 and follower.n_lines == LIVE.count("\n")
+    window = follower.log(last=30)
+    assert window.header is not None and window.n_lines == 31
+    assert np.array_equal(window.levels, parse_log(LIVE).levels[-len(window.ticks) :])

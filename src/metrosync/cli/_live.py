@@ -83,7 +83,7 @@ class LivePanel:
             print(self._plain(status, note), file=self.stream, flush=True)
 
     def _plain(self, status: LiveStatus | None, note: str) -> str:
-        head = f"live t={time.monotonic() - self._start:.1f}s lines={len(self.follower.lines)}"
+        head = f"live t={time.monotonic() - self._start:.1f}s lines={self.follower.n_lines}"
         if status is None:
             return f"{head} {note}"
         gates = " ".join(
@@ -101,7 +101,7 @@ class LivePanel:
         from rich.text import Text
 
         elapsed = time.monotonic() - self._start
-        foot = Text(f"{elapsed:.0f} s, {len(self.follower.lines)} lines", style="dim")
+        foot = Text(f"{elapsed:.0f} s, {self.follower.n_lines} lines", style="dim")
         if status is None:
             return Panel(Group(Text(note), foot), title=self.title)
         table = Table(box=None, pad_edge=False)

@@ -39,7 +39,7 @@ def run(args) -> int:
     from ..lightgate.follow import LogFollower
     from ..lightgate.recorder import record
     from ._io import check_output
-    from ._live import LivePanel
+    from ._live import LIVE_LINES, LivePanel
 
     check_output(args.out, "--out")
     if args.out.exists() and not args.overwrite:
@@ -48,7 +48,7 @@ def run(args) -> int:
         )
     if args.channels is not None and any(not 0 <= c < 8 for c in args.channels):
         raise ParameterError(f"`--channels` must be gates 0..7, got {args.channels!r}.")
-    follower = LogFollower()
+    follower = LogFollower(keep=LIVE_LINES)  # the live view only: the file keeps it all
     title = f"recording {args.port} -> {args.out}"
     with LivePanel(follower, title, channels=args.channels, plain=args.plain or None) as panel:
         summary = record(args.port, args.out, baud=args.baud, duration=args.duration,

@@ -30,6 +30,9 @@ class LogFollower:
     ----------
     path : the capture to follow (None to take text only through `feed`).
     tick, counter_bits, polarity, strict : as for `read_log`.
+    keep : keep only about this many recent lines in memory (and the logger's first
+        header), for a live view of a run of days; `log` then reads those. None keeps
+        every line, as the final analysis of a followed file needs.
     """
 
     def __init__(
@@ -40,7 +43,10 @@ class LogFollower:
         counter_bits: int | str | None = "auto",
         polarity: int | str = "auto",
         strict: bool = False,
+        keep: int | None = None,
     ):
+        self.keep = keep
+        self.n_lines = 0  # complete lines seen, kept or not
         self.path = None if path is None else Path(path)
         self.options = dict(tick=tick, counter_bits=counter_bits, polarity=polarity, strict=strict)
         self.source = "<stream>" if path is None else str(path)
@@ -102,6 +108,11 @@ class LogFollower:
                 for k, (a, b) in enumerate(zip(last, line.gates, strict=True)):
                     self._changes[k] += a != b
             self._last_gates = line.gates
+        self.n_lines += len(new)
+        if self.keep is not None and len(self.lines) > 2 * self.keep:
+            del self.lines[: len(self.lines) - self.keep]
+            if self._header is not None:
+                self._header = (-1, self._header[1])  # now before every kept line
         return len(new)
 
     @property
@@ -119,12 +130,10 @@ class LogFollower:
         Raises `EmptyLogError` (a `LogFormatError`) while it has no record yet.
         """
         tail, terminated = split_lines(self._pending)
-        lines = self.lines
-        if last is not None and len(lines) > last:
-            if self._header is not None and self._header[0] < len(lines) - last:
-                lines = [self._header[1], *lines[-last:]]
-            else:
-                lines = lines[-last:]
+        first = 0 if last is None else max(0, len(self.lines) - last)
+        lines = self.lines[first:]
+        if self._header is not None and self._header[0] < first:  # -1: trimmed (`keep`)
+            lines = [self._header[1], *lines]
         lines = lines + [classify(line) for line in tail]
         if not lines:
             raise EmptyLogError(f"{self.source}: the light-gate log is empty (no lines).")
