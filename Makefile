@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint bench clean system-deps
+.PHONY: run test lint bench clean system-deps firmware
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +26,10 @@ system-deps:
 test: $(STAMP) system-deps
 	$(BIN)/python -m pytest
 
+# The gate-logger firmware (needs gcc-avr and avr-libc): firmware/gate-logger/build/gate-logger.hex
+firmware:
+	$(MAKE) -C firmware/gate-logger
+
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
 
@@ -33,4 +37,4 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/kernel.py
 
 clean:
-	rm -rf $(VENV) results build *.egg-info
+	rm -rf $(VENV) results build *.egg-info firmware/gate-logger/build

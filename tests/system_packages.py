@@ -18,6 +18,7 @@ PROBES = {
     "avr-libc": ("file", "/usr/lib/avr/include/avr/io.h"),
     "simavr": ("program", "simavr"),
     "libsimavr-dev": ("file", "/usr/include/simavr/sim_avr.h"),
+    "gcc": ("program", "gcc"),
 }
 
 

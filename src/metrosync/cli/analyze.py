@@ -59,6 +59,10 @@ def register(subparsers) -> None:
     out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
     out.add_argument("--plot", type=Path, default=None,
                      help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
+    out.add_argument("--follow", action="store_true",
+                     help="follow a LOG that is still being written (by `metrosync record` or "
+                     "a terminal program), with a live panel; at Ctrl-C analyse it and write "
+                     "--out/--plot")  # fmt: skip
     add_aliases(parser, equilibrium_window="--window")
     parser.set_defaults(func=run)
 
@@ -69,8 +73,7 @@ def run(args) -> int:
 
     check_output(args.out, "--out", suffixes=NETCDF)
     check_output(args.plot, "--plot", suffixes=FIGURE)
-    ds = analyze(
-        args.logs,
+    options = dict(
         tick=args.tick,
         counter_bits=args.counter_bits,
         polarity=args.polarity if args.polarity == "auto" else int(args.polarity),
@@ -81,6 +84,11 @@ def run(args) -> int:
         grid_dt=args.grid_dt,
         equilibrium_window=args.window,
     )
+    if getattr(args, "follow", False):
+        from ._follow import follow
+
+        return follow(args, options)
+    ds = analyze(args.logs, **options)
     print(summary(ds))
     write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
     return 0

@@ -11,7 +11,8 @@ experiments. The dataset holds
     frequency_bpm      (metronome)         mean frequency, averaged over logs, BPM
     frequency_bpm_runs (log, metronome)    mean frequency per log, BPM
     period_jitter      (log, metronome)    std of single periods, s
-    passes_kept, passes_dropped, lines_skipped, counter_wraps   counts per log
+    passes_kept, passes_dropped, lines_skipped, counter_wraps, records_lost
+                                           counts per log
                                            (and metronome)
     direction_ambiguous, interrupted_level (log, metronome)   what the cleaning
                                            and the reader found about each gate
@@ -42,6 +43,7 @@ from .cleaning import (
     clean_log,
     cleaning_report,
 )
+from .gatelog import GateLog
 from .reader import DEFAULT_TICK, read_log
 
 
@@ -85,12 +87,38 @@ def analyze(
         raise ParameterError("`paths` is empty: give at least one light-gate log.")
     if not (np.isfinite(grid_dt) and grid_dt > 0):
         raise ParameterError(f"`grid_dt` must be a time > 0 s, got {grid_dt!r}.")
+    logs = [read_log(path, tick=tick, counter_bits=counter_bits, polarity=polarity,
+                     strict=strict) for path in paths]  # fmt: skip
+    return analyze_logs(logs, counter_bits=counter_bits, polarity=polarity, channels=channels,
+                        glitch=glitch, max_interruption=max_interruption,
+                        min_asymmetry=min_asymmetry, grid_dt=grid_dt,
+                        equilibrium_window=equilibrium_window)  # fmt: skip
+
+
+def analyze_logs(
+    logs: Sequence[GateLog],
+    *,
+    counter_bits: int | str | None = "auto",
+    polarity: int | str = "auto",
+    channels: Sequence[int] | None = None,
+    glitch: float = DEFAULT_GLITCH,
+    max_interruption: float = DEFAULT_MAX_INTERRUPTION,
+    min_asymmetry: float = DEFAULT_MIN_ASYMMETRY,
+    grid_dt: float = 0.1,
+    equilibrium_window: float | None = None,
+) -> xr.Dataset:
+    """`analyze` of logs already read (`read_log`, or `LogFollower.log` for a growing one).
+
+    counter_bits, polarity : the reading options the logs were read with (recorded in
+    attrs); the other parameters are `analyze`'s.
+    """
+    if not logs:
+        raise ParameterError("`logs` is empty: give at least one light-gate log.")
+    if not (np.isfinite(grid_dt) and grid_dt > 0):
+        raise ParameterError(f"`grid_dt` must be a time > 0 s, got {grid_dt!r}.")
+    tick = logs[0].tick
     options = dict(glitch=glitch, max_interruption=max_interruption, min_asymmetry=min_asymmetry)
-    logs, cleaned = [], []
-    for path in paths:
-        log = read_log(path, tick=tick, counter_bits=counter_bits, polarity=polarity, strict=strict)
-        logs.append(log)
-        cleaned.append(clean_log(log, **options))
+    cleaned = [clean_log(log, **options) for log in logs]
     k = logs[0].channels
     for log in logs[1:]:
         if log.channels != k:
@@ -157,7 +185,9 @@ def analyze(
                           {"long_name": "lines that are not gate records"}),
         "counter_wraps": (("log",), np.array([log.wraps for log in logs]),
                           {"long_name": "times the logger's counter wrapped"}),
-        "path": (("log",), np.array([str(p) for p in paths]), {"long_name": "log file"}),
+        "records_lost": (("log",), np.array([log.records_lost for log in logs]),
+                         {"long_name": "records the logger reported lost (buffer overflow)"}),
+        "path": (("log",), np.array([log.source for log in logs]), {"long_name": "log file"}),
     }  # fmt: skip
     attrs = {
         "r_eq": r_eq,
@@ -183,7 +213,7 @@ def analyze(
                 {"units": "s", "long_name": "time since each log's first record"},
             ),
             "metronome": ("metronome", np.array(chosen), {"long_name": "gate index (0-based)"}),
-            "log": ("log", np.arange(len(paths)), {"long_name": "log index, in argument order"}),
+            "log": ("log", np.arange(len(logs)), {"long_name": "log index, in argument order"}),
         },
         attrs=attrs,
     )

@@ -19,10 +19,21 @@ a terminal program are messy, so the reader
   short moment per pass, so the interrupted level is the one whose spells are
   shorter (median spell length).
 
+* reads the lines the gate-logger firmware and `metrosync record` add (`messages`):
+  the logger's start-up header (its tick must agree with ``tick``, and its counter
+  width is used when ``counter_bits="auto"``), its overflow lines (``records_lost``),
+  and a restart of the logger (a header after the first record, where its counter
+  began again): the records after it continue the time line after the wall-clock
+  gap that `record` marked before it. These lines are listed in ``skipped`` too (with
+  their reason), but ``strict`` does not refuse them.
+
 It refuses, with a `LogFormatError` subclass, an empty capture (`EmptyLogError`), a
-number of gates that changes mid-file (`ChannelCountError`) and timestamps that no
-wrap explains (`TimestampError`). Every line is accounted for:
-``n_lines == records + len(skipped)``.
+number of gates that changes mid-file or differs from the header's
+(`ChannelCountError`), timestamps that no wrap explains and a restart with no marked
+gap (`TimestampError`). Every line is accounted for: ``n_lines == records + len(skipped)``.
+
+`split_lines`, `classify` and `assemble` are the steps of `parse_log`; `follow` reads
+a growing capture with them, line by line, and gets the same `GateLog`.
 """
 
 from __future__ import annotations
@@ -40,91 +51,18 @@ from ..errors import (
     EmptyLogError,
     ParameterError,
     StrictModeError,
-    TimestampError,
 )
+from .counter import check_bits, unwrap_segments
+from .gatelog import GateLog, SkippedLine
+from .messages import Gap, LoggerHeader, Overflow, parse_message
 
 #: The logger follows at most this many gates.
 MAX_GATES = 8
 #: The logger's clock tick, s (paper §2).
 DEFAULT_TICK = 64e-6
-#: Counter widths accepted, bits.
-COUNTER_BITS_RANGE = (8, 62)
 
 _RECORD = re.compile(r"^[ \t]*([01](?:-[01])*)[ \t]+(\d{1,19})[ \t]*$")
 _LINE_END = re.compile(r"\r\n|\r|\n")
-
-
-@dataclass(frozen=True)
-class SkippedLine:
-    """A line that is not a gate record: 1-based ``line_number``, ``reason``, ``text``."""
-
-    line_number: int
-    reason: str
-    text: str
-
-    def __str__(self) -> str:
-        return f"line {self.line_number}: {self.reason}: {self.text!r}"
-
-
-@dataclass(frozen=True)
-class GateLog:
-    """One capture, parsed.
-
-    levels : (R, K) uint8, the raw gate levels of each record.
-    ticks : (R,) int64, counter ticks since the first record (unwrapped).
-    line_numbers : (R,) int64, 1-based line of each record.
-    interrupted_level : (K,) int8, the level that means "beam interrupted";
-        -1 for a gate that never changes (its polarity cannot be told).
-    tick : seconds per tick.
-    counter_bits : counter width used to unwrap, or None when nothing wrapped.
-    wraps : how many times the counter wrapped.
-    skipped : every line that is not a record.
-    n_lines : lines in the capture (a final line end does not start a new line).
-    source : file name or ``"<text>"``.
-    """
-
-    levels: np.ndarray
-    ticks: np.ndarray
-    line_numbers: np.ndarray
-    interrupted_level: np.ndarray
-    tick: float
-    counter_bits: int | None
-    wraps: int
-    skipped: tuple[SkippedLine, ...]
-    n_lines: int
-    source: str = "<text>"
-
-    @property
-    def times(self) -> np.ndarray:
-        """(R,) seconds since the first record."""
-        return self.ticks * self.tick
-
-    @property
-    def channels(self) -> int:
-        """Number of gates K per record."""
-        return self.levels.shape[1]
-
-    @property
-    def interrupted(self) -> np.ndarray:
-        """(R, K) bool, True while a gate's beam is interrupted."""
-        return self.levels == self.interrupted_level[None, :]
-
-    def report(self) -> str:
-        """Human-readable account of the reading: records, wraps, polarity, skipped lines."""
-        bits = "no wrap" if self.counter_bits is None else f"{self.counter_bits}-bit counter"
-        polarity = " ".join("?" if p < 0 else str(int(p)) for p in self.interrupted_level)
-        lines = [
-            f"{self.source}: {len(self.ticks)} records of {self.channels} gates in "
-            f"{self.n_lines} lines, {self.times[-1]:.3f} s, {bits}, {self.wraps} wraps, "
-            f"interrupted level per gate: {polarity}",
-            f"  skipped {len(self.skipped)} lines",
-        ]
-        reasons = Counter(s.reason for s in self.skipped)
-        for reason, count in sorted(reasons.items()):
-            numbers = [s.line_number for s in self.skipped if s.reason == reason]
-            shown = ", ".join(map(str, numbers[:12])) + (", ..." if len(numbers) > 12 else "")
-            lines.append(f"    {count} x {reason} (lines {shown})")
-        return "\n".join(lines)
 
 
 def read_log(
@@ -173,45 +111,104 @@ def parse_log(
     source: str = "<text>",
 ) -> GateLog:
     """Parse the text of a capture; see `read_log` for the parameters."""
-    if not (isinstance(tick, int | float) and math.isfinite(tick) and tick > 0):
-        raise ParameterError(f"`tick` must be a time > 0 s, got {tick!r}.")
-    bits = _check_bits(counter_bits)
-    if polarity not in ("auto", 0, 1):
-        raise ParameterError(f"`polarity` must be 'auto', 0 or 1, got {polarity!r}.")
-    lines = _LINE_END.split(text)
-    terminated = True
-    if lines and lines[-1] == "":
-        lines.pop()  # the final line end does not open a new line
-    elif lines:
-        terminated = False
+    _check_reading(tick, counter_bits, polarity)
+    lines, terminated = split_lines(text)
     if not lines:
         raise EmptyLogError(f"{source}: the light-gate log is empty (no lines).")
+    return assemble([classify(line) for line in lines], terminated, tick=tick,
+                    counter_bits=counter_bits, polarity=polarity, strict=strict,
+                    source=source)  # fmt: skip
 
-    skipped: list[SkippedLine] = []
-    records: list[tuple[int, str, int]] = []  # (line number, levels, ticks)
-    for number, line in enumerate(lines, start=1):
-        match = _RECORD.match(line)
-        if match is None:
-            reason = "blank line" if not line.strip() else _why_not_record(line)
-            _skip(skipped, number, reason, line, strict, source)
-            continue
+
+@dataclass(frozen=True, slots=True)
+class Line:
+    """One line of a capture, classified: a record (``gates``, ``value``) or not (``reason``)."""
+
+    text: str
+    gates: str | None = None
+    value: int | None = None
+    reason: str | None = None
+    message: LoggerHeader | Overflow | Gap | None = None
+
+
+_REASONS = {LoggerHeader: "logger header", Overflow: "logger overflow", Gap: "recording gap"}
+
+
+def split_lines(text: str) -> tuple[list[str], bool]:
+    """The lines of a capture, and whether the last one ended with a line end."""
+    lines = _LINE_END.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()  # the final line end does not open a new line
+        return lines, True
+    return lines, not lines
+
+
+def classify(line: str) -> Line:
+    """What one line is: a gate record, a message of the logger or `record`, or other text."""
+    match = _RECORD.match(line)
+    if match is not None:
         gates = match.group(1).replace("-", "")
         if len(gates) > MAX_GATES:
-            _skip(skipped, number, f"more than {MAX_GATES} gates", line, strict, source)
+            return Line(line, reason=f"more than {MAX_GATES} gates")
+        return Line(line, gates=gates, value=int(match.group(2)))
+    message = parse_message(line)
+    if message is not None:
+        return Line(line, reason=_REASONS[type(message)], message=message)
+    return Line(line, reason="blank line" if not line.strip() else _why_not_record(line))
+
+
+def assemble(
+    lines: list[Line],
+    terminated: bool,
+    *,
+    tick: float = DEFAULT_TICK,
+    counter_bits: int | str | None = "auto",
+    polarity: int | str = "auto",
+    strict: bool = False,
+    source: str = "<text>",
+) -> GateLog:
+    """The `GateLog` of classified lines (see `parse_log` for the options)."""
+    bits = _check_reading(tick, counter_bits, polarity)
+    if not lines:
+        raise EmptyLogError(f"{source}: the light-gate log is empty (no lines).")
+    texts = [line.text for line in lines]
+    skipped: list[SkippedLine] = []
+    # (line number, levels, ticks, gap before it: None, or seconds, NaN if unknown)
+    records: list[tuple[int, str, int, float | None]] = []
+    header, lost, restart, gap = None, 0, False, None
+    for number, line in enumerate(lines, start=1):
+        if line.gates is None:
+            message = line.message
+            _skip(skipped, number, line.reason, line.text, strict and message is None, source)
+            if isinstance(message, LoggerHeader):
+                header = header or message
+                restart = restart or bool(records)  # a header after a record: a restart
+            elif isinstance(message, Overflow):
+                lost += message.count
+            elif isinstance(message, Gap):
+                gap = message.seconds
             continue
-        records.append((number, gates, int(match.group(2))))
+        before = (math.nan if gap is None else gap) if restart else None
+        records.append((number, line.gates, line.value, before))
+        restart, gap = False, None  # a gap without a restart: the counter went on
     if not records:
         raise EmptyLogError(
             f"{source}: no gate record in {len(lines)} lines (a record looks like "
             f"'0-1-0-0 1450'); {len(skipped)} lines skipped."
         )
-    records = _drop_partial_ends(records, skipped, lines, strict, source)
-    records = _drop_partial_last_tick(records, skipped, lines, terminated, strict, source)
+    records = _drop_partial_ends(records, skipped, texts, strict, source)
+    records = _drop_partial_last_tick(records, skipped, texts, terminated, strict, source)
+    if header is not None:
+        bits = _agree_with_header(header, records, tick, bits, source)
 
     numbers = np.array([r[0] for r in records], dtype=np.int64)
-    levels = np.array([[int(c) for c in r[1]] for r in records], dtype=np.uint8)
+    k = len(records[0][1])
+    levels = (np.frombuffer("".join(r[1] for r in records).encode("ascii"), dtype=np.uint8)
+              - ord("0")).reshape(len(records), k)  # fmt: skip
     raw = [r[2] for r in records]
-    ticks, used_bits, wraps = _unwrap(raw, numbers, bits, source)
+    starts = [i for i, r in enumerate(records) if r[3] is not None and i > 0]
+    ticks, used_bits, wraps = unwrap_segments(raw, numbers, bits, source, starts,
+                                               [records[i][3] for i in starts], tick)  # fmt: skip
     level = _polarity(levels, ticks) if polarity == "auto" else np.full(levels.shape[1], polarity)
     return GateLog(
         levels=levels,
@@ -224,23 +221,40 @@ def parse_log(
         skipped=tuple(sorted(skipped, key=lambda s: s.line_number)),
         n_lines=len(lines),
         source=source,
+        header=header,
+        records_lost=lost,
+        restarts=tuple(int(numbers[i]) for i in starts),
     )
 
 
-def _check_bits(counter_bits) -> int | str | None:
-    if counter_bits is None or counter_bits == "auto":
-        return counter_bits
-    lo, hi = COUNTER_BITS_RANGE
-    if (
-        isinstance(counter_bits, bool)
-        or not isinstance(counter_bits, int | np.integer)
-        or not (lo <= counter_bits <= hi)
-    ):
+def _check_reading(tick, counter_bits, polarity):
+    if not (isinstance(tick, int | float) and math.isfinite(tick) and tick > 0):
+        raise ParameterError(f"`tick` must be a time > 0 s, got {tick!r}.")
+    bits = check_bits(counter_bits)
+    if polarity not in ("auto", 0, 1):
+        raise ParameterError(f"`polarity` must be 'auto', 0 or 1, got {polarity!r}.")
+    return bits
+
+
+def _agree_with_header(header: LoggerHeader, records, tick, bits, source):
+    """The header's counter width when none is given; a conflict with it is an error."""
+    if abs(header.tick - tick) > 1e-9 * tick:
         raise ParameterError(
-            f"`counter_bits` must be 'auto', None or an integer in [{lo}, {hi}], "
-            f"got {counter_bits!r}."
+            f"{source}: `tick` is {tick:g} s but the logger's header says {header.tick:g} s; "
+            f"give tick={header.tick:g} (CLI: --tick {header.tick:g})."
         )
-    return int(counter_bits)
+    if isinstance(bits, int) and bits != header.counter_bits:
+        raise ParameterError(
+            f"{source}: `counter_bits` is {bits} but the logger's header says "
+            f"{header.counter_bits}; give 'auto' to use the header's."
+        )
+    k = len(records[0][1])
+    if k != header.channels:
+        raise ChannelCountError(
+            f"{source}: line {records[0][0]}: {k} gates, but the logger's header says "
+            f"{header.channels}; the capture mixes loggers. Split it where the logger changed."
+        )
+    return header.counter_bits if bits == "auto" else bits
 
 
 def _why_not_record(line: str) -> str:
@@ -275,7 +289,7 @@ def _drop_partial_ends(records, skipped, lines, strict, source):
             reason = f"partial record ({len(out[end][1])} gates, expected {k})"
             _skip(skipped, number, reason, lines[number - 1], strict, source)
             out.pop(end)
-    for number, gates, _ in out:
+    for number, gates, *_ in out:
         if len(gates) != k:
             raise ChannelCountError(
                 f"{source}: line {number}: {len(gates)} gates, but the log has {k} gates per "
@@ -300,47 +314,6 @@ def _drop_partial_last_tick(records, skipped, lines, terminated, strict, source)
     number = records[-1][0]
     _skip(skipped, number, "partial record (cut-off timestamp)", lines[number - 1], strict, source)
     return records[:-1]
-
-
-def _unwrap(
-    raw: list[int], numbers: np.ndarray, bits, source
-) -> tuple[np.ndarray, int | None, int]:
-    """Ticks since the first record, undoing counter overflows."""
-    top = max(raw)
-    if top >= 1 << COUNTER_BITS_RANGE[1]:
-        line = int(numbers[raw.index(top)])
-        raise TimestampError(f"{source}: line {line}: timestamp {top} is out of range.")
-    v = np.array(raw, dtype=np.int64)
-    back = np.flatnonzero(np.diff(v) < 0) + 1
-    if isinstance(bits, int) and top >= 1 << bits:
-        line = int(numbers[raw.index(top)])
-        raise TimestampError(
-            f"{source}: line {line}: timestamp {top} does not fit the {bits}-bit counter "
-            f"(`counter_bits` = {bits}); give the logger's real width or 'auto'."
-        )
-    if back.size == 0:
-        return v - v[0], (bits if isinstance(bits, int) else None), 0
-    if bits is None:
-        i = int(back[0])
-        raise TimestampError(
-            f"{source}: line {int(numbers[i])}: time goes back from {raw[i - 1]} to {raw[i]} "
-            f"ticks, but `counter_bits` is None (a counter that never wraps). Give the "
-            f"counter width, or 'auto'."
-        )
-    width = bits if isinstance(bits, int) else max(top.bit_length(), COUNTER_BITS_RANGE[0])
-    modulus = 1 << width
-    drops = v[back - 1] - v[back]
-    bad = drops <= modulus // 2
-    if np.any(bad):
-        i = int(back[np.argmax(bad)])
-        raise TimestampError(
-            f"{source}: line {int(numbers[i])}: time goes back from {raw[i - 1]} to {raw[i]} "
-            f"ticks, which is no wrap of a {width}-bit counter (a wrap jumps back by about "
-            f"{modulus}). The log is out of order or corrupted there."
-        )
-    steps = np.zeros(v.size, dtype=np.int64)
-    steps[back] = modulus
-    return v - v[0] + np.cumsum(steps), width, int(back.size)
 
 
 def _polarity(levels: np.ndarray, ticks: np.ndarray) -> np.ndarray:

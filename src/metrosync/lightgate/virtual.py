@@ -26,7 +26,8 @@ import numpy as np
 
 from .._files import write_text
 from ..errors import ParameterError
-from .reader import COUNTER_BITS_RANGE, DEFAULT_TICK, MAX_GATES
+from .counter import COUNTER_BITS_RANGE
+from .reader import DEFAULT_TICK, MAX_GATES
 
 _BISECTIONS = 48
 

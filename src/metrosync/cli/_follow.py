@@ -1,0 +1,53 @@
+"""``metrosync analyze --follow``: a growing capture, live, then its dataset at Ctrl-C."""
+
+from __future__ import annotations
+
+import time
+
+from ..errors import ParameterError
+
+#: Seconds between two looks at the followed file.
+POLL_EVERY = 0.1
+
+
+def follow(args, analyze_options: dict) -> int:
+    """Follow ``args.logs[0]`` with the live panel until Ctrl-C, then analyse it whole.
+
+    analyze_options : the keyword arguments `analyze` gets, reading options included.
+    """
+    from ..lightgate.analyze import analyze_logs
+    from ..lightgate.follow import LogFollower
+    from ..lightgate.plots import plot_analysis
+    from ._io import write_outputs
+    from ._live import LivePanel
+    from .analyze import summary
+
+    if len(args.logs) != 1:
+        raise ParameterError(
+            f"`--follow` follows one LOG, got {len(args.logs)}; analyse finished runs "
+            f"together without --follow."
+        )
+    path = args.logs[0]
+    reading = {k: analyze_options.pop(k) for k in ("tick", "counter_bits", "polarity", "strict")}
+    follower = LogFollower(path, **reading)
+    last = time.monotonic()
+    with LivePanel(follower, f"following {path} (Ctrl-C: analyse and stop)",
+                   channels=analyze_options.get("channels")) as panel:  # fmt: skip
+        try:
+            while True:
+                if follower.poll():
+                    last = time.monotonic()
+                panel.tick(time.monotonic() - last)
+                time.sleep(POLL_EVERY)
+        except KeyboardInterrupt:
+            pass
+        follower.poll(final=True)
+        panel.tick(time.monotonic() - last, force=True)
+    if not path.exists():
+        raise ParameterError(f"{str(path)!r} does not exist: nothing was written to it while "
+                             f"it was followed, so there is nothing to analyse.")  # fmt: skip
+    ds = analyze_logs([follower.log()], counter_bits=reading["counter_bits"],
+                      polarity=reading["polarity"], **analyze_options)  # fmt: skip
+    print(summary(ds))
+    write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
+    return 0

@@ -1,0 +1,66 @@
+"""``metrosync record``: the logger's serial stream → a capture file, with a live panel."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ..errors import ParameterError
+from ._options import HelpFormatter, add_aliases, int_list
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "record",
+        help="record a light-gate logger's serial stream, with a live r(t)",
+        description="Read the gate-logger's lines from a serial port and write them, line "
+        "for line, to a capture file that `metrosync analyze` reads (flushed at once, synced "
+        "to disk every second). Shows a live panel: passes and BPM per gate, silent gates, "
+        "and r(t). Ctrl-C ends the recording cleanly.",
+        formatter_class=HelpFormatter,
+    )
+    parser.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyACM0 or COM3")
+    parser.add_argument("--out", type=Path, required=True, help="capture file to write")
+    parser.add_argument("--baud", type=int, default=115200, help="serial rate (the firmware's)")
+    parser.add_argument("--duration", type=float, default=None, metavar="S",
+                        help="stop after S seconds (default: at Ctrl-C)")  # fmt: skip
+    parser.add_argument("--channels", type=int_list, default=None, metavar="I,J,...",
+                        help="gates to show and use for the live r, 0-based (default: all)")
+    parser.add_argument("--reconnect", action="store_true",
+                        help="when the port vanishes, wait for it and mark the gap")  # fmt: skip
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    parser.add_argument("--plain", action="store_true",
+                        help="plain status lines instead of the panel, even on a terminal")
+    add_aliases(parser, duration="--duration", baud="--baud", port="PORT")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..lightgate.follow import LogFollower
+    from ..lightgate.recorder import record
+    from ._io import check_output
+    from ._live import LIVE_LINES, LivePanel
+
+    check_output(args.out, "--out")
+    if args.out.exists() and not args.overwrite:
+        raise ParameterError(
+            f"`--out` {str(args.out)!r} exists; choose another name, or give --overwrite."
+        )
+    if args.channels is not None and any(not 0 <= c < 8 for c in args.channels):
+        raise ParameterError(f"`--channels` must be gates 0..7, got {args.channels!r}.")
+    follower = LogFollower(keep=LIVE_LINES)  # the live view only: the file keeps it all
+    title = f"recording {args.port} -> {args.out}"
+    with LivePanel(follower, title, channels=args.channels, plain=args.plain or None) as panel:
+        summary = record(args.port, args.out, baud=args.baud, duration=args.duration,
+                         reconnect=args.reconnect, overwrite=args.overwrite,
+                         on_line=follower.feed, on_tick=panel.tick)  # fmt: skip
+        panel.tick(force=True)
+    print(f"metrosync record: {summary}", flush=True)
+    if summary.ended == "port vanished":
+        print(
+            f"metrosync record: error: the port {args.port} vanished (cable pulled?); the "
+            f"capture {args.out} is kept. Give --reconnect to wait for it.",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
