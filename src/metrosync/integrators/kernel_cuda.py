@@ -18,14 +18,8 @@ import math
 import numpy as np
 from numba import cuda, float64
 
-from ._state import (
-    RECORD_FIELDS,
-    STATE_FIELDS,
-    STATUS_DIVERGED,
-    STATUS_OVERTURNED,
-    SYSTEM_FIELDS,
-    StepState,
-)
+from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
+from ._state import RECORD_FIELDS, STATE_FIELDS, SYSTEM_FIELDS, StepState
 
 #: Threads per block, a power of two; a block holds one run.
 MAX_THREADS = 256
