@@ -58,7 +58,8 @@ def click_power(samples, trains, rate=RATE, length=0.006):
 def add_noise(samples, snr_db, trains, rng, rate=RATE):
     """White noise whose power is ``snr_db`` below the clicks' power while they sound."""
     power = click_power(samples, trains, rate) / 10 ** (snr_db / 10)
-    return samples + rng.normal(0.0, np.sqrt(power), samples.shape)
+    noisy = samples + rng.normal(0.0, np.sqrt(power), samples.shape)
+    return noisy / max(1.0, np.abs(noisy).max() / 0.95)  # scaled, never clipped
 
 
 def add_reverb(samples, rng, rate=RATE, rt60=0.5, drr_db=0.0):

@@ -92,8 +92,10 @@ def _split(feature: np.ndarray):
     spread = math.sqrt(0.5 * (low.var() + high.var())) or 1e-9
     separation = (high.mean() - low.mean()) / spread
     if separation < MIN_SEPARATION:
-        return None, separation, (
-            f"the groups overlap (separation {separation:.1f} < {MIN_SEPARATION:g} spreads)"
+        return (
+            None,
+            separation,
+            (f"the groups overlap (separation {separation:.1f} < {MIN_SEPARATION:g} spreads)"),
         )
     labels = np.full(k, -1, dtype=np.int8)
     # metronome 0: the higher feature (louder, or more to the left)

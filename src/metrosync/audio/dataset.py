@@ -38,7 +38,7 @@ from ..errors import ParameterError
 from . import detection as det
 from .attribution import attribute_pair
 from .metronome import beat_statistics
-from .order import CLUSTER_GAP, acoustic_order
+from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order
 from .reader import open_recording
 from .summary import summary_text
 from .tempo import beat_period
@@ -127,10 +127,14 @@ def analyze_audio(
                 interval[mine[:-1]] = _beats(ticks.time[mine], s.beat_number)
     else:
         why = "telling metronomes apart is done for two"
-    acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
-    if span < 4 * period * max(n, 1):
+    acoustic = acoustic_order(
+        ticks.time, period, window=order_window, cluster_gap=cluster_gap, metronomes=n
+    )
+    wanted = WINDOW_BEATS * period if order_window is None else order_window
+    if span < wanted:
         warnings.warn(
-            f"the recording holds only {k} ticks over {span:.1f} s: too short for steady "
+            f"the recording holds only {k} ticks over {span:.1f} s, less than one window of "
+            f"the acoustic order parameter ({wanted:.1f} s): too short for steady "
             f"figures; record a minute or more.",
             UserWarning,
             stacklevel=2,
@@ -174,7 +178,8 @@ def _check_options(bpm, metronomes, sensitivity, refractory, window, gap) -> Non
     if bpm is not None and not (math.isfinite(bpm) and 20 <= bpm <= 400):
         raise ParameterError(f"`bpm` must be a tempo in 20..400 BPM, got {bpm!r}.")
     if metronomes is not None and (
-        isinstance(metronomes, bool) or not isinstance(metronomes, int | np.integer)
+        isinstance(metronomes, bool)
+        or not isinstance(metronomes, int | np.integer)
         or metronomes < 1
     ):
         raise ParameterError(f"`metronomes` must be a whole number >= 1, got {metronomes!r}.")
@@ -236,6 +241,7 @@ def _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, 
                         {"units": "s", "long_name": "beat period in the window"}),
     }  # fmt: skip
     if stats:
+
         def per(name):
             return np.array([getattr(s, name) for s in stats])
 

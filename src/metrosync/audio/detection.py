@@ -52,8 +52,9 @@ CLIP_LEVEL = 0.999
 DISPLAY_HOPS = 10
 #: Half-width of the waveform window timed around each tick, s.
 REFINE_HALF = 6e-3
-#: Power floor (per sample, full scale 1) that keeps logarithms of silence finite.
-_FLOOR = 1e-12
+#: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
+#: are not ticks, and the logarithms of digital silence stay finite.
+_FLOOR = 1e-10
 
 
 @dataclass(frozen=True)

@@ -12,11 +12,12 @@ Definition. In a window of length W holding M ticks t_k, with T the beat period 
 N metronomes ticking together give R = 1 (all ticks share one phase of the beat).
 Independent metronomes each keep a nearly fixed phase within a window much shorter
 than the time they need to drift a beat apart, so R is the length of the mean of N
-random unit vectors: E[R²] = 1/N, with N the number of ticks per beat, M·T/W. That is
-the floor reported, R_floor = 1/√(ticks per beat), and R_excess = √((R² − R_floor²) /
-(1 − R_floor²)) (0 where R < R_floor) estimates the synchrony above it. Only where the
-window lasts long enough for each metronome's phase to wander through the beat
-(ticks independent from one to the next) does the floor fall towards 1/√M.
+random unit vectors: E[R²] = 1/N. That is the floor reported, R_floor = 1/√N, with N
+the number of metronomes (given, or the ticks per beat M·T/W of the window), and
+R_excess = √((R² − R_floor²) / (1 − R_floor²)) (0 where R < R_floor) estimates the
+synchrony above it. Only where the window lasts long enough for each metronome's
+phase to wander through the beat (ticks independent from one to the next) does the
+floor fall towards 1/√M.
 
 What it cannot tell: a metronome ticks at every zero crossing, in both directions, so
 its tick phase is twice the pendulum's phase: R is the second harmonic of the paper's
@@ -49,8 +50,8 @@ CLUSTER_GAP = 1 / 16
 class AcousticOrder:
     """The acoustic order parameter over sliding windows (W,).
 
-    time : window centres, s. r : R. floor : 1/√(ticks per beat). excess : R above
-    the floor (NaN with fewer than 1.5 ticks per beat). ticks_per_beat : M·T/W.
+    time : window centres, s. r : R. floor : 1/√N. excess : R above the floor (NaN
+    for N < 1.5). ticks_per_beat : M·T/W.
     clusters : distinct ticks per beat. period : T in each window, s.
     window, step : window length and step, s.
     """
@@ -74,6 +75,7 @@ def acoustic_order(
     step: float | None = None,
     cluster_gap: float = CLUSTER_GAP,
     centres: np.ndarray | None = None,
+    metronomes: int | None = None,
 ) -> AcousticOrder:
     """R over windows of ``window`` s (default 16 beats) every ``step`` s (2 beats).
 
@@ -81,6 +83,7 @@ def acoustic_order(
     used where a window has too few full swings of its own.
     centres : (W,) window centres, s, to compare two trains on the same windows
         (default: every ``step`` from the first tick + window/2 to the last − window/2).
+    metronomes : N for the floor 1/√N (default: each window's ticks per beat).
     """
     times = np.asarray(times, dtype=float)
     window = WINDOW_BEATS * period if window is None else float(window)
@@ -113,10 +116,11 @@ def acoustic_order(
                           & (beat_start < centres[w] + window / 2)]  # fmt: skip
         clusters[w] = np.median(mine) if mine.size else np.nan
         local[w] = T
-    floor = np.minimum(1.0, 1.0 / np.sqrt(per_beat))
+    n = per_beat if metronomes is None else np.full(per_beat.shape, float(metronomes))
+    floor = np.minimum(1.0, 1.0 / np.sqrt(n))
     with np.errstate(invalid="ignore", divide="ignore"):
         excess = np.sqrt(np.clip((r**2 - floor**2) / (1 - floor**2), 0.0, 1.0))
-    excess[~(per_beat >= 1.5)] = np.nan
+    excess[~(n >= 1.5)] = np.nan
     return AcousticOrder(centres, r, floor, excess, per_beat, clusters, local, window, step)
 
 

@@ -87,9 +87,7 @@ def _coarse_lag(times: np.ndarray, lo: float, hi: float, *, pick_shortest: bool)
             f"give the metronomes' setting (`bpm`) or check that the recording holds ticks."
         )
     peaks = np.flatnonzero(
-        (excess >= 0.5 * best)
-        & (excess >= np.roll(excess, 1))
-        & (excess >= np.roll(excess, -1))
+        (excess >= 0.5 * best) & (excess >= np.roll(excess, 1)) & (excess >= np.roll(excess, -1))
     )
     choice = peaks[0] if pick_shortest and peaks.size else int(np.argmax(excess))
     return float(lags[choice])
