@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +39,7 @@ from ..errors import ParameterError
 from . import detection as det
 from .attribution import attribute_pair
 from .metronome import beat_statistics
-from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order
+from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
 from .summary import summary_text
 from .tempo import beat_period
@@ -66,7 +67,8 @@ def analyze_audio(
     ----------
     path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`).
     bpm : the metronomes' setting, BPM; default: found from the ticks.
-    metronomes : how many metronomes sound; default: the ticks per beat, rounded.
+    metronomes : how many metronomes sound; default: the ticks per beat in the windows
+        where they were least together (95th percentile), rounded.
     band : band-pass edges (Hz) of the detector.
     sensitivity : threshold above the detection curve's median, in its robust spreads.
     refractory : shortest time between two ticks, s; default 1/32 of the beat, within
@@ -100,7 +102,13 @@ def analyze_audio(
     period = beat_period(ticks.time, bpm)
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
-    n = int(metronomes) if metronomes is not None else max(1, round(per_beat))
+    acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
+    # Synchronized metronomes tick as one; the windows where they were least together
+    # count them best.
+    busiest = np.nanpercentile(acoustic.ticks_per_beat, 95)
+    n = int(metronomes) if metronomes is not None else max(1, round(busiest))
+    floor, excess = floor_and_excess(acoustic.r, n)
+    acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
     label = np.full(k, -1, dtype=np.int8)
     is_tock = np.full(k, -1, dtype=np.int8)
@@ -127,9 +135,6 @@ def analyze_audio(
                 interval[mine[:-1]] = _beats(ticks.time[mine], s.beat_number)
     else:
         why = "telling metronomes apart is done for two"
-    acoustic = acoustic_order(
-        ticks.time, period, window=order_window, cluster_gap=cluster_gap, metronomes=n
-    )
     wanted = WINDOW_BEATS * period if order_window is None else order_window
     if span < wanted:
         warnings.warn(
@@ -152,7 +157,9 @@ def analyze_audio(
         bpm_ensemble=60.0 / period,
         tempo_source="given (bpm)" if bpm is not None else "found from the ticks",
         metronomes=n,
-        metronomes_source="given" if metronomes is not None else "ticks per beat, rounded",
+        metronomes_source="given"
+        if metronomes is not None
+        else "most ticks per beat in a window (95th percentile), rounded",
         ticks_per_beat=per_beat,
         band=list(scan.band),
         sensitivity=sensitivity,

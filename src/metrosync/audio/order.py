@@ -32,7 +32,6 @@ the median count over its beats, so that a stray sound does not count.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,12 +115,18 @@ def acoustic_order(
                           & (beat_start < centres[w] + window / 2)]  # fmt: skip
         clusters[w] = np.median(mine) if mine.size else np.nan
         local[w] = T
-    n = per_beat if metronomes is None else np.full(per_beat.shape, float(metronomes))
+    floor, excess = floor_and_excess(r, per_beat if metronomes is None else metronomes)
+    return AcousticOrder(centres, r, floor, excess, per_beat, clusters, local, window, step)
+
+
+def floor_and_excess(r: np.ndarray, metronomes) -> tuple[np.ndarray, np.ndarray]:
+    """R_floor = 1/√N and R_excess (NaN where N < 1.5) for R (W,) and N (scalar or (W,))."""
+    n = np.broadcast_to(np.asarray(metronomes, dtype=float), r.shape)
     floor = np.minimum(1.0, 1.0 / np.sqrt(n))
     with np.errstate(invalid="ignore", divide="ignore"):
         excess = np.sqrt(np.clip((r**2 - floor**2) / (1 - floor**2), 0.0, 1.0))
     excess[~(n >= 1.5)] = np.nan
-    return AcousticOrder(centres, r, floor, excess, per_beat, clusters, local, window, step)
+    return floor, excess
 
 
 def _swing_of_each(times: np.ndarray, period: float) -> np.ndarray:
@@ -154,8 +159,3 @@ def ticks_per_beat_heard(times: np.ndarray, period: float, gap: float):
     wrap[has] = times[first[has]] + period - times[last[has]] <= gap * period
     counts = counts - (wrap & (counts > 1))
     return t0 + period * np.arange(beats), counts
-
-
-def floor_rms(ticks_per_beat: float) -> float:
-    """The floor of R for independent metronomes: √E[R²] = 1/√(ticks per beat)."""
-    return 1.0 / math.sqrt(ticks_per_beat)

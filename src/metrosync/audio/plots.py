@@ -16,6 +16,8 @@ import numpy as np
 from ..plots import finish_figure, new_figure
 
 TICK_COLOURS = ("C0", "C3")
+#: Columns of the drawn waveform, at most (a screen's width; more only slows drawing).
+MAX_COLUMNS = 3000
 MARKERS = ("o", "s")
 
 
@@ -36,7 +38,7 @@ def plot_audio(ds, path: Path | str | None = None):
     a = ds.attrs
 
     ax = axes[0]
-    ax.fill_between(ds.wave.values, ds.wave_min.values, ds.wave_max.values, color="0.35", lw=0)
+    ax.fill_between(*_columns(ds, MAX_COLUMNS), color="0.35", lw=0)
     height = 10 ** (ds.tick_strength.values / 20)
     ax.plot(t, height, "|", color="C2", ms=6, label=f"{t.size} ticks detected")
     ax.set_ylabel("waveform")
@@ -82,3 +84,18 @@ def plot_audio(ds, path: Path | str | None = None):
         ax.set_ylabel("phase of 1 in 0's beat (°)")
     axes[-1].set_xlabel("time in the recording (s)")
     return finish_figure(fig, path)
+
+
+def _columns(ds, most: int):
+    """(time, min, max) of the waveform, merged into at most ``most`` columns."""
+    t, lo, hi = ds.wave.values, ds.wave_min.values, ds.wave_max.values
+    k = -(-t.size // most)
+    if k <= 1:
+        return t, lo, hi
+    cut = t.size - t.size % k
+    parts = [(t[:cut].reshape(-1, k).mean(1), lo[:cut].reshape(-1, k).min(1),
+              hi[:cut].reshape(-1, k).max(1))]  # fmt: skip
+    if cut < t.size:
+        parts.append((t[cut:].mean(keepdims=True), lo[cut:].min(keepdims=True),
+                      hi[cut:].max(keepdims=True)))  # fmt: skip
+    return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
