@@ -149,10 +149,11 @@ def scan(
         mins.append(np.array([rest.min()], dtype=np.float32))
         maxs.append(np.array([rest.max()], dtype=np.float32))
     _check_levels(recording, peak, clipped)
-    energy = np.concatenate(energies).astype(np.float64)
+    energy = np.concatenate(energies)
+    del energies
     curve = detection_curve(energy, hop)
     threshold = adaptive_threshold(curve, hop / rate, sensitivity)
-    level = 10 * np.log10(energy / hop + _FLOOR)
+    level = 10 * np.log10(energy / np.float32(hop) + np.float32(_FLOOR))
     return Scan(
         hop, curve.astype(np.float32), threshold.astype(np.float32), level.astype(np.float32),
         np.concatenate(mins), np.concatenate(maxs), peak, clipped, band, sos,
@@ -184,22 +185,28 @@ def _check_levels(recording: Recording, peak: float, clipped: int) -> None:
         )
 
 
-def detection_curve(energy: np.ndarray, hop: int) -> np.ndarray:
+def detection_curve(energy: np.ndarray, hop: int, *, chunk: int = 1 << 20) -> np.ndarray:
     """(F,) rise (dB) of the mean power over `AHEAD` above that over the preceding `PAST`.
 
-    energy : (F,) band-passed energy summed over each hop of ``hop`` samples.
+    energy : (F,) band-passed energy summed over each hop of ``hop`` samples. Before
+    the first hop the power is taken as the mean of the first `PAST`, after the last
+    as 0. Computed ``chunk`` hops at a time: the temporary arrays stay small.
     """
     ahead = max(1, round(AHEAD / HOP))
     past = max(1, round(PAST / HOP))
     floor = _FLOOR * hop
-    c = np.concatenate([[0.0], np.cumsum(energy)])
     f = energy.size
-    k = np.arange(f)
-    a_hi = np.minimum(k + ahead, f)
-    p_lo = np.maximum(k - past, 0)
-    power_ahead = (c[a_hi] - c[k]) / np.maximum(a_hi - k, 1)
-    power_past = (c[k] - c[p_lo]) / np.maximum(k - p_lo, 1)
-    curve = 10 * np.log10((power_ahead + floor) / (power_past + floor))
+    start = np.full(past, energy[:past].mean(dtype=np.float64))
+    padded = np.concatenate([start, energy, np.zeros(ahead)])
+    curve = np.empty(f, dtype=np.float32)
+    for lo in range(0, f, chunk):
+        hi = min(f, lo + chunk)
+        # hop k of the chunk sits at padded[past + k]
+        c = np.concatenate([[0.0], np.cumsum(padded[lo : hi + past + ahead], dtype=np.float64)])
+        k = np.arange(hi - lo) + past
+        power_ahead = (c[k + ahead] - c[k]) / ahead
+        power_past = (c[k] - c[k - past]) / past
+        curve[lo:hi] = 10 * np.log10((power_ahead + floor) / (power_past + floor))
     curve[0] = 0.0  # nothing before the first hop to rise from
     return curve
 
