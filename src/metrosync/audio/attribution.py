@@ -5,12 +5,13 @@ one tick train (K,) into two metronomes and returns an `Attribution`, whose
 ``labels`` (K,) are 0, 1, or −1 for a tick that belongs to neither (two ticks heard as
 one, a stray sound); or None with the reason it could not.
 
-The feature is the left-minus-right level of each tick (dB) in a stereo recording,
-where the metronomes stand apart, and else its loudness (dB). The ticks are split in
+The feature is the balance (L − R)/(L + R) of each tick's peak amplitudes in a stereo
+recording, where the metronomes stand apart, and else its loudness (dB). The ticks are split in
 two by the threshold that minimises the spread within the groups (Otsu). The split
 is accepted only when the groups are far apart for their spreads, |μ₀ − μ₁| /
-√((σ₀² + σ₁²)/2) ≥ `MIN_SEPARATION`, each holds at least a quarter of the ticks, and
-each is a steady train at the ensemble's beat; a tick more than `OUTLIER` spreads from
+√((σ₀² + σ₁²)/2) ≥ `MIN_SEPARATION`, each holds at least a quarter of the ticks, at
+least `MIN_ATTRIBUTED` of the ticks fall in one, and each is a steady train with a tick
+in most beats of the recording; a tick more than `OUTLIER` spreads from
 its group's mean is left unattributed. Metronome 0 is the left (stereo) or the louder
 one.
 
@@ -31,6 +32,7 @@ import numpy as np
 MIN_SEPARATION = 3.0
 OUTLIER = 4.0
 MIN_SHARE = 0.25
+MIN_ATTRIBUTED = 0.8
 
 
 @dataclass(frozen=True)
@@ -56,14 +58,21 @@ def attribute_pair(times, strength, channel_strength, period: float):
     reasons = []
     features = []
     if channel_strength.shape[1] == 2:
-        features.append(("stereo", channel_strength[:, 0] - channel_strength[:, 1]))
+        left, right = (10 ** (channel_strength[:, c] / 20) for c in (0, 1))
+        features.append(("stereo", (left - right) / (left + right)))
     features.append(("loudness", np.asarray(strength, dtype=float)))
     for method, feature in features:
         labels, separation, why = _split(feature)
         if labels is None:
             reasons.append(f"{method}: {why}")
             continue
-        steady = [_is_steady(times[labels == g], period) for g in (0, 1)]
+        if np.mean(labels >= 0) < MIN_ATTRIBUTED:
+            reasons.append(
+                f"{method}: fewer than {MIN_ATTRIBUTED:.0%} of the ticks fall in a group"
+            )
+            continue
+        beats = (times[-1] - times[0]) / period
+        steady = [_is_steady(times[labels == g], period, beats) for g in (0, 1)]
         if not all(steady):
             reasons.append(f"{method}: the two groups are not each a steady tick train")
             continue
@@ -106,8 +115,9 @@ def _split(feature: np.ndarray):
     return labels, float(separation), ""
 
 
-def _is_steady(times: np.ndarray, period: float) -> bool:
-    if times.size < 4:
+def _is_steady(times: np.ndarray, period: float, beats: float) -> bool:
+    """A tick in most beats of the recording, one beat apart."""
+    if times.size < 4 or times.size < 0.6 * beats:
         return False
     gaps = np.diff(times)
     return bool(abs(np.median(gaps) / period - 1) < 0.25)

@@ -283,5 +283,5 @@ def _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, 
                                {"long_name": "metronome (0: alone, louder or left)"})  # fmt: skip
     ds = xr.Dataset(data, coords=coords)
     for name in ("detection", "threshold", "level"):
-        ds[name].encoding = {"zlib": True, "complevel": 4}
+        ds[name].encoding = {"zlib": True, "complevel": 1}
     return ds
