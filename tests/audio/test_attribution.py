@@ -67,3 +67,32 @@ def test_phase_difference_is_the_fraction_of_the_beat():
     other = ref[:-1] + 0.125  # a quarter beat later
     assert np.allclose(phase_difference(ref, other, 0.5), np.pi / 2)
     assert np.allclose(phase_difference(ref, ref[1:-1] + 0.375, 0.5), -np.pi / 2)
+
+
+def test_listen_pair_told_apart_by_side(tmp_path):
+    """`write_wav` pans the two metronomes of a simulation to opposite sides."""
+    import metrosync
+    from metrosync.show.recording import RecordedRun
+    from metrosync.show.sound import crossing_times, write_wav
+
+    ds = metrosync.simulate(2, 184.0, sigma_bpm=0.75, duration=40.0, record_every=1,
+                            trajectories=True, seed=1)  # fmt: skip
+    write_wav(ds, tmp_path / "two.wav")
+    crossings = crossing_times(RecordedRun.from_dataset(ds))
+    out = analyze_audio(tmp_path / "two.wav")
+    assert out.attrs["attribution"] == "stereo"
+    # metronome 0 of the analysis is the left one: the simulation's metronome 1 (at α = π)
+    right, share = assigned_right(out, crossings[::-1])
+    assert right == 1.0 and share > 0.95
+    assert "locked" in out.attrs["summary"]
+
+
+def test_loudness_that_drifts_over_time_is_not_taken_for_two_metronomes(tmp_path):
+    """Two equal metronomes whose loudness fades together: early loud and late soft ticks
+    are two groups of loudness, but not two tick trains."""
+    trains = [synth.metronome_train(184, 40, phase=0.0),
+              synth.metronome_train(187, 40, phase=0.3)]  # fmt: skip
+    x = synth.render(trains, 40, pitches=[2000.0, 2000.0])
+    x *= np.where(np.arange(x.shape[0]) < x.shape[0] // 2, 1.0, 0.1)[:, None]
+    out = analyze_audio(synth.write(tmp_path / "fade.wav", x))
+    assert out.attrs["attribution"] == "none"

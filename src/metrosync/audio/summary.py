@@ -41,9 +41,10 @@ def summary_text(ds) -> str:
         last = last[-max(1, last.size // 4) :]
         z = np.exp(1j * last).mean()
         spread = np.degrees(np.sqrt(max(0.0, -2 * np.log(max(abs(z), 1e-12)))))
+        state = "drifting: not locked" if spread > 60 else "locked"
         lines.append(
             f"  phase difference of the ticks (1 in 0's beat), last quarter: "
-            f"{np.degrees(np.angle(z)):.1f}° ± {spread:.1f}° (0°: together; the "
+            f"{np.degrees(np.angle(z)):.1f}° ± {spread:.1f}° ({state}; 0°: together; the "
             f"pendulums differ by half this, or half plus 180°)"
         )
     if n > 1 or k and "metronome" not in ds.dims:
