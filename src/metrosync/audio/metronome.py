@@ -145,6 +145,16 @@ def beat_statistics(
     )
 
 
+def asymmetry_from_offset(offset: float, amplitude: float) -> float:
+    """The asymmetry (per cent of a beat) of a metronome that ticks when its pendulum,
+    swinging as θ = A sin ωt, passes θ = ``offset`` instead of the vertical.
+
+    It passes θ = ε at ωt = arcsin(ε/A) and π − arcsin(ε/A), so its beats are
+    (π ∓ 2 arcsin(ε/A))/ω: (long − short)/mean = (4/π) arcsin(ε/A).
+    """
+    return 400.0 / math.pi * math.asin(abs(offset) / amplitude)
+
+
 def _swings(times: np.ndarray, number: np.ndarray) -> np.ndarray:
     """Non-overlapping full swings: t(n + 2) − t(n) for even n where both were heard."""
     where = np.searchsorted(number, number + 2)
