@@ -91,3 +91,10 @@ def test_audio_options_with_logs_warn(capsys):
     log = Path(__file__).parents[1] / "data" / "clean.log"
     code, _, err = run(capsys, "analyze", str(log), "--bpm", "180")
     assert "--bpm apply to sound recordings only" in err
+
+
+def test_a_tempo_far_from_the_ticks_warns(capsys, pair_recording):
+    path, _ = pair_recording
+    code, _, err = run(capsys, "analyze", str(path), "--bpm", "62")
+    assert code == 0
+    assert "the ticks sound like 18" in err and "not near `bpm` 62" in err

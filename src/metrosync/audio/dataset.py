@@ -100,6 +100,16 @@ def analyze_audio(
     ticks = det.Ticks(ticks.time[order], ticks.strength[order],
                       ticks.channel_strength[order], ticks.rise[order])  # fmt: skip
     period = beat_period(ticks.time, bpm)
+    if bpm is not None:
+        heard = 60.0 / beat_period(ticks.time)
+        if abs(heard * period / 60.0 - 1) > 0.15:
+            warnings.warn(
+                f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
+                f"analysis keeps near your setting, at {60 / period:.1f} BPM. Check the "
+                f"setting, or leave `bpm` out.",
+                UserWarning,
+                stacklevel=2,
+            )
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)

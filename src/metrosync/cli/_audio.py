@@ -66,7 +66,7 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
         type=int,
         default=None,
         metavar="N",
-        help="how many metronomes sound (default: ticks per beat, rounded)",
+        help="how many metronomes sound (default: the most ticks per beat heard, rounded)",
     )
     g.add_argument(
         "--band",
@@ -78,6 +78,7 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--sensitivity",
         type=float,
+        metavar="K",
         default=DEFAULT_SENSITIVITY,
         help="threshold in robust spreads of the detection curve (lower finds "
         "softer ticks, and more false ones)",
