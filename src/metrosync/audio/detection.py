@@ -40,14 +40,13 @@ import numpy as np
 from scipy import fft, ndimage, signal
 
 from .reader import AudioFileError, Recording
+from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY
 
 HOP = 0.5e-3
 AHEAD = 1.0e-3
 PAST = 4.0e-3
 THRESHOLD_SPAN = 2.0
 MIN_RISE = 6.0
-DEFAULT_SENSITIVITY = 4.5
-DEFAULT_BAND = (1000.0, 10000.0)
 #: Samples at or above this magnitude count as clipped.
 CLIP_LEVEL = 0.999
 #: Width of one column of the plotted waveform, in hops.

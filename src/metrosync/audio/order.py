@@ -36,13 +36,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .settings import CLUSTER_GAP
 from .tempo import SWING_TOLERANCE
 
 #: Default window, in beats, and step between windows, in beats.
 WINDOW_BEATS = 16
 STEP_BEATS = 2
-#: Default largest phase gap inside one cluster, fraction of a beat.
-CLUSTER_GAP = 1 / 16
 
 
 @dataclass(frozen=True)

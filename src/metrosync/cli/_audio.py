@@ -45,8 +45,7 @@ def band_arg(text: str) -> tuple[float, float]:
 
 def add_audio_options(parser: argparse.ArgumentParser) -> None:
     """Add the options for recordings; call after the light-gate options."""
-    from ..audio.detection import DEFAULT_BAND, DEFAULT_SENSITIVITY
-    from ..audio.order import CLUSTER_GAP
+    from ..audio.settings import CLUSTER_GAP, DEFAULT_BAND, DEFAULT_SENSITIVITY
 
     parser.set_defaults(
         _lightgate_defaults={dest: parser.get_default(dest) for dest in LIGHTGATE_OPTIONS}
