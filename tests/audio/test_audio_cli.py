@@ -82,7 +82,7 @@ def test_light_gate_options_with_a_recording_warn(capsys, pair_recording):
     path, _ = pair_recording
     code, _, err = run(capsys, "analyze", str(path), "--glitch", "0.01")
     assert code == 0
-    assert "--glitch apply to light-gate logs only" in err
+    assert "a recording ignores --glitch" in err
 
 
 def test_audio_options_with_logs_warn(capsys):
@@ -90,7 +90,7 @@ def test_audio_options_with_logs_warn(capsys):
 
     log = Path(__file__).parents[1] / "data" / "clean.log"
     code, _, err = run(capsys, "analyze", str(log), "--bpm", "180")
-    assert "--bpm apply to sound recordings only" in err
+    assert "light-gate logs ignore --bpm" in err
 
 
 def test_a_tempo_far_from_the_ticks_warns(capsys, pair_recording):
@@ -98,3 +98,10 @@ def test_a_tempo_far_from_the_ticks_warns(capsys, pair_recording):
     code, _, err = run(capsys, "analyze", str(path), "--bpm", "62")
     assert code == 0
     assert "the ticks sound like 18" in err and "not near `bpm` 62" in err
+
+
+def test_follow_with_a_recording_warns(capsys, pair_recording):
+    path, _ = pair_recording
+    code, _, err = run(capsys, "analyze", str(path), "--follow")
+    assert code == 0
+    assert "a recording ignores --follow" in err

@@ -21,6 +21,7 @@ LIGHTGATE_OPTIONS = {
     "tick": "--tick", "counter_bits": "--counter-bits", "polarity": "--polarity",
     "strict": "--strict", "channels": "--channels", "glitch": "--glitch",
     "min_asymmetry": "--min-asymmetry", "grid_dt": "--grid-dt", "window": "--window",
+    "follow": "--follow",
 }  # fmt: skip
 #: Options of the audio analysis, which light-gate logs ignore.
 AUDIO_OPTIONS = {
@@ -103,7 +104,7 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _changed(args, defaults: dict, names: dict) -> list[str]:
-    return [names[d] for d, v in defaults.items() if getattr(args, d) != v]
+    return [names[d] for d, v in defaults.items() if getattr(args, d, v) != v]
 
 
 def audio_requested(args) -> bool:
@@ -120,8 +121,8 @@ def audio_requested(args) -> bool:
     if not any(audio):
         ignored = _changed(args, args._audio_defaults, AUDIO_OPTIONS)
         if ignored:
-            warnings.warn(f"{', '.join(ignored)} apply to sound recordings only; light-gate "
-                          f"logs ignore them.", UserWarning, stacklevel=2)  # fmt: skip
+            warnings.warn(f"light-gate logs ignore {', '.join(ignored)} (options for sound "
+                          f"recordings).", UserWarning, stacklevel=2)  # fmt: skip
         return False
     return True
 
@@ -135,8 +136,8 @@ def run_audio(args) -> int:
         )
     ignored = _changed(args, args._lightgate_defaults, LIGHTGATE_OPTIONS)
     if ignored:
-        warnings.warn(f"{', '.join(ignored)} apply to light-gate logs only; a recording "
-                      f"ignores them.", UserWarning, stacklevel=2)  # fmt: skip
+        warnings.warn(f"a recording ignores {', '.join(ignored)} (options for light-gate "
+                      f"logs).", UserWarning, stacklevel=2)  # fmt: skip
     check_output(args.out, "--out", suffixes=NETCDF)
     check_output(args.plot, "--plot", suffixes=FIGURE)
     from ..audio import analyze_audio
