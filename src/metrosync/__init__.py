@@ -4,10 +4,11 @@ A model, integrators, observables and analysis tools for the system of Boda, Né
 Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
-`sweep` (parameter grids), `reproduce` (the paper's studies), and `animate`,
-`write_wav`, `write_page`, `plot_run` (seeing and hearing a run), and
-`write_playground` (the model live in a browser). These last five are
-imported on first use, so that ``import metrosync`` stays quick.
+`analyze_audio` (a sound recording of metronomes), `sweep` (parameter grids),
+`reproduce` (the paper's studies), and `animate`, `write_wav`, `write_page`,
+`plot_run` (seeing and hearing a run), and `write_playground` (the model live in a
+browser). Those that need matplotlib, dask or an audio library are imported on first
+use, so that ``import metrosync`` stays quick.
 """
 
 from ._version import __version__
@@ -26,7 +27,7 @@ from .model import (  # noqa: E402
 )
 from .simulate import simulate  # noqa: E402
 
-#: Names served on first use from the modules that need matplotlib or dask.
+#: Names served on first use from the modules that need matplotlib, dask or soundfile.
 _LAZY = {
     "animate": "show",
     "plot_run": "show",
@@ -35,6 +36,7 @@ _LAZY = {
     "write_wav": "show",
     "sweep": "sweeps",
     "reproduce": "paper",
+    "analyze_audio": "audio",
 }
 
 __all__ = [

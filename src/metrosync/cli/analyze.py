@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
+from ._audio import add_audio_options, audio_requested, run_audio
 from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import HelpFormatter, add_aliases, int_list
 
@@ -28,12 +29,14 @@ def counter_bits_arg(text: str):
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "analyze",
-        help="analyse light-gate logs (real or virtual)",
+        help="analyse light-gate logs (real or virtual) or a sound recording",
         description="Read light-gate logs, clean them, and measure r(t), the metronomes' "
-        "frequencies and their spread. Several logs are repeated runs and are averaged.",
+        "frequencies and their spread. Several logs are repeated runs and are averaged. "
+        "A sound recording (.wav, .flac, .ogg, .mp3) is analysed for its ticks instead.",
         formatter_class=HelpFormatter,
     )
-    parser.add_argument("logs", nargs="+", type=Path, metavar="LOG", help="light-gate log files")
+    parser.add_argument("logs", nargs="+", type=Path, metavar="LOG",
+                        help="light-gate log files, or one sound recording")  # fmt: skip
     g = parser.add_argument_group("reading")
     g.add_argument("--tick", type=float, default=DEFAULT_TICK, help="seconds per logger tick")
     g.add_argument("--counter-bits", type=counter_bits_arg, default="auto",
@@ -64,10 +67,13 @@ def register(subparsers) -> None:
                      "a terminal program), with a live panel; at Ctrl-C analyse it and write "
                      "--out/--plot")  # fmt: skip
     add_aliases(parser, equilibrium_window="--window")
+    add_audio_options(parser)
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
+    if audio_requested(args):
+        return run_audio(args)
     from ..lightgate import analyze
     from ..lightgate.plots import plot_analysis
 

@@ -1,0 +1,21 @@
+"""Listen to real metronomes: ticks, tempo, beat and synchrony from a sound recording.
+
+One entry point, `analyze_audio(path)`; the steps are modules of their own:
+`reader` (files, in blocks), `detection` (tick onsets), `tempo` (the beat period),
+`metronome` (one metronome's tempo, jitter and beat), `order` (the acoustic order
+parameter and clusters), `attribution` (two metronomes told apart), `plots`.
+`analyze_audio` is imported on first use (it needs scipy and xarray), so that the
+reader's checks stay quick to import.
+"""
+
+from .reader import AUDIO_SUFFIXES, AudioFileError, is_audio_path, open_recording
+
+__all__ = ["AUDIO_SUFFIXES", "AudioFileError", "analyze_audio", "is_audio_path", "open_recording"]
+
+
+def __getattr__(name: str):
+    if name == "analyze_audio":
+        from .dataset import analyze_audio
+
+        return analyze_audio
+    raise AttributeError(f"module 'metrosync.audio' has no attribute {name!r}")

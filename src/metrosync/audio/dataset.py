@@ -1,0 +1,297 @@
+"""`analyze_audio`: a recording of metronomes → ticks, tempo, beat and synchrony.
+
+Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file in
+blocks (`reader`), finds and times the ticks (`detection`), finds the beat (`tempo`),
+and measures: one metronome's tempo, jitter and beat (`metronome`); the acoustic
+order parameter and clusters of an ensemble (`order`); and for two metronomes that
+can be told apart, each one's ticks and their phase difference (`attribution`). It
+returns an `xarray.Dataset`:
+
+    tick_time, tick_strength, tick_rise   (tick)        onsets (s), loudness (dBFS),
+                                                         detection curve there (dB)
+    tick_channel_strength                 (tick, channel)  loudness per channel, dBFS
+    tick_metronome, tick_is_tock, tick_interval, phase_difference   (tick)
+                                          who ticked (−1 unknown), tick or tock (−1
+                                          unknown), beat to its next tick (s), phase
+                                          in metronome 0's beat (rad)
+    detection, threshold, level           (frame)       the detection curve and its
+                                                         threshold (dB), power (dBFS)
+    wave_min, wave_max                    (wave)        the waveform, for plots
+    r_acoustic, r_floor, r_excess, ticks_per_beat, clusters, beat_period   (window)
+    bpm, bpm_error, jitter, asymmetry, asymmetry_error, long_beat, ticks   (metronome)
+                                          for one metronome, or each of two told apart
+
+with the summary (``attrs["summary"]``), the settings, and the tempo found.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .._version import __version__
+from ..errors import ParameterError
+from . import detection as det
+from .attribution import attribute_pair
+from .metronome import beat_statistics
+from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
+from .reader import open_recording
+from .summary import summary_text
+from .tempo import beat_period
+
+#: Default refractory time, as a fraction of the beat, and its bounds (s).
+REFRACTORY_BEATS = 1 / 32
+REFRACTORY_RANGE = (3e-3, 30e-3)
+
+
+def analyze_audio(
+    path: str | Path,
+    *,
+    bpm: float | None = None,
+    metronomes: int | None = None,
+    band: tuple[float, float] = det.DEFAULT_BAND,
+    sensitivity: float = det.DEFAULT_SENSITIVITY,
+    refractory: float | None = None,
+    order_window: float | None = None,
+    cluster_gap: float = CLUSTER_GAP,
+    progress: bool = False,
+) -> xr.Dataset:
+    """Analyse a sound recording of one or more metronomes.
+
+    Parameters
+    ----------
+    path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`).
+    bpm : the metronomes' setting, BPM; default: found from the ticks.
+    metronomes : how many metronomes sound; default: the ticks per beat in the windows
+        where they were least together (95th percentile), rounded.
+    band : band-pass edges (Hz) of the detector.
+    sensitivity : threshold above the detection curve's median, in its robust spreads.
+    refractory : shortest time between two ticks, s; default 1/32 of the beat, within
+        3–30 ms. Ticks closer than this are heard as one.
+    order_window : window of the acoustic order parameter, s (default 16 beats).
+    cluster_gap : largest gap within one cluster of ticks, fraction of a beat.
+    progress : show a progress bar while reading.
+
+    Returns
+    -------
+    xarray.Dataset, described in the module docstring.
+    """
+    _check_options(bpm, metronomes, sensitivity, refractory, order_window, cluster_gap)
+    recording = open_recording(path)
+    rate = recording.sample_rate
+    from ..progress import progress_bar
+
+    with progress_bar(total=recording.frames, unit="frame", enabled=progress,
+                      desc="reading") as bar:  # fmt: skip
+        scan = det.scan(recording, band=band, sensitivity=sensitivity, progress=bar)
+    hop_s = scan.hop / rate
+    candidates = det.pick_ticks(scan, round(REFRACTORY_RANGE[0] / hop_s))
+    rough = beat_period(candidates * hop_s, bpm)
+    if refractory is None:
+        refractory = float(np.clip(REFRACTORY_BEATS * rough, *REFRACTORY_RANGE))
+    hops = det.pick_ticks(scan, max(1, round(refractory / hop_s)))
+    ticks = det.refine(recording, scan, hops)
+    order = np.argsort(ticks.time, kind="stable")
+    ticks = det.Ticks(ticks.time[order], ticks.strength[order],
+                      ticks.channel_strength[order], ticks.rise[order])  # fmt: skip
+    period = beat_period(ticks.time, bpm)
+    if bpm is not None:
+        heard = 60.0 / beat_period(ticks.time)
+        if abs(heard * period / 60.0 - 1) > 0.15:
+            warnings.warn(
+                f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
+                f"analysis keeps near your setting, at {60 / period:.1f} BPM. Check the "
+                f"setting, or leave `bpm` out.",
+                UserWarning,
+                stacklevel=2,
+            )
+    span = ticks.time[-1] - ticks.time[0]
+    per_beat = ticks.time.size * period / max(span + period, period)
+    acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
+    # Synchronized metronomes tick as one; the windows where they were least together
+    # count them best.
+    busiest = np.nanpercentile(acoustic.ticks_per_beat, 95)
+    n = int(metronomes) if metronomes is not None else max(1, round(busiest))
+    floor, excess = floor_and_excess(acoustic.r, n)
+    acoustic = replace(acoustic, floor=floor, excess=excess)
+    k = ticks.time.size
+    label = np.full(k, -1, dtype=np.int8)
+    is_tock = np.full(k, -1, dtype=np.int8)
+    interval = np.full(k, np.nan)
+    phase = np.full(k, np.nan)
+    stats, attribution, why = [], None, ""
+    if n == 1:
+        s = beat_statistics(ticks.time, period, ticks.strength)
+        stats.append(s)
+        label[:] = 0
+        is_tock[:] = s.is_tock
+        interval[:-1] = _beats(ticks.time, s.beat_number)
+    elif n == 2:
+        attribution, why = attribute_pair(ticks.time, ticks.strength,
+                                          ticks.channel_strength, period)  # fmt: skip
+        if attribution is not None:
+            label = attribution.labels
+            phase = attribution.phase_difference
+            for g in (0, 1):
+                mine = np.flatnonzero(label == g)
+                s = beat_statistics(ticks.time[mine], period, ticks.strength[mine])
+                stats.append(s)
+                is_tock[mine] = s.is_tock
+                interval[mine[:-1]] = _beats(ticks.time[mine], s.beat_number)
+    else:
+        why = "telling metronomes apart is done for two"
+    wanted = WINDOW_BEATS * period if order_window is None else order_window
+    if span < wanted:
+        warnings.warn(
+            f"the recording holds only {k} ticks over {span:.1f} s, less than one window of "
+            f"the acoustic order parameter ({wanted:.1f} s): too short for steady "
+            f"figures; record a minute or more.",
+            UserWarning,
+            stacklevel=2,
+        )
+    ds = _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase)
+    ds.attrs.update(
+        path=str(recording.path),
+        sample_rate=rate,
+        channels=recording.channels,
+        duration=recording.duration,
+        format=f"{recording.format} {recording.subtype}",
+        peak_dbfs=20 * math.log10(scan.peak),
+        clipped_samples=scan.clipped,
+        beat_period=period,
+        bpm_ensemble=60.0 / period,
+        tempo_source="given (bpm)" if bpm is not None else "found from the ticks",
+        metronomes=n,
+        metronomes_source="given"
+        if metronomes is not None
+        else "most ticks per beat in a window (95th percentile), rounded",
+        ticks_per_beat=per_beat,
+        band=list(scan.band),
+        sensitivity=sensitivity,
+        refractory=refractory,
+        order_window=acoustic.window,
+        order_step=acoustic.step,
+        cluster_gap=cluster_gap,
+        attribution=attribution.method if attribution is not None else "none",
+        attribution_note=why,
+        metrosync_version=__version__,
+    )
+    ds.attrs["summary"] = summary_text(ds)
+    return ds
+
+
+def _beats(times: np.ndarray, number: np.ndarray) -> np.ndarray:
+    """(K − 1,) time to the next tick where it is the next beat, else NaN."""
+    gaps = np.diff(times)
+    return np.where(np.diff(number) == 1, gaps, np.nan)
+
+
+def _check_options(bpm, metronomes, sensitivity, refractory, window, gap) -> None:
+    if bpm is not None and not (math.isfinite(bpm) and 20 <= bpm <= 400):
+        raise ParameterError(f"`bpm` must be a tempo in 20..400 BPM, got {bpm!r}.")
+    if metronomes is not None and (
+        isinstance(metronomes, bool)
+        or not isinstance(metronomes, int | np.integer)
+        or metronomes < 1
+    ):
+        raise ParameterError(f"`metronomes` must be a whole number >= 1, got {metronomes!r}.")
+    if not (math.isfinite(sensitivity) and sensitivity > 0):
+        raise ParameterError(f"`sensitivity` must be a number > 0, got {sensitivity!r}.")
+    if refractory is not None and not (math.isfinite(refractory) and 0 < refractory < 1):
+        raise ParameterError(
+            f"`refractory` must be a time in (0, 1) s, got {refractory!r}; ticks closer "
+            f"than it count as one."
+        )
+    if window is not None and not (math.isfinite(window) and window > 0):
+        raise ParameterError(f"`order_window` must be a time > 0 s, got {window!r}.")
+    if not (math.isfinite(gap) and 0 < gap < 0.5):
+        raise ParameterError(
+            f"`cluster_gap` must be a fraction of a beat in (0, 0.5), got {gap!r}."
+        )
+
+
+def _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase):
+    rate = recording.sample_rate
+    hop_s = scan.hop / rate
+    chans = np.arange(recording.channels)
+    data = {
+        "tick_time": (("tick",), ticks.time, {"units": "s", "long_name": "tick onset"}),
+        "tick_strength": (("tick",), ticks.strength,
+                          {"units": "dBFS", "long_name": "tick loudness (envelope peak)"}),
+        "tick_rise": (("tick",), ticks.rise,
+                      {"units": "dB", "long_name": "detection curve at the tick"}),
+        "tick_channel_strength": (("tick", "channel"), ticks.channel_strength,
+                                  {"units": "dBFS", "long_name": "tick loudness per channel"}),
+        "tick_metronome": (("tick",), label,
+                           {"long_name": "metronome that ticked (-1: not told apart)"}),
+        "tick_is_tock": (("tick",), is_tock,
+                         {"long_name": "1 tock, 0 tick, -1 unknown (starts the other beat)"}),
+        "tick_interval": (("tick",), interval,
+                          {"units": "s", "long_name": "beat: time to the same metronome's "
+                                                      "next tick (NaN: unknown or missed)"}),
+        "phase_difference": (("tick",), phase,
+                             {"units": "rad", "long_name": "tick phase of metronome 1 in "
+                                                          "metronome 0's beat"}),
+        "detection": (("frame",), scan.curve,
+                      {"units": "dB", "long_name": "detection curve: rise of band power"}),
+        "threshold": (("frame",), scan.threshold,
+                      {"units": "dB", "long_name": "adaptive threshold on the curve"}),
+        "level": (("frame",), scan.level, {"units": "dBFS", "long_name": "band power per hop"}),
+        "wave_min": (("wave",), scan.wave_min, {"long_name": "waveform minimum (channel mix)"}),
+        "wave_max": (("wave",), scan.wave_max, {"long_name": "waveform maximum (channel mix)"}),
+        "r_acoustic": (("window",), acoustic.r,
+                       {"long_name": "acoustic order parameter |<exp(2 pi i t/T)>|"}),
+        "r_floor": (("window",), acoustic.floor,
+                    {"long_name": "floor of r_acoustic for independent metronomes"}),
+        "r_excess": (("window",), acoustic.excess,
+                     {"long_name": "r_acoustic above its floor"}),
+        "ticks_per_beat": (("window",), acoustic.ticks_per_beat,
+                           {"long_name": "ticks per beat period"}),
+        "clusters": (("window",), acoustic.clusters,
+                     {"long_name": "distinct ticks per beat (clusters)"}),
+        "beat_period": (("window",), acoustic.period,
+                        {"units": "s", "long_name": "beat period in the window"}),
+    }  # fmt: skip
+    if stats:
+
+        def per(name):
+            return np.array([getattr(s, name) for s in stats])
+
+        data |= {
+            "bpm": (("metronome",), per("bpm"), {"units": "BPM", "long_name": "tempo"}),
+            "bpm_error": (("metronome",), per("bpm_error"),
+                          {"units": "BPM", "long_name": "standard error of the tempo"}),
+            "jitter": (("metronome",), per("jitter"),
+                       {"units": "s", "long_name": "std of beats about their kind's mean"}),
+            "asymmetry": (("metronome",), per("asymmetry"),
+                          {"units": "%", "long_name": "(long - short beat) / mean beat"}),
+            "asymmetry_error": (("metronome",), per("asymmetry_error"),
+                                {"units": "%", "long_name": "standard error of the asymmetry"}),
+            "long_beat": (("metronome",), per("long_beat").astype(str),
+                          {"long_name": "which beat is long"}),
+            "beat_verdict": (("metronome",), np.array([s.verdict() for s in stats]),
+                             {"long_name": "the beat in words"}),
+            "ticks": (("metronome",), per("ticks"), {"long_name": "ticks heard"}),
+            "missed_beats": (("metronome",), per("missed"), {"long_name": "beats not heard"}),
+        }  # fmt: skip
+    coords = {
+        "tick": ("tick", np.arange(ticks.time.size), {"long_name": "tick index, in time order"}),
+        "channel": ("channel", chans, {"long_name": "channel of the recording (0 = left)"}),
+        "frame": ("frame", np.arange(scan.curve.size) * hop_s,
+                  {"units": "s", "long_name": "start of each hop of the detection curve"}),
+        "wave": ("wave", (np.arange(scan.wave_min.size) + 0.5) * hop_s * det.DISPLAY_HOPS,
+                 {"units": "s", "long_name": "centre of each waveform column"}),
+        "window": ("window", acoustic.time, {"units": "s", "long_name": "window centre"}),
+    }  # fmt: skip
+    if stats:
+        coords["metronome"] = ("metronome", np.arange(len(stats)),
+                               {"long_name": "metronome (0: alone, louder or left)"})  # fmt: skip
+    ds = xr.Dataset(data, coords=coords)
+    for name in ("detection", "threshold", "level"):
+        ds[name].encoding = {"zlib": True, "complevel": 1}
+    return ds

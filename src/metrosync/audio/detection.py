@@ -1,0 +1,336 @@
+"""Tick detection: every tick's onset time (sub-millisecond) and strength.
+
+Contract: `scan(recording)` reads the file once, block by block, and returns a `Scan`:
+the detection curve, its adaptive threshold, a min/max waveform for plots, and the
+level checks (peak, clipping). `pick_ticks(scan, refractory)` finds the ticks on the
+curve, and `refine(recording, scan, frames)` times each one on the waveform itself.
+Memory is bounded by one block and the curve (two float32 per 0.5 ms).
+
+The detection curve. The channels are averaged and band-passed (Butterworth, 4 poles,
+`band`, default 1–10 kHz: a tick's click is loud there, room rumble and voices are
+mostly below). The power is summed over hops of `HOP` (0.5 ms). The curve is the rise
+in dB of the power over the next `AHEAD` (1 ms) above the mean power over the
+preceding `PAST` (4 ms): a tick is a sudden rise, whatever its loudness, while steady
+noise and a decaying reverberation tail stay near 0 dB.
+
+The threshold adapts to the room: over spans of `THRESHOLD_SPAN` (2 s), the median of
+the curve plus `sensitivity` times its robust spread above the median (1.4826 × the
+median of the deviations above it: the fast falls of a decaying reverberation, below
+the median, do not raise the threshold), and never below `MIN_RISE` dB; linear
+between the spans' centres. A tick is a peak of the curve above the threshold that
+is the largest within ± the refractory time, which the caller derives from the
+tempo, so that the echo or the rattle of a click is not a tick of its own. Rises
+below the noise of 16-bit sound (−100 dBFS) do not count.
+
+Onset times. Around each tick the waveform (channels averaged) is band-passed again
+with the same filter run forwards and backwards (no delay), and its envelope taken
+(Hilbert). The onset is the instant, interpolated between samples, at which the
+envelope last rises through halfway between the background before the tick and the
+tick's peak: for a click that starts abruptly it is the click's first sample within a
+few tens of microseconds, and echoes, which come later, do not move it. The strength
+of a tick is its envelope peak (dBFS), also per channel, which stereo attribution uses.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft, ndimage, signal
+
+from .reader import AudioFileError, Recording
+from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY
+
+HOP = 0.5e-3
+AHEAD = 1.0e-3
+PAST = 4.0e-3
+THRESHOLD_SPAN = 2.0
+MIN_RISE = 6.0
+#: Samples at or above this magnitude count as clipped.
+CLIP_LEVEL = 0.999
+#: Width of one column of the plotted waveform, in hops.
+DISPLAY_HOPS = 10
+#: Half-width of the waveform window timed around each tick, s.
+REFINE_HALF = 6e-3
+#: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
+#: are not ticks, and the logarithms of digital silence stay finite.
+_FLOOR = 1e-10
+
+
+@dataclass(frozen=True)
+class Scan:
+    """What one pass over a recording found.
+
+    hop : frames per hop of the detection curve.
+    curve : (F,) detection curve, dB (rise of the power into each hop).
+    threshold : (F,) adaptive threshold on the curve, dB.
+    level : (F,) band-passed power over each hop, dBFS.
+    wave_min, wave_max : (D,) range of the channel mix over each `DISPLAY_HOPS` hops.
+    peak : largest sample magnitude, any channel (1 = full scale).
+    clipped : samples at or above `CLIP_LEVEL` (any channel).
+    band : the band-pass edges used, Hz.
+    sos : the band-pass filter (second-order sections).
+    """
+
+    hop: int
+    curve: np.ndarray
+    threshold: np.ndarray
+    level: np.ndarray
+    wave_min: np.ndarray
+    wave_max: np.ndarray
+    peak: float
+    clipped: int
+    band: tuple[float, float]
+    sos: np.ndarray
+
+
+def band_filter(band, sample_rate: int) -> tuple[tuple[float, float], np.ndarray]:
+    """The band-pass for ``band`` (Hz), its upper edge kept below 0.45 × the rate."""
+    lo, hi = (float(b) for b in band)
+    hi = min(hi, 0.45 * sample_rate)
+    if not (np.isfinite(lo) and 20.0 <= lo < hi):
+        raise AudioFileError(
+            f"`band` must be two frequencies 20 Hz <= low < high (the high edge at most "
+            f"0.45 × the sample rate, {0.45 * sample_rate:g} Hz), got {tuple(band)!r}."
+        )
+    return (lo, hi), signal.butter(2, (lo, hi), btype="bandpass", fs=sample_rate, output="sos")
+
+
+def scan(
+    recording: Recording,
+    *,
+    band=DEFAULT_BAND,
+    sensitivity: float = DEFAULT_SENSITIVITY,
+    progress=None,
+) -> Scan:
+    """Read ``recording`` once and build the detection curve and its threshold.
+
+    progress : an object with ``update(frames)``, told after each block (or None).
+
+    Raises `AudioFileError` for a file whose every sample is 0; warns for one that
+    clipped or is very quiet.
+    """
+    rate = recording.sample_rate
+    hop = max(1, round(HOP * rate))
+    band, sos = band_filter(band, rate)
+    zi = np.zeros((sos.shape[0], 2))
+    block = hop * DISPLAY_HOPS * max(1, (1 << 20) // (hop * DISPLAY_HOPS))
+    energies, mins, maxs = [], [], []
+    peak, clipped = 0.0, 0
+    rest = np.zeros(0, dtype=np.float32)
+    for _, data in recording.blocks(block):
+        magnitude = np.abs(data)
+        peak = max(peak, float(magnitude.max()))
+        clipped += int(np.count_nonzero(magnitude >= CLIP_LEVEL))
+        del magnitude
+        # float64: scipy's sosfilt runs twice as fast on it as on float32
+        mix = data @ np.full(data.shape[1], 1.0 / data.shape[1])
+        mix = np.concatenate([rest, mix]) if rest.size else mix
+        whole = mix.size - mix.size % (hop * DISPLAY_HOPS)
+        if whole == 0:
+            rest = mix
+            continue
+        rest = mix[whole:].copy()
+        mix = mix[:whole]
+        y, zi = signal.sosfilt(sos, mix, zi=zi)
+        energies.append((y * y).reshape(-1, hop).sum(axis=1).astype(np.float32))
+        cols = mix.reshape(-1, hop * DISPLAY_HOPS)
+        mins.append(cols.min(axis=1))
+        maxs.append(cols.max(axis=1))
+        if progress is not None:
+            progress.update(data.shape[0])
+    if rest.size:  # the last partial column, padded with silence
+        padded = np.zeros(hop * DISPLAY_HOPS, dtype=np.float32)
+        padded[: rest.size] = rest
+        y, zi = signal.sosfilt(sos, padded, zi=zi)
+        energies.append((y * y).reshape(-1, hop).sum(axis=1).astype(np.float32))
+        mins.append(np.array([rest.min()], dtype=np.float32))
+        maxs.append(np.array([rest.max()], dtype=np.float32))
+    _check_levels(recording, peak, clipped)
+    energy = np.concatenate(energies)
+    del energies
+    curve = detection_curve(energy, hop)
+    threshold = adaptive_threshold(curve, hop / rate, sensitivity)
+    level = 10 * np.log10(energy / np.float32(hop) + np.float32(_FLOOR))
+    return Scan(
+        hop, curve.astype(np.float32), threshold.astype(np.float32), level.astype(np.float32),
+        np.concatenate(mins), np.concatenate(maxs), peak, clipped, band, sos,
+    )  # fmt: skip
+
+
+def _check_levels(recording: Recording, peak: float, clipped: int) -> None:
+    name = str(recording.path)
+    if peak == 0.0:
+        raise AudioFileError(
+            f"recording {name!r} is silent: every sample is 0. Check the microphone "
+            f"and that the file is the recording you meant."
+        )
+    if peak < 10 ** (-60 / 20):
+        warnings.warn(
+            f"recording {name!r} is very quiet (peak {20 * np.log10(peak):.0f} dBFS); "
+            f"ticks may drown in the noise of the recorder: record closer or louder.",
+            UserWarning,
+            stacklevel=3,
+        )
+    if clipped:
+        share = clipped / (recording.frames * recording.channels)
+        warnings.warn(
+            f"recording {name!r} clipped: {clipped} samples ({100 * share:.2g} %) at full "
+            f"scale. Tick times stay usable, but loudness (tick strengths, and telling "
+            f"metronomes apart by it) is capped: record with a lower input gain.",
+            UserWarning,
+            stacklevel=3,
+        )
+
+
+def detection_curve(energy: np.ndarray, hop: int, *, chunk: int = 1 << 20) -> np.ndarray:
+    """(F,) rise (dB) of the mean power over `AHEAD` above that over the preceding `PAST`.
+
+    energy : (F,) band-passed energy summed over each hop of ``hop`` samples. Before
+    the first hop the power is taken as the mean of the first `PAST`, after the last
+    as 0. Computed ``chunk`` hops at a time: the temporary arrays stay small.
+    """
+    ahead = max(1, round(AHEAD / HOP))
+    past = max(1, round(PAST / HOP))
+    floor = _FLOOR * hop
+    f = energy.size
+    start = np.full(past, energy[:past].mean(dtype=np.float64))
+    padded = np.concatenate([start, energy, np.zeros(ahead)])
+    curve = np.empty(f, dtype=np.float32)
+    for lo in range(0, f, chunk):
+        hi = min(f, lo + chunk)
+        # hop k of the chunk sits at padded[past + k]
+        c = np.concatenate([[0.0], np.cumsum(padded[lo : hi + past + ahead], dtype=np.float64)])
+        k = np.arange(hi - lo) + past
+        power_ahead = (c[k + ahead] - c[k]) / ahead
+        power_past = (c[k] - c[k - past]) / past
+        curve[lo:hi] = 10 * np.log10((power_ahead + floor) / (power_past + floor))
+    curve[0] = 0.0  # nothing before the first hop to rise from
+    return curve
+
+
+def adaptive_threshold(curve: np.ndarray, hop_seconds: float, sensitivity: float) -> np.ndarray:
+    """(F,) median + ``sensitivity`` × robust upper spread of ``curve`` over spans of
+    `THRESHOLD_SPAN`, at least `MIN_RISE`; linear between the spans' centres."""
+    span = max(8, round(THRESHOLD_SPAN / hop_seconds))
+    count = max(1, curve.size // span)
+    edges = np.linspace(0, curve.size, count + 1).astype(int)
+    centres, values = [], []
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        part = curve[lo:hi]
+        med = float(np.median(part))
+        above = part[part >= med] - med
+        spread = 1.4826 * float(np.median(above)) if above.size else 0.0
+        centres.append(0.5 * (lo + hi))
+        values.append(max(MIN_RISE, med + sensitivity * spread))
+    return np.interp(np.arange(curve.size), centres, values)
+
+
+def pick_ticks(scan: Scan, refractory_hops: int) -> np.ndarray:
+    """(K,) hop indices of the ticks: peaks above the threshold that are the largest of
+    the curve within ± ``refractory_hops``."""
+    width = 2 * max(1, int(refractory_hops)) + 1
+    local = ndimage.maximum_filter1d(scan.curve, size=width, mode="constant", cval=-np.inf)
+    return np.flatnonzero((scan.curve >= local) & (scan.curve > scan.threshold))
+
+
+@dataclass(frozen=True)
+class Ticks:
+    """Ticks timed on the waveform.
+
+    time : (K,) onset times, s from the start of the recording.
+    strength : (K,) envelope peak of the channel mix, dBFS.
+    channel_strength : (K, C) envelope peak of each channel, dBFS.
+    rise : (K,) value of the detection curve at the tick, dB.
+    """
+
+    time: np.ndarray
+    strength: np.ndarray
+    channel_strength: np.ndarray
+    rise: np.ndarray
+
+
+def refine(recording: Recording, scan: Scan, hops: np.ndarray, *, chunk: int = 2048) -> Ticks:
+    """Time the ticks found at ``hops`` on the waveform (see the module docstring)."""
+    rate = recording.sample_rate
+    half = round(REFINE_HALF * rate)
+    starts = hops.astype(np.int64) * scan.hop - half
+    times = np.empty(hops.size)
+    strength = np.empty(hops.size)
+    per_channel = np.empty((hops.size, recording.channels))
+    for first, segments in _segments(recording, starts, 2 * half, chunk):
+        sl = slice(first, first + segments.shape[0])
+        onset, peak, channel_peak = _time_segments(segments, scan, half)
+        times[sl] = (starts[sl] + onset) / rate
+        strength[sl] = 20 * np.log10(peak + 1e-12)
+        per_channel[sl] = 20 * np.log10(channel_peak + 1e-12)
+    return Ticks(times, strength, per_channel, scan.curve[hops].astype(float))
+
+
+def _time_segments(segments: np.ndarray, scan: Scan, half: int):
+    """Onset (fractional sample in the segment), envelope peak of the mix, per channel."""
+    hop = scan.hop
+    width = segments.shape[1]
+    mix = segments @ np.full(segments.shape[2], 1.0 / segments.shape[2], dtype=np.float32)
+    filtered = signal.sosfiltfilt(scan.sos, mix, axis=1)
+    env = np.abs(signal.hilbert(filtered, N=fft.next_fast_len(width), axis=1))[:, :width]
+    lo, hi = half - 2 * hop, half + 4 * hop
+    ip = lo + np.argmax(env[:, lo:hi], axis=1)
+    rows = np.arange(env.shape[0])
+    peak = env[rows, ip]
+    background = np.median(env[:, : half - 2 * hop], axis=1)
+    level = background + 0.5 * (peak - background)
+    below = env < level[:, None]
+    below[:, 0] = True
+    # the last sample below the level before the peak: the envelope rises through it next
+    cols = np.arange(env.shape[1])
+    j = np.max(np.where(below & (cols[None, :] < ip[:, None]), cols[None, :], 0), axis=1)
+    e0, e1 = env[rows, j], env[rows, np.minimum(j + 1, env.shape[1] - 1)]
+    frac = np.clip((level - e0) / np.where(e1 > e0, e1 - e0, 1.0), 0.0, 1.0)
+    if segments.shape[2] > 1:
+        # the largest band-passed sample: within 2 % of the envelope's peak for a click
+        # with 10 or more samples per cycle, and a third of the cost
+        chan = np.abs(signal.sosfilt(scan.sos, segments, axis=1)[:, lo:hi, :])
+        channel_peak = chan.max(axis=1)
+    else:
+        channel_peak = peak[:, None]
+    return j + frac, peak, channel_peak
+
+
+def _segments(recording: Recording, starts: np.ndarray, length: int, chunk: int):
+    """Yield (index of the first, (n, length, C) segments) in order of ``starts`` (sorted),
+    reading the file once; frames outside the file are zeros."""
+    n = starts.size
+    done = 0
+    buffer = np.zeros((0, recording.channels), dtype=np.float32)
+    buffer_start = 0
+    stream = recording.blocks()
+    exhausted = False
+    while done < n:
+        # extend the buffer until it covers the next tick's whole segment (zeros past the end)
+        need = starts[done] + length
+        while buffer_start + buffer.shape[0] < need:
+            block = None if exhausted else next(stream, None)
+            if block is None:
+                exhausted = True
+                block = (0, np.zeros((need - buffer_start - buffer.shape[0], recording.channels),
+                                     dtype=np.float32))  # fmt: skip
+            buffer = np.concatenate([buffer, block[1]])
+        end = buffer_start + buffer.shape[0]
+        stop = done + int(np.searchsorted(starts[done:] + length, end, side="right"))
+        stop = min(stop, done + chunk)
+        idx = starts[done:stop] - buffer_start
+        take = np.empty((stop - done, length, recording.channels), dtype=np.float32)
+        for m, s in enumerate(idx):
+            if s >= 0:
+                take[m] = buffer[s : s + length]
+            else:  # before the first frame
+                take[m] = 0.0
+                take[m, -s:] = buffer[: length + s]
+        yield done, take
+        done = stop
+        if done < n:  # drop what no later segment needs
+            keep_from = min(max(0, starts[done] - buffer_start), buffer.shape[0])
+            buffer = buffer[keep_from:]
+            buffer_start += keep_from

@@ -1,0 +1,60 @@
+"""The printed summary of an `analyze_audio` dataset, in plain words."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _quarter_mean(values: np.ndarray, last: bool) -> float:
+    values = np.asarray(values, dtype=float)
+    q = max(1, values.size // 4)
+    part = values[-q:] if last else values[:q]
+    part = part[np.isfinite(part)]
+    return float(part.mean()) if part.size else float("nan")
+
+
+def summary_text(ds) -> str:
+    """Lines: the file, the ticks and tempo, each metronome's beat, the synchrony."""
+    a = ds.attrs
+    k = ds.sizes["tick"]
+    n = int(a["metronomes"])
+    lines = [
+        f"metrosync analyze: {a['path']} ({a['format']}, {a['channels']} channel(s), "
+        f"{a['sample_rate']} Hz, {a['duration']:.1f} s)",
+        f"  ticks: {k}, beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
+        f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",
+        f"  metronomes: {n} ({a['metronomes_source']})"
+        + (f"; told apart by {a['attribution']}" if a["attribution"] != "none" else "")
+        + (f"; not told apart ({a['attribution_note']})" if a["attribution_note"] else ""),
+    ]
+    if "metronome" in ds.dims:
+        for m in range(ds.sizes["metronome"]):
+            lines.append(
+                f"  metronome {m}: {float(ds.bpm[m]):.3f} ± {float(ds.bpm_error[m]):.3f} BPM, "
+                f"jitter {1e3 * float(ds.jitter[m]):.2f} ms, {int(ds.ticks[m])} ticks"
+                + (f" ({int(ds.missed_beats[m])} beats missed)" if int(ds.missed_beats[m]) else "")
+            )
+            lines.append(f"    {str(ds.beat_verdict.values[m])}")
+    phase = ds.phase_difference.values
+    if np.isfinite(phase).any():
+        last = phase[np.isfinite(phase)]
+        last = last[-max(1, last.size // 4) :]
+        z = np.exp(1j * last).mean()
+        spread = np.degrees(np.sqrt(max(0.0, -2 * np.log(max(abs(z), 1e-12)))))
+        state = "drifting: not locked" if spread > 60 else "locked"
+        lines.append(
+            f"  phase difference of the ticks (1 in 0's beat), last quarter: "
+            f"{np.degrees(np.angle(z)):.1f}° ± {spread:.1f}° ({state}; 0°: together; the "
+            f"pendulums differ by half this, or half plus 180°)"
+        )
+    if n > 1 or k and "metronome" not in ds.dims:
+        r0, r1 = _quarter_mean(ds.r_acoustic, False), _quarter_mean(ds.r_acoustic, True)
+        f1 = _quarter_mean(ds.r_floor, True)
+        c0, c1 = _quarter_mean(ds.clusters, False), _quarter_mean(ds.clusters, True)
+        lines += [
+            f"  acoustic order parameter R (window {a['order_window']:.1f} s): first quarter "
+            f"{r0:.3f}, last quarter {r1:.3f} (independent metronomes: about {f1:.3f}; "
+            f"1: all tick together)",
+            f"  distinct ticks per beat: first quarter {c0:.1f}, last quarter {c1:.1f}",
+        ]
+    return "\n".join(lines)

@@ -1,0 +1,107 @@
+"""``metrosync analyze recording.wav`` as a user meets it: output, files, and errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import synth
+import xarray as xr
+
+import metrosync
+from metrosync.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_lazy_export():
+    assert metrosync.analyze_audio is metrosync.audio.analyze_audio
+
+
+def test_summary_dataset_and_plot(capsys, tmp_path, pair_recording):
+    path, _ = pair_recording
+    nc, png = tmp_path / "pair.nc", tmp_path / "pair.png"
+    code, out, err = run(capsys, "analyze", str(path), "--out", str(nc), "--plot", str(png))
+    assert code == 0, err
+    assert "told apart by stereo" in out and "out of beat" in out and "in beat" in out
+    assert f"wrote {nc}" in out and png.stat().st_size > 10_000
+    with xr.open_dataset(nc, engine="h5netcdf") as ds:
+        assert {"tick_time", "tick_strength", "detection", "threshold", "r_acoustic",
+                "asymmetry", "phase_difference"} <= set(ds.variables)  # fmt: skip
+        assert ds.tick_time.attrs["units"] == "s"
+        assert np.all(np.diff(ds.tick_time.values) > 0)
+
+
+def test_options_reach_the_analysis(capsys, pair_recording):
+    path, _ = pair_recording
+    code, out, _ = run(capsys, "analyze", str(path), "--bpm", "190", "--metronomes", "2",
+                       "--band", "800,8000", "--refractory", "0.005")  # fmt: skip
+    assert code == 0
+    assert "(given (bpm))" in out and "metronomes: 2 (given)" in out
+
+
+@pytest.mark.parametrize(
+    ("setup", "argv", "message"),
+    [
+        (None, ["missing.wav"], "does not exist"),
+        ("empty", ["e.wav"], "empty (0 bytes)"),
+        ("text", ["t.wav"], "as audio"),
+        ("m4a", ["phone.m4a"], "ffmpeg -i phone.m4a phone.wav"),
+        ("silent", ["s.wav"], "silent"),
+        ("two", ["a.wav", "b.wav"], "one recording at a time"),
+        ("mixed", ["a.wav", "run.log"], "not both"),
+        ("silent", ["s.wav", "--bpm", "1000"], "`bpm` (--bpm) must be a tempo in 20..400"),
+        ("silent", ["s.wav", "--out", "x.txt"], "`--out` 'x.txt' must end in .nc"),
+        ("silent", ["s.wav", "--band", "5000,2000"], "`band` (--band) must be two frequencies"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, setup, argv, message):
+    monkeypatch.chdir(tmp_path)
+    if setup == "empty":
+        (tmp_path / "e.wav").write_bytes(b"")
+    elif setup == "text":
+        (tmp_path / "t.wav").write_text("hello")
+    elif setup == "m4a":
+        (tmp_path / "phone.m4a").write_bytes(b"\0\0\0\x18ftypM4A ")
+    elif setup == "silent":
+        synth.write(tmp_path / "s.wav", np.zeros((44100, 1)))
+    elif setup in ("two", "mixed"):
+        synth.write(tmp_path / "a.wav", np.zeros((44100, 1)))
+        synth.write(tmp_path / "b.wav", np.zeros((44100, 1)))
+        (tmp_path / "run.log").write_text("0 1\n")
+    code, out, err = run(capsys, "analyze", *argv)
+    assert code == 2
+    assert message in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_light_gate_options_with_a_recording_warn(capsys, pair_recording):
+    path, _ = pair_recording
+    code, _, err = run(capsys, "analyze", str(path), "--glitch", "0.01")
+    assert code == 0
+    assert "a recording ignores --glitch" in err
+
+
+def test_audio_options_with_logs_warn(capsys):
+    from pathlib import Path
+
+    log = Path(__file__).parents[1] / "data" / "clean.log"
+    code, _, err = run(capsys, "analyze", str(log), "--bpm", "180")
+    assert "light-gate logs ignore --bpm" in err
+
+
+def test_a_tempo_far_from_the_ticks_warns(capsys, pair_recording):
+    path, _ = pair_recording
+    code, _, err = run(capsys, "analyze", str(path), "--bpm", "62")
+    assert code == 0
+    assert "the ticks sound like 18" in err and "not near `bpm` 62" in err
+
+
+def test_follow_with_a_recording_warns(capsys, pair_recording):
+    path, _ = pair_recording
+    code, _, err = run(capsys, "analyze", str(path), "--follow")
+    assert code == 0
+    assert "a recording ignores --follow" in err

@@ -1,0 +1,73 @@
+"""Tick detection: recall, precision and timing on recordings with known tick times."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import synth
+
+from metrosync.audio import analyze_audio
+from metrosync.audio import detection as det
+from metrosync.audio.reader import open_recording
+
+
+def scored(path, trains, **options):
+    """Recall and precision over the ticks the detector can resolve (no tick of another
+    metronome within its refractory time), and the timing errors."""
+    ds = analyze_audio(path, **options)
+    found = ds.tick_time.values
+    times, alone = synth.resolvable(trains, ds.attrs["refractory"])
+    recall, _, errors = synth.match(times[alone], found)
+    # a detection is right when it lies within 1 ms of any tick (merged ones included)
+    _, precision, _ = synth.match(times, found)
+    return recall, precision, errors, ds
+
+
+@pytest.mark.parametrize("noisy", [False, True], ids=["clean", "noise+reverb 10 dB"])
+def test_one_metronome_every_tick_found_within_a_millisecond(tmp_path, rng, noisy):
+    train = synth.metronome_train(176, 30, phase=0.3, asymmetry=0.03, jitter=2e-4, rng=rng)
+    x = synth.render([train], 30)
+    if noisy:
+        x = synth.add_noise(synth.add_reverb(x, rng), 10.0, [train], rng)
+    recall, precision, errors, _ = scored(synth.write(tmp_path / "one.wav", x), [train])
+    assert recall == 1.0 and precision == 1.0
+    assert np.abs(errors).max() <= 1e-3
+    assert np.abs(errors).max() <= 0.2e-3  # in fact a few samples
+
+
+@pytest.mark.parametrize("noisy", [False, True], ids=["clean", "noise+reverb 10 dB"])
+def test_two_metronomes_recall_and_precision_above_99_percent(tmp_path, rng, noisy):
+    trains = [synth.metronome_train(192, 40, phase=0.1),
+              synth.metronome_train(185, 40, phase=0.55)]  # fmt: skip
+    x = synth.render(trains, 40, gains=[0.5, 0.3])
+    if noisy:
+        x = synth.add_noise(synth.add_reverb(x, rng), 10.0, trains, rng)
+    recall, precision, errors, ds = scored(synth.write(tmp_path / "two.wav", x), trains)
+    assert recall >= 0.99 and precision >= 0.99
+    assert np.abs(errors).max() <= 1e-3
+
+
+def test_ticks_across_block_boundaries_are_timed_right(pair_recording):
+    """The recording is longer than one block of the reader (2^20 frames)."""
+    path, trains = pair_recording
+    recall, precision, errors, ds = scored(path, trains)
+    assert open_recording(path).frames > 1 << 20
+    assert recall >= 0.99 and precision >= 0.99 and np.abs(errors).max() <= 1e-3
+
+
+def test_detection_curve_and_threshold_are_kept_for_inspection(pair_recording):
+    path, _ = pair_recording
+    ds = analyze_audio(path)
+    assert ds.detection.shape == ds.threshold.shape == ds.frame.shape
+    frames = np.searchsorted(ds.frame.values, ds.tick_time.values)
+    # every tick is a rise of the curve above its threshold, within a hop or two
+    near = [ds.detection.values[max(0, f - 2) : f + 3].max() for f in frames]
+    thr = ds.threshold.values[np.minimum(frames, ds.frame.size - 1)]
+    assert np.all(np.array(near) > thr)
+    assert np.all(ds.threshold.values >= det.MIN_RISE)
+
+
+def test_white_noise_alone_gives_no_ticks(tmp_path, rng):
+    path = synth.write(tmp_path / "noise.wav", rng.normal(0, 0.05, (44100 * 60, 1)))
+    scan = det.scan(open_recording(path))
+    assert det.pick_ticks(scan, 20).size <= 1  # fewer than one false tick a minute
