@@ -1,0 +1,1 @@
+"""Theory: the steady-swing tuning and the reduced (Kuramoto–Sakaguchi) description."""
