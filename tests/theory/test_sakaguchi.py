@@ -59,8 +59,10 @@ def test_gaussian_threshold_matches_the_dispersion_relation_by_quadrature(alpha)
 
 def erfi_series(x: float) -> float:
     """erfi(x) = (2/√π) Σ x^(2n+1) / (n! (2n+1)), independently of scipy."""
-    return 2 / math.sqrt(math.pi) * sum(
-        x ** (2 * n + 1) / (math.factorial(n) * (2 * n + 1)) for n in range(40)
+    return (
+        2
+        / math.sqrt(math.pi)
+        * sum(x ** (2 * n + 1) / (math.factorial(n) * (2 * n + 1)) for n in range(40))
     )
 
 
