@@ -5,9 +5,10 @@ Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
 `sweep` (parameter grids), `reproduce` (the paper's studies), and `animate`,
-`write_wav`, `write_page`, `plot_run` (seeing and hearing a run), and
-`write_playground` (the model live in a browser). These last five are
-imported on first use, so that ``import metrosync`` stays quick.
+`write_wav`, `write_page`, `plot_run` (seeing and hearing a run),
+`write_playground` (the model live in a browser), and `reduced_theory`,
+`simulate_reduced` (the phase-model reduction, `metrosync.theory`). These last seven
+are imported on first use, so that ``import metrosync`` stays quick.
 """
 
 from ._version import __version__
@@ -35,6 +36,8 @@ _LAZY = {
     "write_wav": "show",
     "sweep": "sweeps",
     "reproduce": "paper",
+    "reduced_theory": "theory",
+    "simulate_reduced": "theory",
 }
 
 __all__ = [

@@ -92,6 +92,7 @@ def test_inversion_is_exact_to_well_below_the_requirement():
     back = steady_swing_l2(DESIGN, ticks)
     np.testing.assert_allclose(back, l2, atol=1e-9)
     np.testing.assert_allclose(tick_rate_bpm(DESIGN, back), ticks, atol=1e-4)
+    np.testing.assert_allclose(tick_rate_bpm(DESIGN, l2, exact=False), ticks, atol=1e-4)
     assert isinstance(steady_swing_l2(DESIGN, 192.0), float)
 
 
@@ -122,3 +123,22 @@ def test_bad_input_is_named():
         steady_swing_l2(overturning, 150.0)
     with pytest.raises(ParameterError, match=r"over the top"):
         steady_swing(overturning.with_l2(0.04))
+
+
+def test_relaxation_rate_is_c_over_2i_for_small_swings_and_matches_a_simulation():
+    from metrosync.theory.tuning import relaxation_rate
+
+    small = dataclasses.replace(DESIGN, drive=6e-6)  # a 0.08 rad swing
+    m = small.with_l2(0.04)
+    assert relaxation_rate(m) == pytest.approx(small.c_theta / (2 * m.inertia), rel=0.01)
+    # At the default swing: start 5 % above it and watch the excess decay.
+    m = DESIGN.with_l2(0.04)
+    swing = steady_swing(m)
+    ds = simulate(n=None, bpm=None, metronomes=[m], changes={"inertia": math.inf},
+                  theta0=[1.05 * swing.amplitude], theta_dot0=[0.0], duration=8.0, dt=2.5e-4,
+                  trajectories=True, record_every=1)  # fmt: skip
+    theta, t = ds.theta.values[:, 0, 0], ds.time.values
+    peaks = np.nonzero((theta[1:-1] > theta[:-2]) & (theta[1:-1] >= theta[2:]))[0] + 1
+    excess = theta[peaks] - swing.amplitude
+    rate = -np.polyfit(t[peaks][2:], np.log(excess[2:]), 1)[0]
+    assert rate == pytest.approx(relaxation_rate(m), rel=0.05)

@@ -98,8 +98,12 @@ def _fields(z, q_re, q_im):
     """K e^{−iα} z at t_n and at t_n + dt/2, z_½ = (3 z_n − z_{n−1})/2."""
     zr, zi, pr, pi_ = z[0], z[1], z[2], z[3]
     hzr, hzi = 1.5 * zr - 0.5 * pr, 1.5 * zi - 0.5 * pi_
-    return (q_re * zr - q_im * zi, q_re * zi + q_im * zr,
-            q_re * hzr - q_im * hzi, q_re * hzi + q_im * hzr)  # fmt: skip
+    return (
+        q_re * zr - q_im * zi,
+        q_re * zi + q_im * zr,
+        q_re * hzr - q_im * hzi,
+        q_re * hzi + q_im * hzr,
+    )
 
 
 @njit(**_OPTIONS)
@@ -130,8 +134,9 @@ def _advance_threads(cr, ci, om, q_re, q_im, z, dt, n_steps, record_every, rec, 
 @njit(parallel=True, **_OPTIONS)
 def _advance_runs(cr, ci, om, q_re, q_im, z, dt, n_steps, record_every, rec, rec0):
     for b in prange(cr.shape[0]):
-        _advance_serial(cr[b], ci[b], om[b], q_re, q_im, z[b], dt, n_steps, record_every,
-                        rec[b], rec0)  # fmt: skip
+        _advance_serial(
+            cr[b], ci[b], om[b], q_re, q_im, z[b], dt, n_steps, record_every, rec[b], rec0
+        )
 
 
 def _per_oscillator(name: str, value, runs: int, n: int | None) -> np.ndarray:
@@ -257,11 +262,22 @@ def simulate_reduced(
             if n >= LARGE_N:
                 advance = _advance_threads if threads else _advance_serial
                 for b in range(runs):
-                    advance(cr[b], ci[b], om[b], *args, z[b], dt, count, record_every,
-                                     rec[b], step // record_every)  # fmt: skip
+                    advance(
+                        cr[b],
+                        ci[b],
+                        om[b],
+                        *args,
+                        z[b],
+                        dt,
+                        count,
+                        record_every,
+                        rec[b],
+                        step // record_every,
+                    )
             else:
-                _advance_runs(cr, ci, om, *args, z, dt, count, record_every, rec,
-                              step // record_every)  # fmt: skip
+                _advance_runs(
+                    cr, ci, om, *args, z, dt, count, record_every, rec, step // record_every
+                )
             step += count
             bar.update(round(count * dt, 6))
 

@@ -116,8 +116,15 @@ def _half_swing(u_plus: float, gamma: float) -> tuple[float, float, float]:
         return y[1]
 
     turn.direction = -1
-    sol = solve_ivp(rhs, (0.0, 200.0), (0.0, u_plus), method="DOP853", rtol=_RTOL, atol=_ATOL,
-                    events=(back, over, turn))  # fmt: skip
+    sol = solve_ivp(
+        rhs,
+        (0.0, 200.0),
+        (0.0, u_plus),
+        method="DOP853",
+        rtol=_RTOL,
+        atol=_ATOL,
+        events=(back, over, turn),
+    )
     if sol.t_events[0].size == 0:
         return math.inf, 0.0, math.pi
     return float(sol.t_events[0][0]), float(-sol.y_events[0][0][1]), float(sol.y_events[2][0][0])
@@ -166,6 +173,23 @@ def steady_swing(metronome: Metronome) -> SteadySwing:
     )
 
 
+def relaxation_rate(metronome: Metronome) -> float:
+    """Rate (1/s) at which the swing amplitude returns to the steady swing.
+
+    The Floquet exponent of the half-swing map at its fixed point: a change δu₊ of the
+    speed after a kick comes back as (du₋/du₊) δu₊ half a period later, so the rate is
+    −ln(du₋/du₊) / (half period). For small swings it is c_θ / (2I).
+    """
+    swing = steady_swing(metronome)
+    omega0 = metronome.natural_omega
+    gamma = metronome.design.c_theta / (metronome.inertia * omega0)
+    u = swing.speed_after_kick / omega0
+    h = 1e-6 * u
+    back = [_half_swing(u + sign * h, gamma)[1] for sign in (-1.0, 1.0)]
+    multiplier = (back[1] - back[0]) / (2 * h)
+    return -math.log(multiplier) * swing.tick_bpm / 60.0
+
+
 def energy_balance_swing(metronome: Metronome) -> SteadySwing:
     """First-order steady swing: elliptic-integral energy balance and period.
 
@@ -196,15 +220,28 @@ def energy_balance_swing(metronome: Metronome) -> SteadySwing:
     )
 
 
-def tick_rate_bpm(design: MetronomeDesign, l2):
+def tick_rate_bpm(design: MetronomeDesign, l2, *, exact: bool = True):
     """Tick rate (BPM) at the steady swing of ``design`` with slider at ``l2`` (m).
 
-    Scalars give a float, arrays an array of the same shape (each solved exactly).
+    Scalars give a float, arrays an array of the same shape. ``exact`` solves each
+    swing (tens of ms apiece); otherwise the per-design table is interpolated (to
+    ~1e-7 BPM, for many metronomes at once).
     """
+    if not exact:
+        l2_arr = np.asarray(l2, dtype=float)
+        natural = np.sqrt(_natural_omega_sq(design, l2_arr)) * 60.0 / math.pi
+        out = _table(design).ratio(l2_arr) * natural
+        return out if out.ndim else float(out)
     l2_arr = np.asarray(l2, dtype=float)
     out = np.array([steady_swing(design.with_l2(float(x))).tick_bpm for x in l2_arr.flat])
     out = out.reshape(l2_arr.shape)
     return out if out.ndim else float(out)
+
+
+def _natural_omega_sq(design: MetronomeDesign, l2):
+    m = design.mass
+    h = (design.w1 * design.l1 - design.w2 * l2) / m
+    return m * design.g * h / (m * h * h + design.w1 * design.l1**2 + design.w2 * l2 * l2)
 
 
 @dataclass(frozen=True)
