@@ -20,8 +20,15 @@ def test_identical_oscillators_leave_the_splay_state_at_half_k_cos_alpha(alpha):
     # Linearising about the splay state gives dz/dt = (iω + (K/2) e^{−iα}) z exactly for
     # N >= 3, so r grows as e^{(K/2) cos α t}: a check of the sign convention of α.
     k, eps = 0.2, 1e-4
-    ds = simulate_reduced(omega=np.zeros(16), k=k, alpha=alpha, phases0=splay(16, eps),
-                          duration=60.0, dt=0.05, record_every=20)  # fmt: skip
+    ds = simulate_reduced(
+        omega=np.zeros(16),
+        k=k,
+        alpha=alpha,
+        phases0=splay(16, eps),
+        duration=60.0,
+        dt=0.05,
+        record_every=20,
+    )
     r = ds.r.values[:, 0]
     t = ds.time.values
     rate = np.polyfit(t, np.log(r), 1)[0]
@@ -33,10 +40,17 @@ def test_scheme_is_second_order():
     rng = np.random.default_rng(3)
     omega, phases = rng.normal(0, 0.05, 300), rng.uniform(0, 2 * np.pi, 300)
     runs = {
-        dt: simulate_reduced(omega=omega, phases0=phases, k=0.15, alpha=0.5, duration=40.0,
-                             dt=dt, record_every=int(round(2.0 / dt))).r.values[:, 0]
+        dt: simulate_reduced(
+            omega=omega,
+            phases0=phases,
+            k=0.15,
+            alpha=0.5,
+            duration=40.0,
+            dt=dt,
+            record_every=int(round(2.0 / dt)),
+        ).r.values[:, 0]
         for dt in (0.4, 0.2, 0.1, 0.05)
-    }  # fmt: skip
+    }
     errors = [np.max(np.abs(runs[dt] - runs[0.05])) for dt in (0.4, 0.2, 0.1)]
     slopes = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     # The error against dt/2^k: 1 − 4^(−k) times the leading term, so the ratios near 2nd
@@ -49,10 +63,13 @@ def test_incoherence_gives_way_at_the_sakaguchi_threshold(alpha):
     sigma = 0.05
     k_c = onset(alpha, sigma).k_c
     r = {
-        f: float(simulate_reduced(20_000, k=f * k_c, alpha=alpha, sigma=sigma, duration=800.0,
-                                  dt=0.25, seed=5).r_eq[0])
+        f: float(
+            simulate_reduced(
+                20_000, k=f * k_c, alpha=alpha, sigma=sigma, duration=800.0, dt=0.25, seed=5
+            ).r_eq[0]
+        )
         for f in (0.9, 1.1)
-    }  # fmt: skip
+    }
     # 10 % below: finite-size noise, a few/√N ≈ 0.02. 10 % above: partial locking.
     assert r[0.9] < 0.05
     assert r[1.1] > 0.25

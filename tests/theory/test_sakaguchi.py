@@ -36,8 +36,16 @@ def gaussian_dispersion_by_quadrature(alpha: float, sigma: float = 1.0):
 
     def big_g(om):
         # Cauchy principal value by scipy's QAWC (weight 1/(ω − Ω)) on a wide interval.
-        pv, _ = quad(g, om - 12 * sigma, om + 12 * sigma, weight="cauchy", wvar=om,
-                     epsabs=1e-13, epsrel=1e-13, limit=200)  # fmt: skip
+        pv, _ = quad(
+            g,
+            om - 12 * sigma,
+            om + 12 * sigma,
+            weight="cauchy",
+            wvar=om,
+            epsabs=1e-13,
+            epsrel=1e-13,
+            limit=200,
+        )
         return complex(math.pi * g(om), -pv)
 
     def equations(v):

@@ -33,9 +33,14 @@ def counted_tick_rate(ds, k: int, settle: float) -> float:
 def tuned_run(bpms, **kwargs):
     l2 = steady_swing_l2(DESIGN, bpms)
     return simulate(
-        n=None, bpm=None, metronomes=[DESIGN.with_l2(x) for x in l2],
-        changes={"inertia": math.inf}, trajectories=True, record_every=1, **kwargs,
-    )  # fmt: skip
+        n=None,
+        bpm=None,
+        metronomes=[DESIGN.with_l2(x) for x in l2],
+        changes={"inertia": math.inf},
+        trajectories=True,
+        record_every=1,
+        **kwargs,
+    )
 
 
 def test_steady_swing_hits_the_nominal_tick_rate_across_the_tunable_range():
@@ -48,10 +53,15 @@ def test_steady_swing_hits_the_nominal_tick_rate_across_the_tunable_range():
     # ...and far tighter than required; the small-amplitude tuning misses by 7 BPM.
     np.testing.assert_allclose(measured, bpms, atol=0.03)
     small = simulate(
-        n=None, bpm=None, metronomes=[DESIGN.with_l2(DESIGN.l2_for_bpm(192.0))],
-        changes={"inertia": math.inf}, trajectories=True, record_every=1, duration=40.0,
+        n=None,
+        bpm=None,
+        metronomes=[DESIGN.with_l2(DESIGN.l2_for_bpm(192.0))],
+        changes={"inertia": math.inf},
+        trajectories=True,
+        record_every=1,
+        duration=40.0,
         dt=2.5e-4,
-    )  # fmt: skip
+    )
     assert counted_tick_rate(small, 0, 20.0) == pytest.approx(184.74, abs=0.05)
 
 
@@ -134,9 +144,18 @@ def test_relaxation_rate_is_c_over_2i_for_small_swings_and_matches_a_simulation(
     # At the default swing: start 5 % above it and watch the excess decay.
     m = DESIGN.with_l2(0.04)
     swing = steady_swing(m)
-    ds = simulate(n=None, bpm=None, metronomes=[m], changes={"inertia": math.inf},
-                  theta0=[1.05 * swing.amplitude], theta_dot0=[0.0], duration=8.0, dt=2.5e-4,
-                  trajectories=True, record_every=1)  # fmt: skip
+    ds = simulate(
+        n=None,
+        bpm=None,
+        metronomes=[m],
+        changes={"inertia": math.inf},
+        theta0=[1.05 * swing.amplitude],
+        theta_dot0=[0.0],
+        duration=8.0,
+        dt=2.5e-4,
+        trajectories=True,
+        record_every=1,
+    )
     theta, t = ds.theta.values[:, 0, 0], ds.time.values
     peaks = np.nonzero((theta[1:-1] > theta[:-2]) & (theta[1:-1] >= theta[2:]))[0] + 1
     excess = theta[peaks] - swing.amplitude

@@ -79,7 +79,14 @@ def register(subparsers) -> None:
     o.add_argument("--plot", type=Path, default=None, help="write the figure to FILE.png")
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_aliases(
-        parser, bpms="--bpm", sigmas="--sigma", measure_n="--measure-n", changes="--set", n="--n"
+        parser,
+        bpms="--bpm",
+        bpm="--bpm",
+        sigmas="--sigma",
+        sigma_bpm="--sigma",
+        measure_n="--measure-n",
+        changes="--set",
+        n="--n",
     )
     parser.set_defaults(func=run)
 
