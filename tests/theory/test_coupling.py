@@ -102,8 +102,10 @@ def test_disk_scale_and_its_limit():
 
 
 def test_bad_input_is_named():
-    with pytest.raises(ParameterError, match=r"`n` must be an integer >= 16"):
+    with pytest.raises(ParameterError, match=r"`n` must be an integer in \[16, 256\]"):
         measure_by_growth(192.0, n=4)
+    with pytest.raises(ParameterError, match=r"outgrow memory"):
+        measure_by_growth(192.0, n=10_000)
     with pytest.raises(ParameterError, match=r"`points` must be an integer >= 4"):
         measure_by_pair(192.0, points=2)
     with pytest.raises(ParameterError, match=r"over the top"):

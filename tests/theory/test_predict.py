@@ -18,7 +18,9 @@ from metrosync.theory.sakaguchi import critical_coupling
 @pytest.fixture(scope="module")
 def prediction(tmp_path_factory):
     cache = tmp_path_factory.mktemp("theory-cache")
-    ds = reduced_theory(bpms=(160.0, 180.0, 200.0), sigmas=(0.75, 1.0, 3.0), cache=cache)
+    ds = reduced_theory(
+        bpms=(160.0, 180.0, 200.0), sigmas=(0.75, 1.0, 3.0), cache=cache, simulate_n=None
+    )
     return ds, cache
 
 
@@ -51,7 +53,9 @@ def test_measurements_are_cached_and_a_damaged_entry_is_measured_again(predictio
         return real(*args, **kwargs)
 
     monkeypatch.setattr(cp, "measure_by_growth", counting)
-    again = reduced_theory(bpms=(160.0, 180.0, 200.0), sigmas=(0.75, 1.0, 3.0), cache=cache)
+    again = reduced_theory(
+        bpms=(160.0, 180.0, 200.0), sigmas=(0.75, 1.0, 3.0), cache=cache, simulate_n=None
+    )
     assert calls == [160.0]
     xr.testing.assert_allclose(again.k, ds.k)
     assert json.loads(files[0].read_text())["coupling"]["bpm"] == 160.0
@@ -84,8 +88,18 @@ def test_cli_prints_writes_and_plots(prediction, tmp_path, capsys):
     assert "sigma =  0.75 BPM: omega_c =" in text and "K (rad/s)" in text
     ds = xr.open_dataset(out, engine="h5netcdf")
     assert set(ds.sigma.values) == {0.75, 1.0} and ds.attrs["n"] == "inf"
+    # The reduced model's r reaches 1/2 above the linear threshold, and r rises with ω₀.
+    assert np.all(ds.omega_half > ds.omega_c)
+    assert np.all(np.diff(ds.r_reduced.sel(sigma=0.75)) > 0)
     ds.close()
     assert plot.stat().st_size > 10_000
+
+
+def test_cli_refuses_an_unwritable_cache_before_measuring(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert main(["theory", "--cache", str(blocker / "sub"), "--bpm", "160,170"]) == 2
+    assert "`--cache`" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(
@@ -98,6 +112,8 @@ def test_cli_prints_writes_and_plots(prediction, tmp_path, capsys):
         (["--out", "x.txt"], "must end in .nc"),
         (["--preset", "nope"], "unknown preset 'nope'"),
         (["--bpm", "400,410"], "outside the tunable range"),
+        (["--bpm", "150:300:10"], "`bpm` (--bpm) = 240 is outside the tunable range"),
+        (["--measure-n", "5000"], "`measure_n` (--measure-n) must be an integer in [16, 256]"),
     ],
 )
 def test_cli_errors_name_the_option(argv, message, capsys, tmp_path):

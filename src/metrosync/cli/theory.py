@@ -77,6 +77,11 @@ def register(subparsers) -> None:
     o.add_argument("--no-cache", action="store_true", help="measure everything again")
     o.add_argument("--out", type=Path, default=None, help="write the results to FILE.nc")
     o.add_argument("--plot", type=Path, default=None, help="write the figure to FILE.png")
+    o.add_argument(
+        "--no-simulate",
+        action="store_true",
+        help="skip the reduced model's r(omega_0) curves (faster)",
+    )
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_aliases(
         parser,
@@ -122,6 +127,8 @@ def run(args) -> int:
     if changes:
         params = params.with_changes(**changes)
     cache = None if args.no_cache else (args.cache or default_cache_dir())
+    if cache is not None:
+        _check_cache(cache)
     ds = reduced_theory(
         params,
         bpms=bpms,
@@ -131,11 +138,27 @@ def run(args) -> int:
         method=args.method,
         measure_n=args.measure_n,
         cache=cache,
+        simulate_n=None if args.no_simulate else 20_000,
         progress=not args.no_progress and sys.stderr.isatty(),
     )
     _print(ds)
     write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_theory)
     return 0
+
+
+def _check_cache(folder: Path) -> None:
+    """Refuse a cache folder that cannot be written, before anything is measured."""
+    import tempfile
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as error:
+        raise ParameterError(
+            f"`--cache` {str(folder)!r} cannot hold files ({error.strerror or error}); choose "
+            f"another folder, or --no-cache."
+        ) from None
 
 
 def _print(ds) -> None:
@@ -158,7 +181,10 @@ def _print(ds) -> None:
             f"{float(one.alpha) * deg:7.1f} +- {float(one.alpha_err) * deg:4.1f} "
             f"{float(one.k_estimate):11.4f} {float(one.alpha_estimate) * deg:10.1f}"
         )
-    print(f"  predicted critical frequency omega_c ({n_text}; range from K +- 1 sigma):")
+    print(
+        f"  predicted critical frequency omega_c ({n_text}; range from K +- 1 sigma), where "
+        f"incoherence turns unstable:"
+    )
     lo, hi = ds.bpm.values[0], ds.bpm.values[-1]
     for i, sigma in enumerate(ds.sigma.values):
         one = ds.isel(sigma=i)
@@ -170,7 +196,9 @@ def _print(ds) -> None:
                 f"widen --bpm"
             )
         else:
+            half = float(one.omega_half) if "omega_half" in ds else math.nan
             print(
                 f"    sigma = {sigma:5.2f} BPM: omega_c = {wc:6.1f} BPM "
                 f"[{float(one.omega_c_low):.1f}, {float(one.omega_c_high):.1f}]"
+                + ("" if math.isnan(half) else f"; reduced model: r = 1/2 at {half:.1f} BPM")
             )

@@ -64,6 +64,8 @@ from ..simulate import simulate
 from .tuning import l2_for_bpm, relaxation_rate, steady_swing
 
 METHODS = ("growth", "pair")
+#: Most metronomes in a growth run (its trajectories are kept in memory).
+MAX_GROWTH_N = 256
 #: Integration step of the measurements, s (continuous-time model; see the docstring).
 MEASURE_DT = 1e-4
 
@@ -187,6 +189,16 @@ def _line(x, y):
     return slope, se
 
 
+def check_growth_n(n, name: str = "n") -> None:
+    """Refuse a growth-run size outside [16, `MAX_GROWTH_N`], naming the argument."""
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 16 <= n <= MAX_GROWTH_N:
+        raise ParameterError(
+            f"`{name}` must be an integer in [16, {MAX_GROWTH_N}] for the growth method (below "
+            f"16, harmonics of H enter through indices ±1 mod N; above, the recorded swings "
+            f"outgrow memory, and K for any N follows from `Coupling.for_n`), got {n!r}."
+        )
+
+
 def measure_by_growth(
     bpm: float,
     *,
@@ -203,11 +215,7 @@ def measure_by_growth(
     r_max : end of the fitted window (r stays in the linear regime below it).
     """
     params = get_preset(params, warn=False)
-    if isinstance(n, bool) or not isinstance(n, int) or n < 16:
-        raise ParameterError(
-            f"`n` must be an integer >= 16 for the growth method (harmonics of H would "
-            f"enter through indices ±1 mod N), got {n!r}."
-        )
+    check_growth_n(n)
     metronome, swing = _tuned(bpm, params, tuning)
     guess = estimate(bpm, n, params, tuning=tuning)
     rate = max(guess.k_cos / 2, 1e-3)
