@@ -6,12 +6,8 @@ import numpy as np
 import pytest
 
 from metrosync import ParameterError, get_preset, simulate
-from metrosync.theory.coupling import (
-    disk_scale,
-    estimate,
-    measure_by_growth,
-    measure_by_pair,
-)
+from metrosync.theory.coupling import disk_scale, measure_by_growth, measure_by_pair
+from metrosync.theory.estimate import estimate
 
 PARAMS = get_preset("default")
 

@@ -10,7 +10,8 @@ Nothing here is imported by ``import metrosync``; `reduced_theory` and
 `simulate_reduced` are served lazily from the top-level package.
 """
 
-from .coupling import Coupling, disk_scale, estimate, measure_by_growth, measure_by_pair
+from .coupling import Coupling, disk_scale, measure_by_growth, measure_by_pair
+from .estimate import estimate
 from .figure import plot_theory
 from .fitted import simulate_fitted
 from .predict import coupling_curve, default_cache_dir, predict_onset, reduced_theory

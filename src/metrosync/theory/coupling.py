@@ -38,14 +38,7 @@ inertia the swinging weights push against (`disk_scale`; with today's J(N) law i
 saturates at N → ∞ at 1/(j + m R²)). K(ω₀, N) is stored as κ(ω₀) = K/(N/D₀) and
 rescaled; a test checks the law between N = 16 and 64.
 
-The analytic estimate (`estimate`), first order in the coupling: the disk turns with
-D₀ φ̈ ≈ m R h Σ_j ω² θ_j, which shifts each pendulum's frequency reactively,
-K sin α = −N μ ω c₂ / 2 with μ = (m R h)² / (I D₀) and c₂ = ⟨cos²θ⟩ over the swing (exact
-for one metronome on the disk), and through the amplitude,
-K cos α = N μ ω A |dω/dA| c₂ / (2 λ_A). This is the mechanism Pantaleone derives for a
-rolling board and van der Pol escapements (Am. J. Phys. 70, 992 (2002), eqs. 34–37):
-synchrony from the coupling acting on the amplitude, turned into phase by the
-pendulum's anisochrony.
+The analytic estimate beside the measurements is in `estimate`.
 """
 
 from __future__ import annotations
@@ -54,8 +47,6 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.integrate import quad
-from scipy.special import ellipk
 
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
@@ -217,6 +208,8 @@ def measure_by_growth(
     params = get_preset(params, warn=False)
     check_growth_n(n)
     metronome, swing = _tuned(bpm, params, tuning)
+    from .estimate import estimate  # it builds on this module
+
     guess = estimate(bpm, n, params, tuning=tuning)
     rate = max(guess.k_cos / 2, 1e-3)
     t_min = 5.0
@@ -360,52 +353,5 @@ def measure_by_pair(
         k_sin_err=float(np.ptp(sin_fits)) / 2,
         method="pair",
         scale=disk_scale(2, params),
-        free_bpm=swing.tick_bpm,
-    )
-
-
-def _mean_cos_squared(amplitude: float) -> float:
-    """⟨cos²θ⟩ over one swing of a conservative pendulum of that amplitude."""
-    k = math.sin(amplitude / 2)
-
-    def integrand(u):
-        theta = 2 * math.asin(k * math.sin(u))
-        return math.cos(theta) ** 2 / math.sqrt(1 - (k * math.sin(u)) ** 2)
-
-    return quad(integrand, 0, math.pi / 2, epsabs=1e-12)[0] / float(ellipk(k * k))
-
-
-def estimate(
-    bpm: float,
-    n: int | float,
-    params: ModelParameters | str = "default",
-    *,
-    tuning: str = "small-amplitude",
-) -> Coupling:
-    """The first-order analytic K e^{−iα} (module docstring); its error is not known (0)."""
-    params = get_preset(params, warn=False)
-    metronome, swing = _tuned(bpm, params, tuning)
-    p = params.platform
-    scale = disk_scale(n, params)
-    mu_per_n = (metronome.mass * p.radius * metronome.h) ** 2 / metronome.inertia * scale
-    omega = math.pi * swing.tick_bpm / 60.0
-    amp = swing.amplitude
-    c2 = _mean_cos_squared(amp)
-
-    def pendulum_omega(a):
-        return math.pi * metronome.natural_omega / (2 * float(ellipk(math.sin(a / 2) ** 2)))
-
-    slope = (pendulum_omega(amp * 1.001) - pendulum_omega(amp * 0.999)) / (0.002 * amp)
-    k_sin = -mu_per_n * omega * c2 / 2
-    k_cos = mu_per_n * omega * amp * abs(slope) * c2 / (2 * relaxation_rate(metronome))
-    return Coupling(
-        bpm=float(bpm),
-        n=n,
-        k_cos=k_cos,
-        k_sin=k_sin,
-        k_cos_err=0.0,
-        k_sin_err=0.0,
-        method="estimate",
-        scale=scale,
         free_bpm=swing.tick_bpm,
     )

@@ -38,6 +38,7 @@ from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
 from ..progress import progress_bar
 from . import coupling as cp
+from .estimate import estimate
 from .reduced import simulate_reduced
 from .sakaguchi import critical_coupling
 from .tuning import l2_for_bpm, steady_swing
@@ -114,7 +115,7 @@ def coupling_curve(
             rows.append(
                 _measure_cached(bpm, method, params, tuning, measure_n, cache).for_n(n, params)
             )
-            estimates.append(cp.estimate(bpm, n, params, tuning=tuning))
+            estimates.append(estimate(bpm, n, params, tuning=tuning))
             bar.update(1)
 
     def column(items, name):
