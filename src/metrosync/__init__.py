@@ -5,10 +5,11 @@ Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
 `analyze_audio` (a sound recording of metronomes), `sweep` (parameter grids),
-`reproduce` (the paper's studies), and `animate`, `write_wav`, `write_page`,
-`plot_run` (seeing and hearing a run), and `write_playground` (the model live in a
-browser). Those that need matplotlib, dask or an audio library are imported on first
-use, so that ``import metrosync`` stays quick.
+`reproduce` (the paper's studies), `animate`, `write_wav`, `write_page`, `plot_run`
+(seeing and hearing a run), `write_playground` (the model live in a browser), and
+`reduced_theory`, `simulate_reduced` (the phase-model reduction, `metrosync.theory`).
+Those that need matplotlib, dask or an audio library are imported on first use, so
+that ``import metrosync`` stays quick.
 """
 
 from ._version import __version__
@@ -37,6 +38,8 @@ _LAZY = {
     "sweep": "sweeps",
     "reproduce": "paper",
     "analyze_audio": "audio",
+    "reduced_theory": "theory",
+    "simulate_reduced": "theory",
 }
 
 __all__ = [

@@ -24,7 +24,7 @@ from ..errors import MetrosyncError
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = (
     "simulate", "presets", "reproduce", "analyze", "calibrate", "sweep",
-    "critical", "animate", "listen", "page", "playground", "record",
+    "critical", "theory", "animate", "listen", "page", "playground", "record",
 )  # fmt: skip
 
 

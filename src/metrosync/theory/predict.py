@@ -1,0 +1,313 @@
+"""The reduced theory's prediction of the critical frequency ω_c, for a preset.
+
+`coupling_curve` measures K(ω₀) e^{−iα(ω₀)} on a grid of nominal BPM (method
+"growth" at N = 32 by default, `coupling`), rescales it to the N asked for (N → ∞ by
+default) and sets the analytic estimate beside it; measurements are cached on disk,
+one file per point, keyed by everything they depend on. `predict_onset` then solves
+
+    K(ω₀, N) = K_c(α(ω₀), σ_ω(ω₀))                       (`sakaguchi.onset`)
+
+for ω₀, where σ_ω is the spread of the metronomes' *tick* frequencies. The
+ensembles draw σ on the nominal BPM; with today's small-amplitude tuning a metronome
+ticks at ρ ≈ 0.96 of its nominal rate, so σ_ω = (π/60) σ d(tick)/d(nominal); with the
+steady-swing tuning the factor is 1. Its error comes from K ± its uncertainty. Below
+ω_c the incoherent state is stable for N → ∞ (r → 0); above it r grows.
+
+Contract: `reduced_theory(...)` returns one `xarray.Dataset` with ``k``, ``alpha``, ``k_cos``,
+``k_sin`` (and ``*_err``, ``*_estimate``) on ``bpm``, ``omega_c`` (and ``omega_c_err``)
+on ``sigma``; `plot_theory` draws it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from scipy.interpolate import PchipInterpolator
+from scipy.optimize import brentq
+
+from .._files import write_text
+from .._version import __version__
+from ..errors import ParameterError
+from ..model import ModelParameters, get_preset
+from ..progress import progress_bar
+from . import coupling as cp
+from .estimate import estimate
+from .reduced import simulate_reduced
+from .sakaguchi import critical_coupling
+from .tuning import l2_for_bpm, steady_swing
+
+#: Bumped when a measurement method changes, so that old cache files are not reused.
+CACHE_VERSION = 1
+
+
+def default_cache_dir() -> Path:
+    """``$XDG_CACHE_HOME/metrosync/theory`` (``~/.cache/metrosync/theory``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "metrosync" / "theory"
+
+
+def _measure_cached(bpm, method, params, tuning, measure_n, cache: Path | None) -> cp.Coupling:
+    settings = {
+        "version": CACHE_VERSION,
+        "bpm": float(bpm),
+        "method": method,
+        "tuning": tuning,
+        "n": measure_n if method == "growth" else 2,
+        "dt": cp.MEASURE_DT,
+        "params": {k: str(v) for k, v in params.as_dict().items() if k != "preset"},
+    }
+    key = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:20]
+    path = None if cache is None else Path(cache) / f"{method}-{bpm:g}-{key}.json"
+    if path is not None and path.is_file():
+        try:
+            return cp.Coupling(**json.loads(path.read_text())["coupling"])
+        except (ValueError, KeyError, TypeError):
+            pass  # a damaged entry is measured again and overwritten
+    if method == "growth":
+        result = cp.measure_by_growth(bpm, n=measure_n, params=params, tuning=tuning)
+    else:
+        result = cp.measure_by_pair(bpm, params=params, tuning=tuning)
+    if path is not None:
+        write_text(json.dumps({"settings": settings, "coupling": vars(result)}, indent=1), path)
+    return result
+
+
+def coupling_curve(
+    bpms: Sequence[float],
+    *,
+    n: int | float = math.inf,
+    params: ModelParameters | str = "default",
+    tuning: str = "small-amplitude",
+    method: str = "growth",
+    measure_n: int = 32,
+    cache: Path | None = None,
+    progress: bool = False,
+) -> xr.Dataset:
+    """K(ω₀, N), α(ω₀) measured at each nominal BPM, with the analytic estimate beside it.
+
+    bpms : nominal beat frequencies, BPM (at least 2, increasing).
+    n : metronomes the coupling is expressed for (``math.inf``: the N → ∞ limit).
+    method : ``"growth"`` or ``"pair"`` (`coupling`).   measure_n : N of the growth runs.
+    cache : folder of cached measurements (None: measure every time).
+    """
+    params = get_preset(params, warn=False)
+    if method not in cp.METHODS:
+        raise ParameterError(f"unknown `method` {method!r}; choose one of {list(cp.METHODS)}.")
+    bpms = np.asarray(bpms, dtype=float)
+    if bpms.ndim != 1 or bpms.size < 2 or np.any(np.diff(bpms) <= 0):
+        raise ParameterError(
+            f"`bpms` must be at least 2 increasing nominal BPM values, got {bpms.tolist()!r}."
+        )
+    cp.disk_scale(n, params)  # checks n
+    if method == "growth":
+        cp.check_growth_n(measure_n, "measure_n")
+    l2_for_bpm(params.metronome, bpms, tuning=tuning)  # every BPM tunable, before any work
+    rows, estimates = [], []
+    with progress_bar(total=bpms.size, unit="BPM", enabled=progress, desc="measuring K") as bar:
+        for bpm in bpms:
+            rows.append(
+                _measure_cached(bpm, method, params, tuning, measure_n, cache).for_n(n, params)
+            )
+            estimates.append(estimate(bpm, n, params, tuning=tuning))
+            bar.update(1)
+
+    def column(items, name):
+        return np.array([getattr(c, name) for c in items], dtype=float)
+
+    data = {}
+    for name, unit, text in (
+        ("k", "rad/s", "coupling K"),
+        ("alpha", "rad", "phase lag alpha"),
+        ("k_cos", "rad/s", "K cos alpha"),
+        ("k_sin", "rad/s", "K sin alpha"),
+    ):
+        data[name] = ("bpm", column(rows, name), {"units": unit, "long_name": text})
+        data[f"{name}_err"] = ("bpm", column(rows, f"{name}_err"), {"units": unit})
+        data[f"{name}_estimate"] = (
+            "bpm",
+            column(estimates, name),
+            {"units": unit, "long_name": f"{text}, analytic estimate"},
+        )
+    data["free_bpm"] = (
+        "bpm",
+        column(rows, "free_bpm"),
+        {"units": "BPM", "long_name": "tick rate at the steady swing"},
+    )
+    data["spread_factor"] = (
+        "bpm",
+        np.array([spread_factor(b, params, tuning) for b in bpms]),
+        {"long_name": "d(tick rate)/d(nominal BPM)"},
+    )
+    return xr.Dataset(
+        data,
+        coords={"bpm": ("bpm", bpms, {"units": "BPM", "long_name": "nominal beat frequency"})},
+        attrs={
+            "n": "inf" if n == math.inf else int(n),
+            "method": method,
+            "tuning": tuning,
+            "measure_n": measure_n,
+            "measure_dt": cp.MEASURE_DT,
+            "preset": params.name,
+            "metrosync_version": __version__,
+        },
+    )
+
+
+def spread_factor(bpm: float, params: ModelParameters, tuning: str) -> float:
+    """d(tick rate)/d(nominal BPM) at ``bpm``: how a nominal spread becomes a tick spread."""
+    if tuning == "steady-swing":
+        return 1.0
+    design = params.metronome
+    ticks = [
+        steady_swing(design.with_l2(float(l2_for_bpm(design, b, tuning=tuning)))).tick_bpm
+        for b in (bpm - 0.5, bpm + 0.5)
+    ]
+    return ticks[1] - ticks[0]
+
+
+def threshold(curve: xr.Dataset, sigma_bpm: float) -> np.ndarray:
+    """K_c(α(ω₀), σ_ω(ω₀)) along a `coupling_curve`, rad/s."""
+    sigma_omega = math.pi / 60 * sigma_bpm * curve.spread_factor.values
+    return np.asarray(critical_coupling(curve.alpha.values, sigma_omega))
+
+
+def predict_onset(curve: xr.Dataset, sigma_bpm: float, *, shift: float = 0.0) -> float:
+    """ω_c (nominal BPM) where K(ω₀) + shift·K_err first rises through K_c; NaN if it
+    does not within the curve's BPM range (found by monotone interpolation)."""
+    bpm = curve.bpm.values
+    k = curve.k.values + shift * curve.k_err.values
+    k_c = threshold(curve, sigma_bpm)
+    gap = PchipInterpolator(bpm, k - k_c)
+    values = gap(bpm)
+    sign_change = np.nonzero(np.diff(np.sign(values)) > 0)[0]
+    if sign_change.size == 0:
+        return math.nan
+    i = sign_change[0]
+    return float(brentq(gap, bpm[i], bpm[i + 1], xtol=1e-6))
+
+
+def _reduced_r(curve, sigma_bpm: float, bpm: float, n: int, runs: int, seed=0) -> float:
+    """Mean r_eq of the reduced model at ``bpm``, K and α interpolated along the curve."""
+    grid = curve.bpm.values
+
+    def at(name):
+        return float(PchipInterpolator(grid, curve[name].values)(bpm))
+
+    sigma = math.pi / 60 * sigma_bpm * at("spread_factor")
+    k = at("k")
+    dt = min(0.5, 0.4 / (6 * sigma + k))
+    ds = simulate_reduced(
+        n, k=k, alpha=at("alpha"), sigma=sigma, runs=runs, duration=600.0, dt=dt, seed=seed
+    )
+    return float(ds.r_eq.mean())
+
+
+def order_curve(curve: xr.Dataset, sigma_bpm: float, *, n: int = 20_000, runs: int = 1):
+    """r_eq(ω₀) of the reduced model at the curve's BPM values: ``runs`` runs of ``n``
+    oscillators with Gaussian tick frequencies of spread σ_ω (the same draw throughout).
+
+    For the N → ∞ curve, n = 20 000 leaves finite-size noise of ≈ 0.01 in r.
+    """
+    return np.array([_reduced_r(curve, sigma_bpm, b, n, runs) for b in curve.bpm.values])
+
+
+def half_order(curve, sigma_bpm: float, r: np.ndarray, *, n: int, runs: int) -> float:
+    """The ω₀ where the reduced r_eq rises through 1/2: bracketed on the curve, then
+    bisected to 0.2 BPM with K, α interpolated. NaN if r does not cross 1/2."""
+    bpm = curve.bpm.values
+    up = np.nonzero((r[:-1] < 0.5) & (r[1:] >= 0.5))[0]
+    if up.size == 0:
+        return math.nan
+    lo, hi = bpm[up[0]], bpm[up[0] + 1]
+    while hi - lo > 0.2:
+        mid = (lo + hi) / 2
+        if _reduced_r(curve, sigma_bpm, mid, n, runs) < 0.5:
+            lo = mid
+        else:
+            hi = mid
+    return float(lo + hi) / 2
+
+
+def reduced_theory(
+    preset: ModelParameters | str = "default",
+    *,
+    bpms: Sequence[float] = tuple(range(150, 231, 10)),
+    sigmas: Sequence[float] = (0.5, 0.75, 1.0, 1.25, 1.5),
+    n: int | float = math.inf,
+    tuning: str = "small-amplitude",
+    method: str = "growth",
+    measure_n: int = 32,
+    cache: Path | None = None,
+    simulate_n: int | None = 20_000,
+    progress: bool = False,
+) -> xr.Dataset:
+    """K(ω₀), α(ω₀) for a preset and the predicted ω_c for each σ (BPM); see module docs.
+
+    simulate_n : also run the reduced model with this many oscillators (for finite ``n``:
+        ``n`` of them, 16 runs) at every BPM and σ, giving ``r_reduced(sigma, bpm)`` and the
+        ω₀ where it reaches 1/2, ``omega_half``; None skips it.
+    """
+    params = get_preset(preset, warn=False)
+    if params.overturns:
+        raise ParameterError(
+            f"preset {params.name!r} overturns (energy-balance amplitude "
+            f"{params.steady_amplitude:.2f} rad): there is no steady swing to reduce to a phase "
+            f"model. Use a preset whose swing stays below pi/2, e.g. 'default'."
+        )
+    sigmas = np.asarray(sigmas, dtype=float)
+    if sigmas.ndim != 1 or sigmas.size == 0 or not np.all(np.isfinite(sigmas) & (sigmas > 0)):
+        raise ParameterError(f"`sigmas` must be spreads > 0 BPM, got {sigmas.tolist()!r}.")
+    ds = coupling_curve(
+        bpms,
+        n=n,
+        params=params,
+        tuning=tuning,
+        method=method,
+        measure_n=measure_n,
+        cache=cache,
+        progress=progress,
+    )
+    centre = [predict_onset(ds, s) for s in sigmas]
+    # More coupling moves the crossing down: the +1σ curve gives the lower bound.
+    low = [predict_onset(ds, s, shift=1.0) for s in sigmas]
+    high = [predict_onset(ds, s, shift=-1.0) for s in sigmas]
+    ds = ds.assign_coords(
+        sigma=("sigma", sigmas, {"units": "BPM", "long_name": "spread of nominal frequencies"})
+    )
+    ds["omega_c"] = (
+        "sigma",
+        np.array(centre),
+        {"units": "BPM", "long_name": "predicted critical frequency (NaN: off grid)"},
+    )
+    ds["omega_c_low"] = ("sigma", np.array(low), {"units": "BPM"})
+    ds["omega_c_high"] = ("sigma", np.array(high), {"units": "BPM"})
+    ds["k_c"] = (
+        ("sigma", "bpm"),
+        np.stack([threshold(ds, s) for s in sigmas]),
+        {"units": "rad/s", "long_name": "Sakaguchi threshold K_c(alpha, sigma_omega)"},
+    )
+    if simulate_n is not None:
+        # N → ∞: one large population; finite N: 16 populations of N, averaged.
+        size, runs = (simulate_n, 1) if n == math.inf else (int(n), 16)
+        r = np.stack([order_curve(ds, s, n=size, runs=runs) for s in sigmas])
+        ds["r_reduced"] = (
+            ("sigma", "bpm"),
+            r,
+            {"long_name": "r_eq of the reduced model (Gaussian tick frequencies)"},
+        )
+        half = [half_order(ds, s, row, n=size, runs=runs) for s, row in zip(sigmas, r, strict=True)]
+        ds["omega_half"] = (
+            "sigma",
+            np.array(half),
+            {"units": "BPM", "long_name": "where the reduced r_eq reaches 1/2"},
+        )
+    ds.attrs.update({k: str(v) if isinstance(v, list) else v for k, v in params.as_dict().items()})
+    ds.attrs["preset"] = params.name
+    return ds
