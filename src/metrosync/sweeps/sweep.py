@@ -18,7 +18,7 @@ from typing import Any
 
 import xarray as xr
 
-from ..errors import OverturnWarning
+from ..errors import Interrupted, OverturnWarning
 from .executors import Execution, execute
 from .grid import MODEL_PARAMETERS, Grid
 from .store import PointStore, merge, write_dataset
@@ -131,9 +131,16 @@ def sweep(
         if not points.has(spec.key) or (retry_failed and points.failed(spec.key))
     ]
     show = sys.stderr.isatty() if progress is None else progress
-    execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
-    dataset = merge(grid, points)
-    out_path = write_dataset(dataset, out) if out is not None else None
+    try:
+        execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
+        dataset = merge(grid, points)
+        out_path = write_dataset(dataset, out) if out is not None else None
+    except KeyboardInterrupt:
+        kept = sum(points.has(spec.key) for spec in specs)
+        raise Interrupted(
+            f"{kept} of {len(specs)} points kept in {points.root}; run the same command "
+            f"again to resume"
+        ) from None
     return SweepResult(dataset, grid, points.root, len(specs) - len(todo), execution, out_path)
 
 
