@@ -28,8 +28,8 @@ import xarray as xr
 
 from ._version import __version__
 from .budget import simulation_budget
-from .ensemble import Ensemble, build_ensemble, check_time_step
-from .errors import ParameterError, require_positive
+from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
+from .errors import ParameterError
 from .integrators import INTEGRATORS
 from .integrators import reference as numpy_backend
 from .integrators import verlet as numba_backend
@@ -118,7 +118,11 @@ def simulate(
         raise ParameterError(f"`overturn_angle` must be > 0 rad, got {overturn_angle!r}.")
     # Size before work: everything below that grows with the inputs is estimated and
     # checked before the ensemble's first array is allocated.
-    require_positive("dt", dt, unit="s")
+    if not (math.isfinite(dt) and dt > 0):
+        raise ParameterError(
+            f"`dt` = {dt!r} s does not resolve any period: it needs 0 < dt <= "
+            f"period/{MIN_STEPS_PER_PERIOD} ({120 / 192 / MIN_STEPS_PER_PERIOD:g} s at 192 BPM)."
+        )
     if not duration / dt < MAX_STEPS:
         raise ParameterError(
             f"`duration` / `dt` = {duration:g} s / {dt:g} s = {duration / dt:.3g} steps, more "
