@@ -139,3 +139,23 @@ def test_reproduce_says_how_many_points_it_kept(tmp_path, monkeypatch):
         r"command again to resume",
         interrupt.value.kept,
     )
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["animate", "--duration", "120", "--speedup", "1", "--dpi", "40"], "a.gif"),
+        (["listen", "--duration", "3000"], "t.wav"),
+    ],
+)
+def test_ctrl_c_while_writing_leaves_no_partial_file(tmp_path, argv, name):
+    out = tmp_path / "out"
+    (tmp_path / "kernel-entered").touch()  # wait for the file being written instead
+    code, err, seconds = interrupt_child(
+        tmp_path, [*argv, "--out", str(out / name)],
+        ready=lambda: out.is_dir() and any(out.glob(".*partial*")), settle=0.3,
+    )  # fmt: skip
+    assert code == 130
+    assert err == f"metrosync {argv[0]}: interrupted: nothing was written\n"
+    assert seconds < 5.0
+    assert list(out.iterdir()) == []
