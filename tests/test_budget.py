@@ -177,3 +177,57 @@ def test_results_do_not_depend_on_the_chunking(monkeypatch):
     monkeypatch.setattr(pacing, "FIRST_SECONDS", 1e3)
     whole = simulate(7, 192.0, **kwargs)
     xr.testing.assert_identical(tiny, whole)
+
+
+# -- the other entry points -----------------------------------------------------------
+
+
+def test_sweep_refuses_before_computing_any_point(sixteen_gib, tmp_path):
+    from metrosync.sweeps import sweep
+
+    grid = {"bpm": "150:199:0.5"}  # 99 points x 1000 runs of r(t) over 1e6 s
+    fixed = {"runs": 1000, "duration": 1e6}
+    message = refused_quickly(
+        lambda: sweep(grid, tmp_path / "store", fixed=fixed, keep_r=True), r"merged result"
+    )
+    assert "drop `keep_r` (--keep-r)" in message
+    assert not (tmp_path / "store").exists()
+
+
+def test_a_long_sweep_warns_with_its_estimate(tmp_path):
+    from metrosync.sweeps import sweep
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)
+        with pytest.raises(LongRunWarning, match=r"the sweep is estimated to take about .* \(58 "
+                                                 r"points, 6.2e\+10 oscillator-steps\)"):  # fmt: skip
+            sweep({"bpm": "150:220:2.5", "n": [7, 64]}, tmp_path, fixed={"runs": 100,
+                  "duration": 3000})  # fmt: skip
+    assert not (tmp_path / "points").exists()
+
+
+def test_bootstrap_of_critical_is_sized_before_it_runs(sixteen_gib):
+    from metrosync.sweeps.critical import critical_frequency
+
+    bpm = np.arange(150.0, 221.0, 2.5)
+    sweep = xr.Dataset(
+        {"r_eq": (("n", "bpm", "run"), np.random.default_rng(0).random((2, bpm.size, 100)))},
+        coords={"n": [7, 16], "bpm": bpm},
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)
+        with pytest.raises(LongRunWarning, match=r"about 58 min \(10000000 replicas x 2 sizes"):
+            critical_frequency(sweep, n_boot=10_000_000)
+    refused_quickly(
+        lambda: critical_frequency(sweep, n_boot=1_000_000_000), r"replicas 29.8 GiB.*`n_boot`"
+    )
+
+
+def test_page_is_sized_before_it_is_built(monkeypatch):
+    from metrosync.show.page import page_data
+    from metrosync.show.recording import RecordedRun
+
+    ds = simulate(3, 192.0, duration=5.0, record_every=1, trajectories=True)
+    monkeypatch.setattr(budget, "available_memory", lambda: 1e5)
+    with pytest.raises(ResourceError, match=r"the page would need .*lower `max_rate`"):
+        page_data(RecordedRun.from_dataset(ds))

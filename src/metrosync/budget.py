@@ -162,7 +162,7 @@ def simulation_budget(
         seconds = runs * float(steps) * (NUMBA_RUN_STEP + NUMBA_OSC_STEP * n)
     fixes = "use fewer `runs`, a shorter `duration` or a larger `dt`"
     if trajectories:
-        fixes = "record less often (a larger `record_every`), " + fixes
+        fixes = "record less often: a larger `record_every`; or " + fixes
     return Budget(what, arrays, seconds, f"{oscillators * steps:.2g} oscillator-steps", fixes)
 
 

@@ -129,7 +129,7 @@ def simulate(
             f"than the {MAX_STEPS:.3g} a run can count; shorten `duration` or enlarge `dt`."
         )
     n_steps = int(round(duration / dt))
-    record_every, record_reason = _record_stride(record_every, n_steps, dt)
+    record_every, record_reason = record_stride(record_every, n_steps, dt)
     n_records = n_steps // record_every + 1
     size = _request_size(n, runs, frequencies_bpm, metronomes, theta0)
     if size is not None:
@@ -195,8 +195,10 @@ def simulate(
     return _to_dataset(ensemble, records, record_every * dt, window, settings)
 
 
-def _record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
-    """The record stride (steps) and why it is what it is (stored in ``attrs``)."""
+def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
+    """The record stride (steps) of a run of ``n_steps`` steps of ``dt`` s, and why it
+    is what it is (stored in ``attrs``): ``record_every`` when given, else 0.1 s or
+    the stride that keeps `MAX_RECORDS` records."""
     reason = "given"
     if record_every is None:
         record_every = max(1, int(round(RECORD_SECONDS / dt)))

@@ -88,7 +88,8 @@ def _run(argv: list[str] | None) -> int:
     args = parser.parse_args(argv)
 
     def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-        print(f"metrosync {args.command}: warning: {message}", file=sys.stderr)
+        text = name_options(str(message), getattr(args, "_aliases", None) or {})
+        print(f"metrosync {args.command}: warning: {text}", file=sys.stderr)
 
     try:
         with warnings.catch_warnings():
