@@ -197,12 +197,12 @@ def test_sweep_refuses_before_computing_any_point(sixteen_gib, tmp_path):
 def test_a_long_sweep_warns_with_its_estimate(tmp_path):
     from metrosync.sweeps import sweep
 
+    fixed = {"runs": 100, "duration": 3000}
     with warnings.catch_warnings():
         warnings.simplefilter("error", LongRunWarning)
-        with pytest.raises(LongRunWarning, match=r"the sweep is estimated to take about .* \(58 "
-                                                 r"points, 6.2e\+10 oscillator-steps\)"):  # fmt: skip
-            sweep({"bpm": "150:220:2.5", "n": [7, 64]}, tmp_path, fixed={"runs": 100,
-                  "duration": 3000})  # fmt: skip
+        estimate = r"the sweep is estimated to take about .* \(58 points, 6.2e\+10 oscillator-steps"
+        with pytest.raises(LongRunWarning, match=estimate):
+            sweep({"bpm": "150:220:2.5", "n": [7, 64]}, tmp_path, fixed=fixed)
     assert not (tmp_path / "points").exists()
 
 
