@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from tqdm import tqdm
 
 from .. import interrupts
+from ..budget import LongRunWarning
 from ..errors import ParameterError
 from .keep import kept_dataset
 from .points import PointSpec
@@ -78,6 +79,8 @@ def run_point(spec: PointSpec, threads: int | None = None):
     started = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        # The sweep estimated its whole work up front; a point's own estimate is noise.
+        warnings.simplefilter("ignore", LongRunWarning)
         try:
             ds = kept_dataset(spec, simulate(**spec.kwargs, progress=False))
         except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
