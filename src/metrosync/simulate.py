@@ -1,7 +1,10 @@
 """`simulate`: the one entry point for running an ensemble.
 
-It checks the inputs, builds the ensemble, advances it in chunks (with a progress
-bar on long work), and wraps what was recorded in an `xarray.Dataset`:
+It checks the inputs, estimates the memory and time the run will take before it
+allocates anything (`metrosync.budget`: refused when it cannot fit, a warning when
+it will take minutes), builds the ensemble, advances it in chunks of about 0.25 s
+each (`metrosync.pacing`: Ctrl-C and the progress bar act promptly), and wraps what
+was recorded in an `xarray.Dataset`:
 
     r            (time, run)              analytic-phase order parameter
     r_crossing   (time, run)              crossing-interpolated order parameter (NaN
@@ -102,6 +105,12 @@ def simulate(
     Returns
     -------
     xarray.Dataset, described in the module docstring.
+
+    Raises
+    ------
+    ParameterError for bad input; `metrosync.budget.ResourceError` when the run would
+    not fit in the memory available (before anything is allocated). Warns
+    `metrosync.budget.LongRunWarning` when it is estimated to take minutes or more.
     """
     params = get_preset(preset, warn=not changes)
     if changes:
