@@ -11,6 +11,9 @@ created.
 The temporary name is hidden and ends in ``.partial`` (``.run.nc.<hex>.partial``), so
 that no glob for the real files (``*.nc``) ever picks up one in flight. Writers that
 pick the format from the file name (Pillow, ffmpeg) ask for ``keep_suffix=True``.
+
+Inside `recording_writes`, every path put in place is also noted, so that a command
+stopped by Ctrl-C can say exactly which files it kept.
 """
 
 from __future__ import annotations
@@ -20,6 +23,19 @@ import os
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
+
+_written: list[Path] | None = None
+
+
+@contextlib.contextmanager
+def recording_writes() -> Iterator[list[Path]]:
+    """Yield a list that collects the path of every file written completely inside."""
+    global _written
+    outer, _written = _written, []
+    try:
+        yield _written
+    finally:
+        _written = outer
 
 
 @contextlib.contextmanager
@@ -40,6 +56,8 @@ def atomic_path(path: str | Path, *, keep_suffix: bool = False) -> Iterator[Path
     try:
         yield tmp
         os.replace(tmp, path)
+        if _written is not None:
+            _written.append(path)
     finally:
         tmp.unlink(missing_ok=True)
 

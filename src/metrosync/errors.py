@@ -74,3 +74,15 @@ class AnalysisError(MetrosyncError, ValueError):
 
 class CalibrationError(MetrosyncError, ValueError):
     """A parameter cannot be estimated from the data given (no solution, or not unique)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) stopped long work; ``kept`` says what survives and how to resume.
+
+    Raised in place of the bare `KeyboardInterrupt` by work that keeps partial results
+    (a sweep's finished points), so that the command line can say what was kept.
+    """
+
+    def __init__(self, kept: str) -> None:
+        super().__init__(kept)
+        self.kept = kept

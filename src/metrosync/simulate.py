@@ -1,7 +1,10 @@
 """`simulate`: the one entry point for running an ensemble.
 
-It checks the inputs, builds the ensemble, advances it in chunks (with a progress
-bar on long work), and wraps what was recorded in an `xarray.Dataset`:
+It checks the inputs, estimates the memory and time the run will take before it
+allocates anything (`metrosync.budget`: refused when it cannot fit, a warning when
+it will take minutes), builds the ensemble, advances it in chunks of about 0.25 s
+each (`metrosync.pacing`: Ctrl-C and the progress bar act promptly), and wraps what
+was recorded in an `xarray.Dataset`:
 
     r            (time, run)              analytic-phase order parameter
     r_crossing   (time, run)              crossing-interpolated order parameter (NaN
@@ -19,6 +22,7 @@ bar on long work), and wraps what was recorded in an `xarray.Dataset`:
 from __future__ import annotations
 
 import math
+import operator
 import sys as _sys
 from collections.abc import Mapping, Sequence
 
@@ -26,7 +30,8 @@ import numpy as np
 import xarray as xr
 
 from ._version import __version__
-from .ensemble import Ensemble, build_ensemble, check_time_step
+from .budget import simulation_budget
+from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
 from .errors import ParameterError
 from .integrators import INTEGRATORS
 from .integrators import reference as numpy_backend
@@ -34,12 +39,18 @@ from .integrators import verlet as numba_backend
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
+from .pacing import Pacer
 from .progress import progress_bar
 from .status import STATUS_MEANINGS
 
 BACKENDS = {"numba": numba_backend, "numpy": numpy_backend, "gpu": None}  # gpu: imported on use
-#: Oscillator-steps per chunk between progress updates.
-CHUNK_WORK = 4_000_000
+#: Time between records of r(t) when `record_every` is not given, s.
+RECORD_SECONDS = 0.1
+#: Most records of r(t) per run when `record_every` is not given: a longer run records
+#: at a larger stride, so that memory does not grow with the duration.
+MAX_RECORDS = 100_000
+#: Most steps of one run: step times are exact in float64 below 2**53.
+MAX_STEPS = 2.0**53
 
 
 def simulate(
@@ -82,7 +93,9 @@ def simulate(
         (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through numba.cuda; no
         trajectories yet).
     frequencies_bpm, metronomes, amplitude, theta0, theta_dot0 : see `build_ensemble`.
-    record_every : record every this many steps; default the step count of 0.1 s.
+    record_every : record every this many steps; default the step count of 0.1 s, or
+        the stride that keeps `MAX_RECORDS` records when 0.1 s would give more (the
+        stride used is in ``attrs["record_every"]`` and ``attrs["record_interval"]``).
     trajectories : also keep θ, θ̇, φ, φ̇ at each record.
     equilibrium_window : length (s) of the final window averaged for r_eq;
         default a quarter of ``duration``.
@@ -92,6 +105,12 @@ def simulate(
     Returns
     -------
     xarray.Dataset, described in the module docstring.
+
+    Raises
+    ------
+    ParameterError for bad input; `metrosync.budget.ResourceError` when the run would
+    not fit in the memory available (before anything is allocated). Warns
+    `metrosync.budget.LongRunWarning` when it is estimated to take minutes or more.
     """
     params = get_preset(preset, warn=not changes)
     if changes:
@@ -106,6 +125,27 @@ def simulate(
         raise ParameterError(f"`duration` must be a finite time > 0 s, got {duration!r}.")
     if not (math.isfinite(overturn_angle) and overturn_angle > 0):
         raise ParameterError(f"`overturn_angle` must be > 0 rad, got {overturn_angle!r}.")
+    # Size before work: everything below that grows with the inputs is estimated and
+    # checked before the ensemble's first array is allocated.
+    if not (math.isfinite(dt) and dt > 0):
+        raise ParameterError(
+            f"`dt` = {dt!r} s does not resolve any period: it needs 0 < dt <= "
+            f"period/{MIN_STEPS_PER_PERIOD} ({120 / 192 / MIN_STEPS_PER_PERIOD:g} s at 192 BPM)."
+        )
+    if not duration / dt < MAX_STEPS:
+        raise ParameterError(
+            f"`duration` / `dt` = {duration:g} s / {dt:g} s = {duration / dt:.3g} steps, more "
+            f"than the {MAX_STEPS:.3g} a run can count; shorten `duration` or enlarge `dt`."
+        )
+    n_steps = int(round(duration / dt))
+    record_every, record_reason = record_stride(record_every, n_steps, dt)
+    n_records = n_steps // record_every + 1
+    size = _request_size(n, runs, frequencies_bpm, metronomes, theta0)
+    if size is not None:
+        simulation_budget(
+            n=size[0], runs=size[1], steps=n_steps, records=n_records,
+            trajectories=trajectories, integrator=integrator, backend=backend, dt=dt,
+        ).check()  # fmt: skip
     ensemble = build_ensemble(
         n,
         bpm,
@@ -120,21 +160,6 @@ def simulate(
         theta_dot0=theta_dot0,
     )
     check_time_step(dt, ensemble)
-    n_steps = int(round(duration / dt))
-    if record_every is None:
-        record_every = max(1, int(round(0.1 / dt)))
-    if (
-        isinstance(record_every, bool)
-        or not isinstance(record_every, int | np.integer)
-        or record_every < 1
-    ):
-        raise ParameterError(f"`record_every` must be an integer >= 1 step, got {record_every!r}.")
-    if record_every > n_steps:
-        raise ParameterError(
-            f"`record_every` = {record_every} steps exceeds the {n_steps} steps of the run; "
-            f"lower it or lengthen `duration`."
-        )
-    n_records = n_steps // record_every + 1
     window = duration / 4 if equilibrium_window is None else float(equilibrium_window)
     if not (0 < window <= duration):
         raise ParameterError(
@@ -171,10 +196,56 @@ def simulate(
         "integrator": integrator,
         "backend": backend if integrator == "verlet" else "scipy",
         "record_every": record_every,
+        "record_interval": record_every * dt,
+        "record_every_reason": record_reason,
         "equilibrium_window": window,
         "overturn_angle": overturn_angle,
     }
     return _to_dataset(ensemble, records, record_every * dt, window, settings)
+
+
+def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
+    """The record stride (steps) of a run of ``n_steps`` steps of ``dt`` s, and why it
+    is what it is (stored in ``attrs``): ``record_every`` when given, else 0.1 s or
+    the stride that keeps `MAX_RECORDS` records."""
+    reason = "given"
+    if record_every is None:
+        record_every = max(1, int(round(RECORD_SECONDS / dt)))
+        reason = f"default {RECORD_SECONDS:g} s"
+        capped = math.ceil(n_steps / (MAX_RECORDS - 1))
+        if capped > record_every:
+            record_every = capped
+            reason = (
+                f"raised from {RECORD_SECONDS:g} s to keep at most {MAX_RECORDS} records per run"
+            )
+    if (
+        isinstance(record_every, bool)
+        or not isinstance(record_every, int | np.integer)
+        or record_every < 1
+    ):
+        raise ParameterError(f"`record_every` must be an integer >= 1 step, got {record_every!r}.")
+    if record_every > n_steps:
+        raise ParameterError(
+            f"`record_every` = {record_every} steps exceeds the {n_steps} steps of the run; "
+            f"lower it or lengthen `duration`."
+        )
+    return int(record_every), reason
+
+
+def _request_size(n, runs, frequencies_bpm, metronomes, theta0) -> tuple[int, int] | None:
+    """(N, runs) of a request, read without building anything; None when the inputs
+    are malformed (`build_ensemble` then says what is wrong)."""
+    try:
+        if metronomes is not None:
+            n = len(metronomes)
+        elif frequencies_bpm is not None:
+            n = np.shape(frequencies_bpm)[-1]
+        elif theta0 is not None and n is None:
+            n = np.shape(theta0)[-1]
+        n, runs = operator.index(n), operator.index(runs)
+    except (TypeError, IndexError):
+        return None
+    return (n, runs) if n >= 1 and runs >= 1 else None
 
 
 def _backend_module(backend: str, trajectories: bool):
@@ -202,17 +273,18 @@ def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, tra
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
         n_records=n_records, trajectories=trajectories,
     )  # fmt: skip
-    per_chunk = max(1, CHUNK_WORK // (ensemble.runs * ensemble.n))
-    per_chunk = max(record_every, per_chunk // record_every * record_every)
+    # Chunks sized from the measured throughput end every ~0.25 s, so that Ctrl-C and
+    # the progress bar act promptly whatever the problem size (see `metrosync.pacing`).
+    estimate = simulation_budget(
+        n=ensemble.n, runs=ensemble.runs, steps=1, records=1, trajectories=False,
+        backend="numpy" if backend is numpy_backend else "numba",
+    ).seconds  # fmt: skip
     with progress_bar(total=round(n_steps * dt, 6), unit="s", enabled=show) as bar:
-        step = 0
-        while step < n_steps:
-            count = min(per_chunk, n_steps - step)
+        for step, count in Pacer(n_steps, estimate):
             backend.advance_state(
                 state, ensemble.system, dt=dt, step0=step, n_steps=count,
                 record_every=record_every, overturn_angle=overturn_angle,
             )  # fmt: skip
-            step += count
             bar.update(round(count * dt, 6))
     return records_of(state)
 

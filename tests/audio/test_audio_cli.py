@@ -97,7 +97,7 @@ def test_a_tempo_far_from_the_ticks_warns(capsys, pair_recording):
     path, _ = pair_recording
     code, _, err = run(capsys, "analyze", str(path), "--bpm", "62")
     assert code == 0
-    assert "the ticks sound like 18" in err and "not near `bpm` 62" in err
+    assert "the ticks sound like 18" in err and "not near `bpm` (--bpm) 62" in err
 
 
 def test_follow_with_a_recording_warns(capsys, pair_recording):

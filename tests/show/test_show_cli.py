@@ -58,3 +58,52 @@ def test_errors_are_reported_with_exit_code_2(recorded_ds, tmp_path, capsys, arg
 def test_a_bad_time_step_is_reported_by_simulate(tmp_path, capsys):
     assert main(["page", *SMALL, "--dt", "0", "--out", str(tmp_path / "x.html")]) == 2
     assert "`dt` = 0.0 s does not resolve" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("speedup", "message"),
+    [
+        ("1e6", "`speedup` = 1e+06 brings a metronome's ticks 0.312 µs apart"),
+        ("1e-6", "`speedup` = 1e-06 makes 600 s of simulation last 19 years of audio"),
+    ],
+)
+def test_listen_refuses_a_useless_speedup_before_simulating(
+    tmp_path, capsys, monkeypatch, speedup, message
+):
+    from metrosync.cli import _show_source
+
+    def no_simulation(args):
+        raise AssertionError("simulated before refusing")
+
+    monkeypatch.setattr(_show_source, "simulate_from_args", no_simulation)
+    assert main(["listen", "--speedup", speedup, "--out", str(tmp_path / "t.wav")]) == 2
+    assert message in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--dpi", "1e6"], "`dpi` = 1e+06 makes 8 x 4 in frames of 8000000 x 4000000 pixels"),
+        (["--fps", "60"], "`fps` = 60 is faster than a GIF can play"),
+        (["--speedup", "0.001"], "9000001 frames exceed 20000; raise `speedup`"),
+    ],
+)
+def test_animate_refuses_impossible_options_before_simulating(
+    tmp_path, capsys, monkeypatch, argv, message
+):
+    from metrosync.cli import _show_source
+
+    def no_simulation(args):
+        raise AssertionError("simulated before refusing")
+
+    monkeypatch.setattr(_show_source, "simulate_from_args", no_simulation)
+    assert main(["animate", *argv, "--out", str(tmp_path / "a.gif")]) == 2
+    assert message in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_animate_defaults_pick_a_speedup_and_say_so(tmp_path, capsys):
+    out = tmp_path / "a.gif"
+    assert main(["animate", *SMALL[:2], "--duration", "45", "--dpi", "30", "--out", str(out)]) == 0
+    assert "(338 frames at 15 fps, speed-up 2, 23 s)" in capsys.readouterr().out

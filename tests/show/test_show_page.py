@@ -63,6 +63,19 @@ def test_bad_max_rate_is_refused(recorded_ds):
 # -- end to end, in headless Chromium ------------------------------------------------
 
 
+def wait_for_frames(browser, count: int, *, later_than: float | None = None) -> float:
+    """Wait until the page has drawn ``count`` more frames (and, if given, shows a
+    simulated time later than ``later_than``); return the time it shows."""
+    start = browser.evaluate("window.metrosyncFrame || 0")
+    deadline = time.monotonic() + 30
+    while True:
+        frame, shown = browser.evaluate("[window.metrosyncFrame || 0, window.metrosyncTime]")
+        if frame >= start + count and (later_than is None or shown > later_than):
+            return shown
+        assert time.monotonic() < deadline, f"the page drew {frame - start} frames in 30 s"
+        browser.pump(0.02)
+
+
 def test_page_plays_in_headless_chromium(recorded_ds, tmp_path, browser):
     path = write_page(recorded_ds, tmp_path / "run.html")
     browser.open_page(path.resolve().as_uri())
@@ -70,17 +83,32 @@ def test_page_plays_in_headless_chromium(recorded_ds, tmp_path, browser):
         "(() => { const r = document.getElementById('disk').getBoundingClientRect();"
         " return {x: r.x, y: r.y, width: r.width, height: r.height}; })()"
     )
-    browser.pump(0.3)
-    still = [browser.screenshot(rect) for _ in range(2)]
-    assert still[0] == still[1]  # paused: nothing moves by itself
+
+    def shot_at(seconds: float) -> bytes:
+        """Seek (paused) to ``seconds``; a screenshot once the page has drawn it."""
+        browser.evaluate(
+            f"(() => {{ const s = document.getElementById('seek'); s.value = {seconds};"
+            f" s.dispatchEvent(new Event('input')); }})()"
+        )
+        deadline = time.monotonic() + 30
+        while browser.evaluate("window.metrosyncTime") != seconds:
+            assert time.monotonic() < deadline
+            browser.pump(0.02)
+        wait_for_frames(browser, 2)
+        return browser.screenshot(rect)
+
+    paused_at = wait_for_frames(browser, 2)
+    before = browser.screenshot(rect)
+    assert wait_for_frames(browser, 3) == paused_at  # paused: the time shown stays
+    assert browser.screenshot(rect) == before  # and nothing moves by itself
+    at_2, at_4, again_2 = shot_at(2.0), shot_at(4.0), shot_at(2.0)
+    assert at_2 != at_4  # another time, another picture
+    assert at_2 == again_2  # the same time, the same picture
     browser.evaluate("document.getElementById('play').click()")
     assert browser.evaluate("document.getElementById('play').textContent") == "Pause"
-    browser.pump(0.4)
-    first = browser.screenshot(rect)
-    browser.pump(0.4)
-    second = browser.screenshot(rect)
-    assert first != second
-    assert float(browser.evaluate("document.getElementById('seek').value")) > 0.0
+    playing = wait_for_frames(browser, 2, later_than=2.0)
+    assert wait_for_frames(browser, 2, later_than=playing) > playing  # time runs on
+    assert float(browser.evaluate("document.getElementById('seek').value")) > 2.0
     browser.pump(0.1)
     assert browser.console_errors() == []
     # The check can fail: an error logged by the page is seen.

@@ -120,3 +120,47 @@ def test_pan_follows_the_place_on_the_disk(pair_ds):
 def test_bad_options_name_the_argument(pair_ds, options, name):
     with pytest.raises(ParameterError, match=f"`{name}`"):
         click_track(RecordedRun.from_dataset(pair_ds), **options)
+
+
+# -- bounded memory and lengths that make sense --------------------------------------
+
+
+def test_blocks_add_up_to_the_same_audio_whatever_their_size(recorded_ds):
+    track = click_track(RecordedRun.from_dataset(recorded_ds), speedup=1.5)
+    whole = np.concatenate(list(track.blocks(10**8)))
+    small = np.concatenate(list(track.blocks(997)))  # clicks straddle most block edges
+    assert whole.shape == (track.n_samples, 2) and np.abs(whole).max() > 0.05
+    np.testing.assert_array_equal(small, whole)
+
+
+def test_writing_does_not_hold_the_audio_in_memory(recorded_ds, tmp_path):
+    import tracemalloc
+
+    run = RecordedRun.from_dataset(recorded_ds)
+    peaks = []
+    for speedup in (1.0, 0.25):  # 20 s and 80 s of audio
+        track = click_track(run, speedup=speedup)
+        tracemalloc.start()
+        try:
+            track.write(tmp_path / f"x{speedup}.wav")
+            peaks.append(tracemalloc.get_traced_memory()[1])
+        finally:
+            tracemalloc.stop()
+    samples_bytes = 80.0 * 44100 * 2 * 8  # the longer track as float samples: 56 MB
+    assert peaks[1] < 0.1 * samples_bytes
+    assert peaks[1] < 1.5 * peaks[0]  # four times the audio, not four times the memory
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"speedup": 1e6}, r"`speedup` = 1e\+06 brings a metronome's ticks .* closer than one "
+                           r"click \(6 ms\).*at most 51\."),
+        ({"speedup": 1e-6}, r"`speedup` = 1e-06 makes 20 s of simulation last 231 days of "
+                            r"audio, more than 1 h; use a `speedup` of at least 0.00556"),
+        ({"start": 5.0, "end": 5.2}, r"shorter than one tick period \(0.31\d s\)"),
+    ],
+)  # fmt: skip
+def test_useless_lengths_are_refused(recorded_ds, options, match):
+    with pytest.raises(ParameterError, match=match):
+        click_track(RecordedRun.from_dataset(recorded_ds), **options)

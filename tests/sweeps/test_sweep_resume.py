@@ -16,20 +16,25 @@ from metrosync.sweeps import Grid, PointStore
 
 GRID = {"axes": {"bpm": "184:194:2", "n": [2, 3]}, "fixed": {"runs": 3, "duration": 5.0}}
 
-# The child slows down after each stored point (only the child; the results are
-# untouched), so the kill reliably lands with some points done and some not.
+#: Points the child stores before it is killed.
+KEPT = 3
+
+# After its KEPT-th stored point the child stops in place (only the child; the results
+# are untouched), so the kill lands with exactly KEPT points done, however fast or
+# slow the machine: the test waits for the store, never for the clock.
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import sys, threading
     from metrosync.sweeps import Grid, sweep
     from metrosync.sweeps.store import PointStore
 
     write = PointStore.write
-    def slow_write(self, ds, **kw):
+    def write_then_stop(self, ds, **kw):
         path = write(self, ds, **kw)
-        time.sleep(0.4)
+        if len(list(self.points.glob("*.nc"))) == {kept}:
+            threading.Event().wait()  # until killed
         return path
-    PointStore.write = slow_write
+    PointStore.write = write_then_stop
     sweep(Grid(**{grid!r}), sys.argv[1], progress=False)
     """
 )
@@ -46,19 +51,19 @@ def test_sigkill_then_restart_equals_an_uninterrupted_sweep(tmp_path):
     log = tmp_path / "child.log"
     with open(log, "wb") as sink:
         child = subprocess.Popen(
-            [sys.executable, "-c", CHILD.format(grid=GRID), str(store.root)],
+            [sys.executable, "-c", CHILD.format(grid=GRID, kept=KEPT), str(store.root)],
             env=env, stdout=sink, stderr=subprocess.STDOUT,
         )  # fmt: skip
     deadline = time.monotonic() + 120
-    while (len(snapshot(store)) if store.points.exists() else 0) < 3:
+    while (len(snapshot(store)) if store.points.exists() else 0) < KEPT:
         assert child.poll() is None, log.read_text()
-        assert time.monotonic() < deadline, "the child stored no points in 120 s"
-        time.sleep(0.05)
+        assert time.monotonic() < deadline, f"the child stored fewer than {KEPT} points in 120 s"
+        time.sleep(0.05)  # polling the store; the child waits for the kill
     child.send_signal(signal.SIGKILL)
     child.wait()
     assert child.returncode == -signal.SIGKILL
     before = snapshot(store)
-    assert 3 <= len(before) < grid.size, "kill should land partway"
+    assert len(before) == KEPT < grid.size
     logged_before = len(store.logged_keys())
 
     resumed = sweep(grid, store.root, progress=False)

@@ -6,7 +6,8 @@ sets ``func`` to a handler taking the parsed arguments and returning an exit cod
 Exit codes: 0 success; 1 the work ran but did not fully succeed (a sweep with
 failed or missing points), a file could not be written, or the reader of the output
 went away; 2 bad input, reported in one line that names the option, the value and
-what to do (a `MetrosyncError`). Warnings print as one line each.
+what to do (a `MetrosyncError`); 130 stopped by Ctrl-C (SIGINT), reported in one line
+that says what was kept and how to resume. Warnings print as one line each.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ import re
 import sys
 import warnings
 
+from .. import interrupts
+from .._files import recording_writes
 from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
@@ -57,11 +60,36 @@ def name_options(message: str, aliases: dict[str, str]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``metrosync`` with ``argv`` (default: the process's); returns the exit code."""
+    written: list = []
+    try:
+        with recording_writes() as written, interrupts.sigint_checked():
+            return _run(argv)
+    except KeyboardInterrupt as interrupt:
+        # The one handler for Ctrl-C: every subcommand's outputs are atomic, so what
+        # exists is whole; say what that is, and how to go on.
+        command = " ".join(sys.argv[1:2] if argv is None else argv[:1])
+        print(f"metrosync {command}: interrupted: {_kept(interrupt, written)}", file=sys.stderr)
+        return 130
+
+
+def _kept(interrupt: KeyboardInterrupt, written: list) -> str:
+    kept = getattr(interrupt, "kept", None)
+    if kept:
+        return kept
+    if not written:
+        return "nothing was written"
+    names = ", ".join(str(path) for path in written[:3])
+    more = f" and {len(written) - 3} more" if len(written) > 3 else ""
+    return f"kept {names}{more} (complete); the rest was not written"
+
+
+def _run(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
 
     def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-        print(f"metrosync {args.command}: warning: {message}", file=sys.stderr)
+        text = name_options(str(message), getattr(args, "_aliases", None) or {})
+        print(f"metrosync {args.command}: warning: {text}", file=sys.stderr)
 
     try:
         with warnings.catch_warnings():

@@ -20,22 +20,44 @@ def register(subparsers) -> None:
     add_source_options(parser, record_seconds=0.05)
     out = parser.add_argument_group("animation")
     out.add_argument("--out", type=Path, default=Path("metrosync.gif"), help="FILE.gif or FILE.mp4")
-    out.add_argument("--fps", type=float, default=20.0, help="frames per second")
+    out.add_argument("--fps", type=float, default=15.0,
+                     help="frames per second (at most 50 for a GIF)")  # fmt: skip
     out.add_argument(
-        "--speedup", type=float, default=1.0, help="simulated seconds per second shown"
+        "--speedup",
+        type=float,
+        default=None,
+        help="simulated seconds per second shown (default: the speed-up of 1, 2, 2.5, 4, 5, "
+        "10, ... that fits the window in 30 s)",
     )
-    out.add_argument("--dpi", type=float, default=80.0, help="resolution (pixels = 8x4 in x dpi)")
+    out.add_argument("--dpi", type=float, default=80.0,
+                     help="resolution: frames of 8 x 4 in x dpi pixels, 25 to 512")  # fmt: skip
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..show.animation import animate
+    from ..show.animation import animate, plan
 
     check_output(args.out, "--out", suffixes=(".gif", ".mp4"))
+    if args.input is None and args.duration > 0:
+        # Before simulating: refuse what the options already make impossible, and warn
+        # about a long rendering, on the window the simulation will cover.
+        start = 0.0 if args.start is None else args.start
+        end = args.duration if args.end is None else args.end
+        if end > start:
+            plan(start, end, fps=args.fps, speedup=args.speedup, dpi=args.dpi, size=(8.0, 4.0),
+                 path=args.out)[2].check()  # fmt: skip
     ds = load_or_simulate(args)
+    speedup = args.speedup
+    if speedup is None:
+        from ..show.animation import auto_speedup
+        from ..show.recording import RecordedRun
+
+        window = RecordedRun.from_dataset(ds, args.run).window(args.start, args.end)
+        speedup = auto_speedup(window[1] - window[0])
     frames = animate(
-        ds, args.out, run=args.run, fps=args.fps, speedup=args.speedup,
+        ds, args.out, run=args.run, fps=args.fps, speedup=speedup,
         start=args.start, end=args.end, dpi=args.dpi,
     )  # fmt: skip
-    print(f"wrote {args.out} ({frames} frames at {args.fps:g} fps, speed-up {args.speedup:g})")
+    print(f"wrote {args.out} ({frames} frames at {args.fps:g} fps, speed-up {speedup:g}, "
+          f"{frames / args.fps:.0f} s)")  # fmt: skip
     return 0

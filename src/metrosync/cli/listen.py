@@ -27,9 +27,16 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from ..show.sound import write_wav
+    from ..show.sound import check_length, write_wav
 
     check_output(args.out, "--out", suffixes=(".wav",))
+    if args.input is None and args.duration > 0 and args.bpm > 0 and args.speedup > 0:
+        # Before simulating: the lengths the options already fix (the nominal BPM
+        # stands for the metronomes; the drawn frequencies are checked again after).
+        start = 0.0 if args.start is None else args.start
+        end = args.duration if args.end is None else args.end
+        if end > start:
+            check_length(args.speedup, start, end, fastest_bpm=args.bpm, slowest_bpm=args.bpm)
     ds = load_or_simulate(args)
     track = write_wav(
         ds, args.out, run=args.run, speedup=args.speedup, start=args.start, end=args.end,

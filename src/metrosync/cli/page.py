@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._io import check_output
-from ._options import HelpFormatter
+from ._options import HelpFormatter, add_aliases
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -23,6 +23,7 @@ def register(subparsers) -> None:
     out.add_argument("--out", type=Path, default=Path("metrosync.html"), help="FILE.html")
     out.add_argument("--max-rate", type=float, default=50.0,
                      help="keep at most this many records per second")  # fmt: skip
+    add_aliases(parser, max_rate="--max-rate")
     parser.set_defaults(func=run)
 
 

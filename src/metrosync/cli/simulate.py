@@ -127,4 +127,9 @@ def summary(ds, elapsed: float) -> str:
         f"  runs flagged: {bad} of {a['runs']}" + (f" ({flagged})" if bad else ""),
         f"  {elapsed:.2f} s wall, {steps / max(elapsed, 1e-9):.3g} oscillator-steps/s",
     ]
+    if str(a.get("record_every_reason", "")).startswith("raised"):
+        lines.append(
+            f"  r(t) recorded every {a['record_interval']:g} s ({a['record_every']} steps), "
+            f"{a['record_every_reason']}"
+        )
     return "\n".join(lines)

@@ -26,7 +26,7 @@ import xarray as xr
 
 from .._files import write_netcdf
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import Interrupted, ParameterError
 from ..sweeps import PointStore
 from ..sweeps.executors import check_scheduler
 from ..sweeps.points import PointSpec
@@ -115,7 +115,18 @@ def reproduce(
         find_experiment(Path(experiment))
         lightgate_analyze()
     say = log or (lambda line: None)
+    try:
+        return _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
+                          n_workers)  # fmt: skip
+    except KeyboardInterrupt:
+        kept, total = kept_points(out, mode, chosen)
+        raise Interrupted(
+            f"{kept} of {total} points kept in {PointStore(out).points}; run the same command "
+            f"again to resume"
+        ) from None
 
+
+def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler, n_workers):
     say("parameter consistency table")
     consistency = consistency_table(_bpms(chosen, mode))
     write_netcdf(consistency, out / "consistency.nc")

@@ -1,7 +1,10 @@
 """HTML, CSS and JavaScript of the playback page (see `metrosync.show.page`).
 
 ``@TITLE@`` and ``@DATA@`` are replaced by the escaped title and the run's JSON.
-Nothing here loads from the network.
+Nothing here loads from the network. After drawing each frame the page sets
+``window.metrosyncFrame`` (frames drawn so far) and ``window.metrosyncTime`` (the
+simulated time shown, s), so that a test or a screen recorder can wait for frames
+rather than for wall-clock time.
 """
 
 TEMPLATE = r"""<!DOCTYPE html>
@@ -192,6 +195,8 @@ r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
     seek.value = t;
     readout.textContent = "t = " + t.toFixed(2) + " s   r = " + st.r.toFixed(3)
       + "   φ = " + st.phi.toFixed(3) + " rad";
+    window.metrosyncTime = t;
+    window.metrosyncFrame = (window.metrosyncFrame || 0) + 1;
   }
   function setPlaying(on) {
     playing = on; last = null;

@@ -12,29 +12,47 @@ has floor((end − start)·fps/speedup) + 1 frames. States between records come 
 `RecordedRun`'s Hermite interpolation of the recorded trajectories.
 
 The format follows the file name: ``.gif`` (Pillow, always available) or ``.mp4``
-(ffmpeg, when it is on PATH). Writes are atomic.
+(ffmpeg, when it is on PATH). Frames are streamed to the file one at a time
+(`metrosync.show.frames`), so memory holds one frame however long the animation; the
+figure's static parts are drawn once and each frame redraws only what moves. Without
+a speed-up, one is chosen that fits the window in `TARGET_LENGTH` seconds. The size
+of the frames and the time it will take are checked before the first is drawn:
+frames larger than `MAX_SIDE` pixels a side are refused. Writes are atomic.
 """
 
 from __future__ import annotations
 
 import math
-import shutil
 from pathlib import Path
 
 import numpy as np
-from matplotlib import animation as mpl_animation
+from matplotlib import font_manager
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
+from PIL import Image, ImageDraw, ImageFont
 
+from .. import interrupts
 from .._files import atomic_path
+from ..budget import Budget
 from ..errors import ParameterError
 from ..progress import progress_bar
+from .frames import check_format, open_sink
 from .recording import RecordedRun
 
 #: Largest number of frames `animate` renders (a guard against a forgotten speed-up).
 MAX_FRAMES = 20_000
+#: Length (s) of an animation whose speed-up was not given.
+TARGET_LENGTH = 30.0
+#: Speed-ups chosen automatically: these times powers of ten.
+NICE_SPEEDUPS = (1.0, 2.0, 2.5, 4.0, 5.0)
+#: Frame size limits, pixels a side.
+MAX_SIDE, MIN_SIDE = 4096, 100
+#: Wall time of one 640 × 320 frame (drawing, colour reduction, encoding), s: measured
+#: 25-35 ms on the 2-core development machine.
+FRAME_SECONDS = 0.05
 #: Pendulum rod length drawn from above at sin θ = 1, as a fraction of the disk radius.
 ROD_SCALE = 0.35
 PHASE_CMAP = "hsv"
@@ -58,19 +76,65 @@ def _check_positive(name: str, value) -> float:
     return float(value)
 
 
-def writer_for(path: Path, fps: float):
-    """The matplotlib writer for ``path``'s suffix (.gif or .mp4)."""
-    suffix = path.suffix.lower()
-    if suffix == ".gif":
-        return mpl_animation.PillowWriter(fps=fps)
-    if suffix == ".mp4":
-        if shutil.which("ffmpeg") is None:
-            raise ParameterError(
-                f"writing {path.name!r} needs ffmpeg on PATH; install it "
-                f"(e.g. `apt-get install ffmpeg`) or write a .gif instead."
-            )
-        return mpl_animation.FFMpegWriter(fps=fps, codec="h264", extra_args=["-pix_fmt", "yuv420p"])
-    raise ParameterError(f"the animation file must end in .gif or .mp4, got {str(path)!r}.")
+def auto_speedup(span: float, target: float = TARGET_LENGTH) -> float:
+    """The smallest of 1, 2, 2.5, 4, 5 times a power of ten that shows ``span`` seconds
+    in at most ``target`` seconds (at least 1: never slower than real time)."""
+    need = span / target
+    if need <= 1:
+        return 1.0
+    decade = 10.0 ** math.floor(math.log10(need))
+    for nice in (*NICE_SPEEDUPS, 10.0):
+        if nice * decade >= need * (1 - 1e-12):
+            return nice * decade
+    raise AssertionError("unreachable")
+
+
+def frame_pixels(dpi: float, size: tuple[float, float]) -> tuple[int, int]:
+    """(width, height) in pixels of frames of ``size`` inches at ``dpi``; refuses a
+    size outside [`MIN_SIDE`, `MAX_SIDE`] pixels a side, naming the option to change."""
+    dpi = _check_positive("dpi", dpi)
+    if not (isinstance(size, tuple | list) and len(size) == 2):
+        raise ParameterError(f"`size` must be (width, height) in inches, got {size!r}.")
+    width_in, height_in = (_check_positive("size", float(v)) for v in size)
+    width, height = int(width_in * dpi), int(height_in * dpi)  # as Agg sizes its canvas
+    if max(width, height) > MAX_SIDE or min(width, height) < MIN_SIDE:
+        low = MIN_SIDE / min(width_in, height_in)
+        high = MAX_SIDE / max(width_in, height_in)
+        raise ParameterError(
+            f"`dpi` = {dpi:g} makes {width_in:g} x {height_in:g} in frames of {width} x "
+            f"{height} pixels; frames must be {MIN_SIDE} to {MAX_SIDE} pixels a side: use a "
+            f"`dpi` between {math.ceil(low)} and {math.floor(high)}, or another `size`."
+        )
+    return width, height
+
+
+def plan(start: float, end: float, *, fps: float, speedup: float | None, dpi: float,
+         size: tuple[float, float], path: Path) -> tuple[float, int, Budget]:  # fmt: skip
+    """Check an animation of [start, end] before anything is drawn.
+
+    Returns the speed-up (chosen when None), the frame count and the `Budget` (one
+    frame's buffers, and the time for every frame).
+    """
+    fps = _check_positive("fps", fps)
+    speedup = auto_speedup(end - start) if speedup is None else _check_positive("speedup", speedup)
+    check_format(Path(path), fps)
+    width, height = frame_pixels(dpi, size)
+    count = frame_count(start, end, fps, speedup)
+    if count > MAX_FRAMES:
+        raise ParameterError(
+            f"{count} frames exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
+            f"lower `fps` (now {fps:g}) or shorten the window."
+        )
+    pixels = float(width * height)
+    budget = Budget(
+        "the animation",
+        # the canvas, its saved background, the RGB copy and its palette image
+        {"one frame's buffers": 13.0 * pixels},
+        seconds=count * FRAME_SECONDS * max(1.0, pixels / (640 * 320)),
+        work=f"{count} frames of {width} x {height} pixels",
+        fixes="raise `speedup`, lower `fps` or `dpi`, or shorten the window (`start`, `end`)",
+    )
+    return speedup, count, budget
 
 
 class DiskView:
@@ -119,6 +183,42 @@ class DiskView:
         title = f"N = {run.n}, {a.get('bpm', '?')} BPM, σ = {a.get('sigma_bpm', '?')} BPM"
         order_ax.set_title(f"{title}, run {run.run}", fontsize=9)
         self.cursor = order_ax.axvline(start, color="C3", lw=1.2)
+        self.moving = (self.spokes, self.guides, self.rods, self.boxes, self.bobs, self.cursor)
+        self._background = None
+
+    def render(self, t: float, dpi: float) -> Image.Image:
+        """The frame at simulated time ``t``, an RGB image.
+
+        The static parts are drawn on the first call only; later calls restore them
+        and draw what moves. The clock line is drawn by Pillow with matplotlib's font:
+        matplotlib lays out and rasterizes a text anew at every draw, which took over
+        half of a frame's time.
+        """
+        canvas = self.fig.canvas
+        if self._background is None:
+            self.fig.set_dpi(dpi)
+            canvas = FigureCanvasAgg(self.fig)
+            self.clock.set_visible(False)
+            for artist in self.moving:
+                artist.set_animated(True)  # left out of the full draw
+            canvas.draw()
+            self.fig.set_layout_engine("none")  # freeze the layout the draw settled
+            self._background = canvas.copy_from_bbox(self.fig.bbox)
+            x, y = self.clock.get_transform().transform(self.clock.get_position())
+            self._clock_at = (x, canvas.get_width_height()[1] - y)
+            size = self.clock.get_fontsize() * dpi / 72  # points to pixels
+            self._font = ImageFont.truetype(font_manager.findfont(self.clock.get_fontproperties()),
+                                            size=size)  # fmt: skip
+        self.draw(t)
+        canvas.restore_region(self._background)
+        for artist in self.moving:
+            self.fig.draw_artist(artist)
+        width, height = canvas.get_width_height()
+        image = Image.frombuffer("RGBA", (width, height), canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+        image = image.convert("RGB")
+        ImageDraw.Draw(image).text(self._clock_at, self.clock.get_text(), font=self._font,
+                                   fill=(0, 0, 0), anchor="la")  # fmt: skip
+        return image
 
     def draw(self, t: float) -> None:
         """Move every artist to simulated time ``t`` (s)."""
@@ -153,8 +253,8 @@ def animate(
     path: Path | str,
     *,
     run: int = 0,
-    fps: float = 20.0,
-    speedup: float = 1.0,
+    fps: float = 15.0,
+    speedup: float | None = None,
     start: float | None = None,
     end: float | None = None,
     dpi: float = 80.0,
@@ -168,10 +268,12 @@ def animate(
     ds : dataset from `metrosync.simulate(..., trajectories=True)`.
     path : output file, ``.gif`` or ``.mp4``.
     run : which run of the ensemble.
-    fps : frames per second of the animation.
-    speedup : simulated seconds per second of animation.
+    fps : frames per second of the animation (at most 50 for a GIF).
+    speedup : simulated seconds per second of animation; default the one that shows
+        the window in at most `TARGET_LENGTH` seconds (`auto_speedup`).
     start, end : simulated time window, s; default the whole recording.
-    dpi, size : resolution and figure size (inches); pixels = size·dpi.
+    dpi, size : resolution and figure size (inches); pixels = size·dpi, at most
+        `MAX_SIDE` a side.
     progress : show a progress bar; default when stderr is a terminal.
 
     Returns
@@ -181,26 +283,24 @@ def animate(
     import sys
 
     path = Path(path)
-    fps = _check_positive("fps", fps)
-    speedup = _check_positive("speedup", speedup)
-    dpi = _check_positive("dpi", dpi)
-    writer = writer_for(path, fps)
     recorded = RecordedRun.from_dataset(ds, run)
     start, end = recorded.window(start, end)
-    count = frame_count(start, end, fps, speedup)
-    if count > MAX_FRAMES:
-        raise ParameterError(
-            f"{count} frames exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
-            f"lower `fps` (now {fps:g}) or shorten the window."
-        )
+    speedup, count, budget = plan(start, end, fps=fps, speedup=speedup, dpi=dpi, size=size,
+                                  path=path)  # fmt: skip
+    budget.check()
     times = frame_times(start, end, fps, speedup)
     view = DiskView(recorded, start, end, size=size)
+    width, height = frame_pixels(dpi, size)
     show = sys.stderr.isatty() if progress is None else progress
     with progress_bar(total=times.size, unit="frame", enabled=show, desc="animate") as bar:
         # The writers pick the format from the file name, so the temporary one keeps it.
-        with atomic_path(path, keep_suffix=True) as tmp, writer.saving(view.fig, str(tmp), dpi):
-            for t in times:
-                view.draw(float(t))
-                writer.grab_frame()
-                bar.update(1)
+        with atomic_path(path, keep_suffix=True) as tmp:
+            with open_sink(tmp, fps, width, height) as sink:
+                for t in times:
+                    interrupts.check()
+                    frame = view.render(float(t), dpi)
+                    if frame.size != (width, height):  # pragma: no cover - a guard
+                        raise RuntimeError(f"frame {frame.size} is not {width} x {height}")
+                    sink.add(frame)
+                    bar.update(1)
     return int(times.size)

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import write_text
+from ..budget import Budget
 from ..errors import ParameterError
 from ._page_template import TEMPLATE
 from .recording import RecordedRun
@@ -43,6 +44,7 @@ def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0)
         raise ParameterError(
             f"the window [{start:g}, {end:g}] s holds fewer than two records; widen it."
         )
+    page_budget(index.size, run.n).check()
     end = min(end, float(run.time[index[-1]]))
 
     def rounded(values, digits=5):
@@ -70,6 +72,20 @@ def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0)
         else None,
         "r_eq": run.r_eq if math.isfinite(run.r_eq) else None,
     }
+
+
+def page_budget(records: int, n: int) -> Budget:
+    """Memory and time of a page of ``records`` records of ``n`` metronomes: each
+    number is held as a Python float in a list, then as JSON text twice (the
+    payload and the page), about 100 bytes and 1 µs a number."""
+    numbers = float(records) * (2 * n + 4)
+    return Budget(
+        "the page",
+        {"the page's numbers and text": 100.0 * numbers},
+        seconds=1e-6 * numbers,
+        work=f"{numbers:.3g} numbers",
+        fixes="lower `max_rate` or shorten the window (`start`, `end`)",
+    )
 
 
 def render_page(run: RecordedRun, **options) -> str:

@@ -16,18 +16,26 @@ its x position R cos(α_i + φ) on the disk seen from above (constant-power pan)
 has a pitch of its own so that the ear can tell them apart. Each click has the gain
 0.9/N, so the file never clips and a synchronized ensemble sounds louder, as it does
 in the room.
+
+The audio is rendered and written in blocks of `BLOCK_SAMPLES`, so memory does not
+depend on its length. Refused before any sample is made: a speed-up that brings a
+metronome's ticks closer together than one click (they would merge into a tone), a
+window shorter than one tick, and audio longer than an hour.
 """
 
 from __future__ import annotations
 
 import math
 import wave
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .. import interrupts
 from .._files import atomic_path
+from ..budget import Budget, format_seconds
 from ..errors import ParameterError
 from .recording import RecordedRun
 
@@ -36,22 +44,31 @@ CLICK_LENGTH = 0.006
 CLICK_DECAY = 0.001
 #: Pitches (Hz) of the clicks span this range across the metronomes.
 PITCH_RANGE = (1800.0, 2600.0)
+#: Samples rendered and written at a time: memory does not grow with the length.
+BLOCK_SAMPLES = 1 << 16
+#: Longest audio written, s.
+MAX_AUDIO_SECONDS = 3600.0
 
 
 @dataclass(frozen=True)
 class ClickTrack:
-    """A rendered click track.
+    """A click track: where each click sounds, rendered to samples block by block.
 
-    samples : (S, 2) float in [−1, 1], left and right channels.
-    sample_rate : samples per second.
+    sample_rate : samples per second.   n_samples : length of the audio.
     click_times : N arrays of click onsets in audio time, s (the crossing times
         mapped through (t − start)/speedup).
+    onsets : N arrays of the clicks' first samples, round(click_time · sample_rate).
+    gains : N arrays (K_i, 2) of each click's left and right gain.
+    waveforms : N arrays, the click of each metronome.
     start, end, speedup : the simulated window [start, end] (s) and the speed-up.
     """
 
-    samples: np.ndarray
     sample_rate: int
+    n_samples: int
     click_times: list[np.ndarray]
+    onsets: list[np.ndarray]
+    gains: list[np.ndarray]
+    waveforms: list[np.ndarray]
     start: float
     end: float
     speedup: float
@@ -59,17 +76,44 @@ class ClickTrack:
     @property
     def duration(self) -> float:
         """Length of the audio, s."""
-        return self.samples.shape[0] / self.sample_rate
+        return self.n_samples / self.sample_rate
+
+    def blocks(self, size: int = BLOCK_SAMPLES) -> Iterator[np.ndarray]:
+        """The audio as consecutive (≤ size, 2) float blocks in [−1, 1] (left, right)."""
+        for first in range(0, self.n_samples, size):
+            interrupts.check()
+            yield self._render(first, min(first + size, self.n_samples))
+
+    @property
+    def samples(self) -> np.ndarray:
+        """(S, 2) the whole audio in memory (for inspection; `write` streams it)."""
+        parts = list(self.blocks())
+        return np.concatenate(parts) if parts else np.zeros((0, 2))
+
+    def _render(self, first: int, stop: int) -> np.ndarray:
+        block = np.zeros((stop - first, 2))
+        for onset, gain, click in zip(self.onsets, self.gains, self.waveforms, strict=True):
+            # The clicks that sound in [first, stop): onsets from first − len + 1 on.
+            lo, hi = np.searchsorted(onset, [first - click.size + 1, stop])
+            if lo == hi:
+                continue
+            index = onset[lo:hi, None] + np.arange(click.size)[None, :] - first
+            inside = (index >= 0) & (index < stop - first)
+            for channel in (0, 1):
+                values = gain[lo:hi, channel, None] * click
+                np.add.at(block[:, channel], index[inside], values[inside])
+        return block
 
     def write(self, path: Path | str) -> Path:
-        """Write a 16-bit PCM stereo WAV atomically; returns the path."""
+        """Write a 16-bit PCM stereo WAV atomically, block by block; returns the path."""
         path = Path(path)
-        pcm = np.round(np.clip(self.samples, -1.0, 1.0) * 32767).astype("<i2")
         with atomic_path(path) as tmp, wave.open(str(tmp), "wb") as out:
             out.setnchannels(2)
             out.setsampwidth(2)
             out.setframerate(self.sample_rate)
-            out.writeframes(pcm.tobytes())
+            for block in self.blocks():
+                pcm = np.round(np.clip(block, -1.0, 1.0) * 32767).astype("<i2")
+                out.writeframes(pcm.tobytes())
         return path
 
 
@@ -139,9 +183,12 @@ def click_track(
     end: float | None = None,
     sample_rate: int = 44100,
 ) -> ClickTrack:
-    """Render the clicks of a recorded run between ``start`` and ``end`` (s).
+    """The clicks of a recorded run between ``start`` and ``end`` (s).
 
-    The audio lasts round((end − start)/speedup · sample_rate) samples.
+    The audio lasts round((end − start)/speedup · sample_rate) samples. Refused: a
+    ``speedup`` that brings a metronome's ticks closer than one click (they would merge
+    into a tone), a window shorter than one tick of the slowest metronome, and audio
+    longer than `MAX_AUDIO_SECONDS`.
     """
     if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
         raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
@@ -154,23 +201,68 @@ def click_track(
             f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
         )
     start, end = run.window(start, end)
+    bpm = 60.0 * np.asarray(run.omega) / np.pi
+    check_length(speedup, start, end, fastest_bpm=float(bpm.max()), slowest_bpm=float(bpm.min()))
     n_samples = int(round((end - start) / speedup * sample_rate))
-    samples = np.zeros((n_samples, 2))
+    budget = Budget(
+        "the sound",
+        {"one block of samples": 16.0 * BLOCK_SAMPLES, "click onsets": 48.0 * run.theta.size},
+        seconds=n_samples * 5e-8 + run.theta.size * 1e-7,
+    )
+    budget.check()
     gain = 0.9 / run.n
     pitches = np.linspace(*PITCH_RANGE, run.n) if run.n > 1 else [PITCH_RANGE[0]]
-    audio_times = []
+    audio_times, onsets, gains, waveforms = [], [], [], []
     for i, times in enumerate(crossing_times(run)):
         times = times[(times >= start) & (times < end)]
         tau = (times - start) / speedup
         audio_times.append(tau)
-        onset = np.round(tau * sample_rate).astype(np.int64)
-        click = click_waveform(pitches[i], sample_rate)
+        onsets.append(np.round(tau * sample_rate).astype(np.int64))
         left, right = pan_gains(np.cos(run.rim_angles[i] + run.phi_at(times)))
-        index = onset[:, None] + np.arange(click.size)[None, :]
-        inside = index < n_samples
-        np.add.at(samples[:, 0], index[inside], (gain * left[:, None] * click)[inside])
-        np.add.at(samples[:, 1], index[inside], (gain * right[:, None] * click)[inside])
-    return ClickTrack(samples, int(sample_rate), audio_times, start, end, float(speedup))
+        gains.append(gain * np.column_stack([left, right]))
+        waveforms.append(click_waveform(pitches[i], sample_rate))
+    return ClickTrack(
+        int(sample_rate), n_samples, audio_times, onsets, gains, waveforms, start, end,
+        float(speedup),
+    )  # fmt: skip
+
+
+def _milliseconds(seconds: float) -> str:
+    return f"{seconds * 1e3:.3g} ms" if seconds >= 1e-3 else f"{seconds * 1e6:.3g} µs"
+
+
+def check_length(
+    speedup: float, start: float, end: float, *, fastest_bpm: float, slowest_bpm: float
+) -> None:
+    """Refuse audio whose ticks merge, that holds no tick, or that lasts for hours.
+
+    speedup : the speed-up.   start, end : the simulated window, s.
+    fastest_bpm, slowest_bpm : the metronomes' extreme natural frequencies, BPM.
+    """
+    tick_fast = 60.0 / fastest_bpm  # ω = π·BPM/60 and two ticks a period
+    tick_slow = 60.0 / slowest_bpm
+    fastest = tick_fast / CLICK_LENGTH
+    if speedup > fastest:
+        raise ParameterError(
+            f"`speedup` = {speedup:g} brings a metronome's ticks "
+            f"{_milliseconds(tick_fast / speedup)} apart in the audio, closer than one click "
+            f"({CLICK_LENGTH * 1e3:g} ms): they "
+            f"would merge into a tone. Use a `speedup` of at most {math.floor(fastest)}."
+        )
+    if end - start < tick_slow:
+        raise ParameterError(
+            f"the window [{start:g}, {end:g}] s is shorter than one tick period "
+            f"({tick_slow:.3g} s): the audio would hold at most one click per metronome. "
+            f"Widen it (`start`, `end`) or simulate a longer `duration`."
+        )
+    seconds = (end - start) / speedup
+    if seconds > MAX_AUDIO_SECONDS:
+        raise ParameterError(
+            f"`speedup` = {speedup:g} makes {end - start:g} s of simulation last "
+            f"{format_seconds(seconds)} of audio, more than {MAX_AUDIO_SECONDS / 3600:g} h; "
+            f"use a `speedup` of at least {(end - start) / MAX_AUDIO_SECONDS:.3g}, or a "
+            f"shorter window (`start`, `end`)."
+        )
 
 
 def write_wav(ds, path: Path | str, *, run: int = 0, **options) -> ClickTrack:

@@ -21,8 +21,10 @@ printed: a worker's output would be lost, and the caller decides what to report.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
+import signal
 import socket
 import time
 import warnings
@@ -31,10 +33,17 @@ from dataclasses import dataclass, field
 
 from tqdm import tqdm
 
+from .. import interrupts
+from ..budget import LongRunWarning
 from ..errors import ParameterError
 from .keep import kept_dataset
 from .points import PointSpec
 from .store import PointStore
+
+#: Seconds to wait for a Dask client and cluster to close.
+CLOSE_SECONDS = 10
+#: Seconds between two looks at the cluster's finished points.
+POLL_SECONDS = 0.1
 
 
 @dataclass
@@ -70,6 +79,8 @@ def run_point(spec: PointSpec, threads: int | None = None):
     started = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        # The sweep estimated its whole work up front; a point's own estimate is noise.
+        warnings.simplefilter("ignore", LongRunWarning)
         try:
             ds = kept_dataset(spec, simulate(**spec.kwargs, progress=False))
         except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
@@ -133,11 +144,13 @@ def execute(
                 on_done(spec)
 
         try:
-            if scheduler is None:
-                for spec in specs:
-                    done(spec, *run_point(spec))
-            else:
-                _execute_dask(specs, scheduler, n_workers, done, report)
+            with interrupts.sigint_checked():
+                if scheduler is None:
+                    for spec in specs:
+                        interrupts.check()
+                        done(spec, *run_point(spec))
+                else:
+                    _execute_dask(specs, scheduler, n_workers, done, report)
         finally:
             report.seconds = time.perf_counter() - started
     return report
@@ -171,23 +184,65 @@ def _execute_dask(specs, scheduler, n_workers, done, report) -> None:
             raise ParameterError(
                 f"cannot reach the Dask scheduler at {scheduler!r}: {error}"
             ) from None
+    by_key = {}
     try:
-        by_key = {}
         for spec in specs:
             future = client.submit(
                 run_point, spec, threads, key=f"metrosync-point-{spec.key}", retries=1
             )
             by_key[future.key] = (spec, future)
-        for future in as_completed([f for _, f in by_key.values()]):
-            spec, _ = by_key[future.key]
-            try:
-                ds, seconds, host = future.result()
-            except Exception as error:  # noqa: BLE001 - a lost worker loses a point, not the sweep
-                report.lost[spec.key] = f"{type(error).__name__}: {error}"
-                continue
-            done(spec, ds, seconds, host)
-            future.release()
-    finally:
-        client.close()
+        queue = as_completed([f for _, f in by_key.values()])
+        while not queue.is_empty():
+            interrupts.check()  # polled: a Ctrl-C lost in dask's callbacks still lands
+            batch = queue.next_batch(block=False)
+            if not batch:
+                time.sleep(POLL_SECONDS)
+            for future in batch:
+                spec, _ = by_key[future.key]
+                try:
+                    ds, seconds, host = future.result()
+                except Exception as error:  # noqa: BLE001 - a lost worker loses a point only
+                    report.lost[spec.key] = f"{type(error).__name__}: {error}"
+                    continue
+                done(spec, ds, seconds, host)
+                future.release()
+    except BaseException:
+        # Ctrl-C (or an error here): drop the queued and running points at once rather
+        # than letting the cluster finish them; the finished ones are already stored.
+        with contextlib.suppress(Exception):
+            client.cancel([future for _, future in by_key.values()], force=True)
         if cluster is not None:
-            cluster.close()
+            _stop_local_workers(cluster)
+        raise
+    finally:
+        with _quiet_dask():
+            client.close(timeout=CLOSE_SECONDS)
+            if cluster is not None:
+                cluster.close(timeout=CLOSE_SECONDS)
+
+
+def _stop_local_workers(cluster) -> None:
+    """Kill the worker processes of our own LocalCluster. A worker in the middle of a
+    point finishes it before it obeys a polite close (seconds to minutes); its result
+    would be thrown away anyway."""
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):
+            nanny.auto_restart = False
+            process = nanny.process.process
+            if process is not None and process.pid:
+                os.kill(process.pid, signal.SIGKILL)
+
+
+@contextlib.contextmanager
+def _quiet_dask():
+    """Silence distributed's loggers while a cluster shuts down: closing it with work
+    cancelled makes them report every cancelled task and closed connection."""
+    names = ("distributed", "tornado", "asyncio")
+    levels = {name: logging.getLogger(name).level for name in names}
+    try:
+        for name in names:
+            logging.getLogger(name).setLevel(logging.CRITICAL)
+        yield
+    finally:
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)

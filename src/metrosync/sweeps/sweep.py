@@ -10,6 +10,7 @@ interrupted sweep and gives the same dataset as an uninterrupted one.
 from __future__ import annotations
 
 import itertools
+import os
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -18,7 +19,9 @@ from typing import Any
 
 import xarray as xr
 
-from ..errors import OverturnWarning
+from ..budget import Budget, simulation_budget
+from ..errors import Interrupted, OverturnWarning, ParameterError
+from ..simulate import record_stride
 from .executors import Execution, execute
 from .grid import MODEL_PARAMETERS, Grid
 from .store import PointStore, merge, write_dataset
@@ -130,11 +133,64 @@ def sweep(
         for spec in specs
         if not points.has(spec.key) or (retry_failed and points.failed(spec.key))
     ]
+    sweep_budget(specs, todo, scheduler=scheduler, n_workers=n_workers).check()
     show = sys.stderr.isatty() if progress is None else progress
-    execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
-    dataset = merge(grid, points)
-    out_path = write_dataset(dataset, out) if out is not None else None
+    try:
+        execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
+        dataset = merge(grid, points)
+        out_path = write_dataset(dataset, out) if out is not None else None
+    except KeyboardInterrupt:
+        kept = sum(points.has(spec.key) for spec in specs)
+        raise Interrupted(
+            f"{kept} of {len(specs)} points kept in {points.root}; run the same command "
+            f"again to resume"
+        ) from None
     return SweepResult(dataset, grid, points.root, len(specs) - len(todo), execution, out_path)
+
+
+#: Memory of one point's dataset object while the sweep is merged, besides its arrays.
+POINT_OVERHEAD = 50_000
+
+
+def sweep_budget(specs, todo, *, scheduler=None, n_workers=None) -> Budget:
+    """Memory and time of a sweep of ``specs`` that computes ``todo``, before it starts.
+
+    Memory: the largest point's simulation (on each local worker; none for a remote
+    cluster) or the merge, whichever is larger: every point's arrays loaded, the
+    merged arrays, and r(t) of every run with ``keep_r``. Time: the points to compute,
+    one after another, on this machine.
+    """
+    sims, merge = [], 0.0
+    to_compute = {spec.key for spec in todo}
+    for spec in specs:
+        k = spec.kwargs
+        steps = round(k["duration"] / k["dt"])
+        try:
+            every, _ = record_stride(k["record_every"], steps, k["dt"])
+        except ParameterError:
+            every = steps or 1  # the point fails, quickly
+        records = steps // every + 1
+        merge += 2 * (17.0 * k["runs"] + (16.0 * records * k["runs"] if spec.keep_r else 0.0))
+        merge += POINT_OVERHEAD
+        if spec.key in to_compute:
+            sims.append(
+                simulation_budget(
+                    n=k["n"], runs=k["runs"], steps=steps, records=records, trajectories=False,
+                    integrator=k["integrator"], backend=k["backend"], dt=k["dt"],
+                )  # fmt: skip
+            )
+    workers = {None: 1, "local": n_workers or os.cpu_count() or 1}.get(scheduler, 0)
+    largest = max((b.nbytes for b in sims), default=0.0) * workers
+    arrays = {"merged result": merge}
+    if largest > merge:
+        arrays = {"the largest point" + (f" on {workers} workers" if workers > 1 else ""): largest}
+    seconds = sum(b.seconds for b in sims)
+    work = sum(spec.work for spec in todo)
+    fixes = "sweep fewer points, use fewer `runs` or a shorter `duration`"
+    if any(spec.keep_r for spec in specs):
+        fixes += ", or drop `keep_r` (--keep-r)"
+    return Budget("the sweep", arrays, seconds, f"{len(todo)} points, {work:.2g} oscillator-steps",
+                  fixes)  # fmt: skip
 
 
 def _warn_overturn(grid: Grid) -> None:

@@ -1,0 +1,161 @@
+"""Ctrl-C: one line that says what was kept, exit status 130, no partial file, and
+within a couple of seconds, also in the middle of long compiled work."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from metrosync import interrupts
+from metrosync.errors import Interrupted
+
+# Runs the command line in a child that leaves a marker when the compiled kernel is
+# first entered, so that the test signals it in the middle of the work, not during
+# start-up.
+CHILD = textwrap.dedent(
+    """
+    import sys
+    from pathlib import Path
+    from metrosync.integrators import verlet
+    advance = verlet.advance_state
+    def marked(*args, **kwargs):
+        Path(sys.argv[1]).touch()
+        return advance(*args, **kwargs)
+    verlet.advance_state = marked
+    from metrosync.cli import main
+    sys.exit(main(sys.argv[2:]))
+    """
+)
+
+
+def interrupt_child(tmp_path: Path, argv: list[str], *, ready, settle: float = 1.0):
+    """Start the CLI with ``argv``, wait until ``ready()``, send SIGINT; return
+    (exit status, stderr, seconds from the signal to the exit)."""
+    marker = tmp_path / "kernel-entered"
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(marker), *argv],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "NUMBA_NUM_THREADS": "2"},
+    )  # fmt: skip
+    deadline = time.monotonic() + 120
+    while not (marker.exists() and ready()):
+        assert child.poll() is None, child.stderr.read()
+        assert time.monotonic() < deadline, "the child never started computing"
+        time.sleep(0.05)
+    time.sleep(settle)  # well inside the compiled work
+    sent = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    _, err = child.communicate(timeout=60)
+    return child.returncode, err, time.monotonic() - sent
+
+
+def test_ctrl_c_in_a_long_kernel_run_of_simulate(tmp_path):
+    out = tmp_path / "out"
+    # 4000 runs x 60000 steps, recorded every 20000 steps: before chunks were timed,
+    # one compiled call ran for a whole record interval (several seconds).
+    argv = ["simulate", "--runs", "4000", "--duration", "600", "--save-every", "20000",
+            "--out", str(out / "r.nc"), "--plot", str(out / "r.png")]  # fmt: skip
+    code, err, seconds = interrupt_child(tmp_path, argv, ready=lambda: True)
+    assert code == 130
+    assert err == "metrosync simulate: interrupted: nothing was written\n"
+    assert seconds < 5.0, f"took {seconds:.1f} s to stop"
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_ctrl_c_in_an_in_process_sweep_says_what_was_kept(tmp_path):
+    store = tmp_path / "sw.points"
+    points = store / "points"
+    argv = ["sweep", "--bpm", "186:194:2", "--n", "7", "--runs", "1000", "--duration", "300",
+            "--out", str(tmp_path / "sw.nc")]  # fmt: skip
+    code, err, seconds = interrupt_child(
+        tmp_path, argv, ready=lambda: points.is_dir() and any(points.glob("*.nc")), settle=0.5
+    )
+    assert code == 130
+    kept = len(list(points.glob("*.nc")))
+    assert err == (
+        f"metrosync sweep: interrupted: {kept} of 5 points kept in {store}; run the same "
+        f"command again to resume\n"
+    )
+    assert 1 <= kept < 5
+    assert seconds < 5.0, f"took {seconds:.1f} s to stop"
+    assert not (tmp_path / "sw.nc").exists()
+    assert not list(tmp_path.rglob("*partial*"))
+
+
+@pytest.mark.slow
+def test_ctrl_c_in_a_dask_sweep_stops_the_cluster_quietly(tmp_path):
+    store = tmp_path / "sw.points"
+    points = store / "points"
+    argv = ["sweep", "--bpm", "186:194:2", "--n", "7", "--runs", "1000", "--duration", "300",
+            "--scheduler", "local", "--workers", "2", "--out", str(tmp_path / "sw.nc")]  # fmt: skip
+    # The kernel runs in the workers: wait for a stored point instead of the marker.
+    (tmp_path / "kernel-entered").touch()
+    code, err, seconds = interrupt_child(
+        tmp_path, argv, ready=lambda: points.is_dir() and any(points.glob("*.nc")), settle=0.5
+    )
+    assert code == 130
+    assert re.fullmatch(
+        r"metrosync sweep: interrupted: [1-4] of 5 points kept in .*; run the same command "
+        r"again to resume\n",
+        err,
+    ), err
+    assert seconds < 10.0, f"took {seconds:.1f} s to stop"
+
+
+def test_a_lost_interrupt_is_raised_again_at_the_next_check(capsys):
+    class Swallows:
+        def __del__(self):  # Python discards what __del__ raises, as it does in gc callbacks
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(10**7):  # the handler runs at one of these bytecodes
+                pass
+
+    with interrupts.sigint_checked():
+        Swallows()  # the interrupt is raised and lost in __del__
+        with pytest.raises(KeyboardInterrupt):
+            interrupts.check()
+    interrupts.check()  # outside, nothing is pending
+    assert capsys.readouterr().err == ""  # and nothing was printed about it
+
+
+def test_reproduce_says_how_many_points_it_kept(tmp_path, monkeypatch):
+    from metrosync.paper import pipeline
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pipeline, "run_study", stop)
+    with pytest.raises(Interrupted) as interrupt:
+        pipeline.reproduce(tmp_path, studies=["fig8_top"])
+    assert re.fullmatch(
+        rf"0 of \d+ points kept in {re.escape(str(tmp_path / 'points'))}; run the same "
+        r"command again to resume",
+        interrupt.value.kept,
+    )
+
+
+@pytest.mark.parametrize(
+    ("argv", "name"),
+    [
+        (["animate", "--duration", "120", "--speedup", "1", "--dpi", "40"], "a.gif"),
+        (["listen", "--duration", "3000"], "t.wav"),
+    ],
+)
+def test_ctrl_c_while_writing_leaves_no_partial_file(tmp_path, argv, name):
+    out = tmp_path / "out"
+    (tmp_path / "kernel-entered").touch()  # wait for the file being written instead
+    code, err, seconds = interrupt_child(
+        tmp_path, [*argv, "--out", str(out / name)],
+        ready=lambda: out.is_dir() and any(out.glob(".*partial*")), settle=0.3,
+    )  # fmt: skip
+    assert code == 130
+    assert err == f"metrosync {argv[0]}: interrupted: nothing was written\n"
+    assert seconds < 5.0
+    assert list(out.iterdir()) == []
