@@ -137,8 +137,16 @@ def analyze_logs(
         spans.append((max(s for s, _ in ch_spans), min(e for _, e in ch_spans)))
     grid = ph.common_grid(spans, grid_dt)
     if grid.size < 2:
+        start, end = max(s for s, _ in spans), min(e for _, e in spans)
+        shown = ", ".join(f"{s:.3f} .. {e:.3f}" for s, e in spans)
+        if end > start:  # there is a common span; the grid is too coarse for it
+            raise ParameterError(
+                f"`grid_dt` = {grid_dt:g} s leaves fewer than two grid times in the logs' "
+                f"common span {start:.3f} .. {end:.3f} s; give `grid_dt` <= "
+                f"{(end - start) / 2:.3g} s."
+            )
         raise AnalysisError(
-            f"the logs share no common span where every gate has a phase (spans {spans} s); "
+            f"the logs share no common span where every gate has a phase (spans {shown} s); "
             f"analyse them separately or leave out a gate that stops early (`channels=`)."
         )
     r_runs = np.stack([ph.order_on_grid([(c.kept, c.cycles) for c in chans], grid)

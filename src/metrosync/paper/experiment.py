@@ -1,8 +1,10 @@
 """Fig. 9: simulated against measured equilibrium r, from folders of light-gate logs.
 
 Contract: ``DIR`` holds one sub-folder per nominal ω₀, named by its BPM (``DIR/192/``),
-each with the logger captures ``*.txt`` of that ω₀. `find_experiment` checks that
-layout up front (so a long reproduction never fails at its end); `compare_experiment`
+each with the logger captures of that ω₀: every file in it that is not hidden (``*.txt``
+from the logger, ``*.log`` from ``metrosync simulate --lightgate-dir``, any name the
+reader accepts). `find_experiment` reads each capture up front (so a long
+reproduction never fails at its end on a stray file); `compare_experiment`
 analyses each folder with `metrosync.lightgate.analyze` (whose result carries the
 equilibrium r averaged over the logs in ``attrs["r_eq"]``) and pairs it with the
 simulated N = 7 equilibrium r at the same ω₀ from the Fig. 8 (top) study.
@@ -31,15 +33,31 @@ def find_experiment(directory: Path) -> dict[float, list[Path]]:
             bpm = float(sub.name)
         except ValueError:
             continue  # folders not named by a BPM are not ω₀ data
-        logs = sorted(sub.glob("*.txt"))
+        logs = sorted(p for p in sub.iterdir() if p.is_file() and not p.name.startswith("."))
         if logs:
             found[bpm] = logs
     if not found:
         raise ParameterError(
-            f"`--experiment` {str(directory)!r} holds no folder named by a BPM with *.txt logs; "
-            f"expected e.g. {str(directory / '192' / 'run01.txt')!r}."
+            f"`--experiment` {str(directory)!r} holds no folder named by a BPM with light-gate "
+            f"logs; expected e.g. {str(directory / '192' / 'run01.txt')!r} (or run01.log)."
         )
+    _check_captures([path for paths in found.values() for path in paths])
     return found
+
+
+def _check_captures(paths: list[Path]) -> None:
+    """Read every capture once, so a file the reader refuses stops the run at its start."""
+    from ..errors import LogFormatError
+    from ..lightgate.reader import read_log
+
+    for path in paths:
+        try:
+            read_log(path)
+        except LogFormatError as error:
+            raise ParameterError(
+                f"`--experiment`: {str(path)!r} is not a light-gate capture ({error}); move it "
+                f"out of the folder."
+            ) from None
 
 
 def lightgate_analyze():
