@@ -60,3 +60,15 @@ def test_experiment_folders_take_simulated_logs_and_refuse_stray_files(tmp_path,
     (folder / "notes.md").write_text("# what we did\n")
     with pytest.raises(ParameterError, match=r"notes.md' is not a light-gate capture"):
         find_experiment(tmp_path / "exp")
+
+
+def test_a_virtual_gate_beyond_the_swing_warns_naming_the_option(tmp_path, capsys):
+    argv = ["simulate", "--n", "2", "--runs", "1", "--duration", "10",
+            "--lightgate-dir", str(tmp_path), "--gate-offset", "5"]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "warning: the light gate at `offset` (--gate-offset) = 5 rad" in err
+    assert "(2 never)" in err
+    assert main(["analyze", str(DATA / "clean.log")]) == 0
+    header = capsys.readouterr().out.splitlines()[1]
+    assert header.endswith("passes bridged")
