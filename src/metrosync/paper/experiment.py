@@ -83,13 +83,22 @@ def compare_experiment(directory: Path, simulated: xr.Dataset) -> xr.Dataset:
 
     Returns
     -------
-    Dataset over ``bpm`` with ``r_exp``, ``n_logs``, ``r_sim``, ``sigma_r_sim``; r_sim is
-    NaN for an ω₀ the simulation did not cover.
+    Dataset over ``bpm`` with ``r_exp``, ``r_exp_std`` (σ of the logs' own equilibrium
+    r, NaN for one log), ``n_logs``, ``r_sim``, ``sigma_r_sim``; r_sim is NaN for an ω₀
+    the simulation did not cover.
     """
+    from ..observables.order import equilibrium_order
+
     analyze = lightgate_analyze()
     logs = find_experiment(directory)
     bpms = sorted(logs)
-    r_exp = [float(analyze(logs[b]).attrs["r_eq"]) for b in bpms]
+    r_exp, r_exp_std = [], []
+    for b in bpms:
+        measured = analyze(logs[b])
+        r_exp.append(float(measured.attrs["r_eq"]))
+        per_log = equilibrium_order(measured.r_runs.values.T, measured.time.values,
+                                    measured.attrs["equilibrium_window"])  # fmt: skip
+        r_exp_std.append(float(np.std(per_log, ddof=1)) if per_log.size > 1 else np.nan)
     sim_bpm = np.asarray(simulated.bpm.values, dtype=float)
     r_sim, s_sim = [], []
     for b in bpms:
@@ -99,6 +108,7 @@ def compare_experiment(directory: Path, simulated: xr.Dataset) -> xr.Dataset:
     return xr.Dataset(
         {
             "r_exp": ("bpm", r_exp, {"long_name": "measured equilibrium r (mean over logs)"}),
+            "r_exp_std": ("bpm", r_exp_std, {"long_name": "std over logs of their equilibrium r"}),
             "n_logs": ("bpm", [len(logs[b]) for b in bpms]),
             "r_sim": ("bpm", r_sim, {"long_name": "simulated equilibrium r, N = 7"}),
             "sigma_r_sim": ("bpm", s_sim),
