@@ -16,7 +16,7 @@ BASE = ["sweep", "--bpm", "186,190", "--runs", "2", "--duration", "2", "--no-pro
     ("extra", "expected"),
     [
         (["--workers", "2"], "`n_workers` (--workers) = 2 applies to scheduler='local' only"),
-        (["--scheduler", "foo"], "`scheduler` (--scheduler) must be 'local' or 'tcp://HOST:PORT'"),
+        (["--scheduler", "foo"], "`scheduler` (--scheduler) must be None (in process), 'local'"),
         (["--scheduler", "local", "--workers", "0"], "`n_workers` (--workers) must be an integer"),
     ],
 )

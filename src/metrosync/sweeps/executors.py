@@ -96,8 +96,8 @@ def check_scheduler(scheduler: str | None, n_workers: int | None) -> None:
         or (scheduler != "local" and not scheduler.startswith("tcp://"))
     ):
         raise ParameterError(
-            "`scheduler` must be 'local' or 'tcp://HOST:PORT' (or None, the default: in "
-            f"process), got {scheduler!r}."
+            "`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', "
+            f"got {scheduler!r}."
         )
     if n_workers is not None and (
         isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1
