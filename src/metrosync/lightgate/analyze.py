@@ -163,7 +163,7 @@ def analyze_logs(
     bridged = np.array([[c.bridged for c in chans] for chans in per_log])
     irregular = np.array([[c.irregular for c in chans] for chans in per_log])
     extra = np.array([[c.dropped.get("duplicate", 0) for c in chans] for chans in per_log])
-    _warn_missed_passes(paths, chosen, bridged, extra, irregular, kept)
+    _warn_missed_passes([log.source for log in logs], chosen, bridged, extra, irregular, kept)
     dropped = np.array([[sum(c.dropped.values()) for c in chans] for chans in per_log])
     ambiguous = np.array([[c.direction_ambiguous for c in chans] for chans in per_log])
     levels = np.array([log.interrupted_level[chosen] for log in logs], dtype=np.int8)
@@ -242,10 +242,10 @@ def analyze_logs(
     )
 
 
-def _warn_missed_passes(paths, chosen, bridged, extra, irregular, kept) -> None:
+def _warn_missed_passes(sources, chosen, bridged, extra, irregular, kept) -> None:
     """One warning per log whose gates missed passes, saw extra ones, or irregular
     intervals: the frequency and jitter of those gates rest on bridged data."""
-    for path, b_row, e_row, i_row, k_row in zip(paths, bridged, extra, irregular, kept,
+    for path, b_row, e_row, i_row, k_row in zip(sources, bridged, extra, irregular, kept,
                                                 strict=True):  # fmt: skip
         gates = []
         for gate, b, e, i, k in zip(chosen, b_row, e_row, i_row, k_row, strict=True):
