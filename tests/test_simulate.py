@@ -64,7 +64,7 @@ def test_explicit_frequencies_and_initial_conditions():
     [
         ({"n": 0}, r"`n` must be an integer >= 1, got 0"),
         ({"runs": -2}, r"`runs` must be an integer >= 1"),
-        ({"bpm": 400.0}, r"`bpm` = 400.0 is outside the tunable range"),
+        ({"bpm": 400.0}, r"`bpm` = 400 is outside the tunable range"),
         ({"bpm": float("nan")}, r"`bpm` must be a finite number"),
         ({"sigma_bpm": -1.0}, r"`sigma_bpm` must be >= 0"),
         ({"sigma_bpm": 60.0}, r"drawn natural frequency .* outside the tunable range"),

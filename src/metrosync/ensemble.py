@@ -82,9 +82,9 @@ def build_ensemble(
     runs : B, the number of independent runs.
     seed : seed of every random choice.
     frequencies_bpm : explicit natural frequencies, shape (N,) or (B, N); replaces the
-        draw (then ``n``, ``bpm`` and ``sigma_bpm`` are not used).
+        draw (``bpm`` is not used; ``n`` must be N or None, ``sigma_bpm`` 0).
     metronomes : explicit, fully specified metronomes (shape (N,)): every parameter
-        per metronome, the same in every run.
+        per metronome, the same in every run (``n`` must be N or None, ``sigma_bpm`` 0).
     amplitude : swing amplitude (rad) of the random-phase start; default the
         energy-balance amplitude 2M/(π c_θ) (MODEL-NOTES §6).
     theta0, theta_dot0 : explicit initial angles and angular velocities, (N,) or (B, N).
@@ -98,10 +98,20 @@ def build_ensemble(
     freq_rng, phase_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     design = params.metronome
 
+    if (
+        isinstance(sigma_bpm, bool)
+        or not isinstance(sigma_bpm, int | float | np.integer | np.floating)
+        or not (math.isfinite(sigma_bpm) and sigma_bpm >= 0)
+    ):
+        raise ParameterError(
+            f"`sigma_bpm` must be >= 0 BPM, got {describe(sigma_bpm)}; give a number "
+            f"(0 tunes every metronome to the nominal `bpm`)."
+        )
     if metronomes is not None:
         metronomes = list(metronomes)
         if not metronomes:
             raise ParameterError("`metronomes` is empty: give at least one Metronome.")
+        _require_explicit("metronomes", len(metronomes), n, sigma_bpm)
         n = len(metronomes)
         l2 = np.broadcast_to([m.l2 for m in metronomes], (runs, n)).copy()
         per = {
@@ -111,20 +121,24 @@ def build_ensemble(
     else:
         if frequencies_bpm is not None:
             freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
+            _require_explicit("frequencies_bpm", freq.shape[1], n, sigma_bpm)
             n = freq.shape[1]
+            low, high = design.bpm_range()
+            outside = np.argwhere((freq < low) | (freq > high))
+            if outside.size:
+                # Name the entry as the caller wrote it: a list of N, or a (runs, N) table.
+                at = outside[0] if np.ndim(frequencies_bpm) == 2 else outside[0][1:]
+                where = "".join(f"[{int(k)}]" for k in at)
+                raise ParameterError(
+                    design.out_of_range(f"frequencies_bpm{where}", float(freq[tuple(outside[0])]))
+                )
         else:
             n = _require_count("n", n)
             if bpm is None or not math.isfinite(float(bpm)):
                 raise ParameterError(f"`bpm` must be a finite number, got {bpm!r}.")
-            if not (math.isfinite(sigma_bpm) and sigma_bpm >= 0):
-                raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {sigma_bpm!r}.")
             low, high = design.bpm_range()
             if not low <= float(bpm) <= high:
-                raise ParameterError(
-                    f"`bpm` = {bpm!r} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
-                    f"of this metronome design (slider L2 in {design.l2_bounds} m). Choose a BPM "
-                    f"in range, or widen `l2_bounds`."
-                )
+                raise ParameterError(design.out_of_range("bpm", float(bpm)))
             freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
             if np.any((freq < low) | (freq > high)):
                 raise ParameterError(
@@ -223,6 +237,20 @@ def _require_count(name: str, value) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
         raise ParameterError(f"`{name}` must be an integer >= 1, got {describe(value)}.")
     return int(value)
+
+
+def _require_explicit(name: str, count: int, n, sigma_bpm) -> None:
+    """Explicit metronomes fix N and every frequency: refuse an `n` or a spread that
+    says otherwise rather than ignore it."""
+    if n is not None and n != count:
+        raise ParameterError(
+            f"`n` = {n!r} but `{name}` gives {count} metronome(s); pass n={count} or n=None."
+        )
+    if sigma_bpm:
+        raise ParameterError(
+            f"`sigma_bpm` = {sigma_bpm!r} has no effect with `{name}`, which fixes every "
+            f"frequency; drop it (or give the spread in the frequencies)."
+        )
 
 
 def _per_metronome(name: str, values, runs: int, n: int | None) -> np.ndarray:

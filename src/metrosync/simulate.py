@@ -11,8 +11,10 @@ was recorded in an `xarray.Dataset`:
                                           where some metronome has no phase yet)
     r_eq         (run)                    mean of r_crossing over the final window
     r_eq_analytic(run)                    the same from r
-    status       (run)                    bit flags: 1 overturned, 2 diverged
+    status       (run)                    bit flags (see `metrosync.status`)
     frequency_bpm, l2 (run, metronome)    natural frequency and slider position
+    tick_rate_bpm (run, metronome)        ticks per minute measured at the end of the
+                                          run (see `metrosync.observables.ticks`)
     theta, theta_dot (time, run, metronome), phi, phi_dot (time, run)
                                           trajectories, only when asked for
 
@@ -24,6 +26,7 @@ from __future__ import annotations
 import math
 import operator
 import sys as _sys
+import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -32,13 +35,14 @@ import xarray as xr
 from ._version import __version__
 from .budget import simulation_budget
 from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
-from .errors import ParameterError
+from .errors import OverturnWarning, ParameterError
 from .integrators import INTEGRATORS
 from .integrators import reference as numpy_backend
 from .integrators import verlet as numba_backend
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
+from .observables.ticks import CrossingTally, tail_span, tick_rate
 from .pacing import Pacer
 from .progress import progress_bar
 from .status import STATUS_MEANINGS
@@ -79,9 +83,16 @@ def simulate(
 ) -> xr.Dataset:
     """Simulate ``runs`` independent ensembles of ``n`` metronomes on a free disk.
 
+    The defaults describe one deterministic run of identical metronomes (σ = 0, one
+    run): a building block that the calibration, the sweeps and the paper's studies
+    configure explicitly. The command line's defaults (σ = 0.75 BPM, 20 runs) describe
+    the paper's experiment instead; ``metrosync simulate --help`` says so too.
+
     Parameters
     ----------
     n, bpm : number of metronomes and nominal beat frequency (BPM, two beats a period).
+        The nominal BPM tunes the small-swing frequency; at the default swing a
+        metronome ticks slower (``tick_rate_bpm`` in the result holds the measured rate).
     sigma_bpm : spread (std, BPM) of the natural frequencies, drawn per run.
     runs : number of independent runs B.
     duration, dt : simulated time and time step, s.
@@ -138,6 +149,11 @@ def simulate(
             f"than the {MAX_STEPS:.3g} a run can count; shorten `duration` or enlarge `dt`."
         )
     n_steps = int(round(duration / dt))
+    if n_steps < 1:
+        raise ParameterError(
+            f"`duration` = {duration!r} s is shorter than one time step (`dt` = {dt!r} s); "
+            f"lengthen `duration`."
+        )
     record_every, record_reason = record_stride(record_every, n_steps, dt)
     n_records = n_steps // record_every + 1
     size = _request_size(n, runs, frequencies_bpm, metronomes, theta0)
@@ -166,12 +182,15 @@ def simulate(
             f"`equilibrium_window` must be in (0, duration], got {equilibrium_window!r}."
         )
     show = _sys.stderr.isatty() if progress is None else progress
+    _warn_overturned_start(ensemble, amplitude, overturn_angle)
+    longest_period = float(2 * np.pi / np.min(ensemble.system.omega))
+    tail_steps = min(n_steps, math.ceil(tail_span(window, longest_period) / dt))
 
     if integrator == "verlet":
         kernel = _backend_module(backend, trajectories)
-        records = _run_fixed_step(
+        records, rates = _run_fixed_step(
             ensemble, kernel, dt, n_steps, record_every, n_records, trajectories,
-            overturn_angle, show,
+            overturn_angle, show, tail_steps,
         )  # fmt: skip
     else:
         from .integrators import exact  # scipy's solvers load only when asked for
@@ -183,6 +202,10 @@ def simulate(
                 trajectories=trajectories, overturn_angle=overturn_angle,
                 on_run_done=lambda: bar.update(1),
             )  # fmt: skip
+        since = (n_steps - tail_steps) * dt
+        rates = np.stack([tick_rate(run, since) for run in records.crossings])
+    # A run that overturned or diverged has no steady tick.
+    rates[records.status != 0] = np.nan
     settings = {
         "n": ensemble.n,
         "bpm": "explicit"
@@ -200,8 +223,32 @@ def simulate(
         "record_every_reason": record_reason,
         "equilibrium_window": window,
         "overturn_angle": overturn_angle,
+        "tick_rate_span": tail_steps * dt,
     }
-    return _to_dataset(ensemble, records, record_every * dt, window, settings)
+    return _to_dataset(ensemble, records, rates, record_every * dt, window, settings)
+
+
+def _warn_overturned_start(ensemble: Ensemble, amplitude, overturn_angle: float) -> None:
+    """Warn when some pendulum starts swinging past ``overturn_angle``: its run will be
+    flagged at once and its r means nothing."""
+    swing = np.hypot(ensemble.theta0, ensemble.theta_dot0 / ensemble.system.omega)
+    if not np.any(swing > overturn_angle):
+        return
+    runs = int(np.any(swing > overturn_angle, axis=1).sum())
+    given = (
+        f"`amplitude` = {amplitude!r} rad"
+        if amplitude is not None
+        else (
+            f"the start (`theta0`, `theta_dot0`) swings up to {float(swing.max()):.3g} rad, which"
+        )
+    )
+    warnings.warn(
+        f"{given} is beyond `overturn_angle` = {overturn_angle:.4g} rad: {runs} of "
+        f"{ensemble.runs} run(s) start overturned, are flagged in `status`, and their r is "
+        f"not meaningful. Start below {overturn_angle:.4g} rad.",
+        OverturnWarning,
+        stacklevel=3,
+    )
 
 
 def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
@@ -209,6 +256,7 @@ def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
     is what it is (stored in ``attrs``): ``record_every`` when given, else 0.1 s or
     the stride that keeps `MAX_RECORDS` records."""
     reason = "given"
+    defaulted = record_every is None
     if record_every is None:
         record_every = max(1, int(round(RECORD_SECONDS / dt)))
         reason = f"default {RECORD_SECONDS:g} s"
@@ -225,6 +273,12 @@ def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
     ):
         raise ParameterError(f"`record_every` must be an integer >= 1 step, got {record_every!r}.")
     if record_every > n_steps:
+        if defaulted:  # the user gave no stride: the run is what is too short
+            raise ParameterError(
+                f"`duration` = {n_steps * dt:g} s is shorter than the default recording "
+                f"interval ({record_every * dt:g} s, {record_every} steps of {dt!r} s); "
+                f"lengthen `duration`, or give `record_every` <= {n_steps} steps."
+            )
         raise ParameterError(
             f"`record_every` = {record_every} steps exceeds the {n_steps} steps of the run; "
             f"lower it or lengthen `duration`."
@@ -268,7 +322,10 @@ def _backend_module(backend: str, trajectories: bool):
 
 
 def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, trajectories,
-                    overturn_angle, show) -> Records:  # fmt: skip
+                    overturn_angle, show, tail_steps) -> tuple[Records, np.ndarray]:  # fmt: skip
+    """Advance in paced chunks; the last ``tail_steps`` go in segments shorter than half
+    the shortest period, to count ticks (`CrossingTally`). Returns the records and the
+    (B, N) tick rates."""
     state = StepState.start(
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
         n_records=n_records, trajectories=trajectories,
@@ -279,18 +336,29 @@ def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, tra
         n=ensemble.n, runs=ensemble.runs, steps=1, records=1, trajectories=False,
         backend="numpy" if backend is numpy_backend else "numba",
     ).seconds  # fmt: skip
+    per_segment = max(1, int(ensemble.shortest_period() / 2 / dt))
+    head = n_steps - tail_steps
     with progress_bar(total=round(n_steps * dt, 6), unit="s", enabled=show) as bar:
-        for step, count in Pacer(n_steps, estimate):
+
+        def advance(step: int, count: int) -> None:
             backend.advance_state(
                 state, ensemble.system, dt=dt, step0=step, n_steps=count,
                 record_every=record_every, overturn_angle=overturn_angle,
             )  # fmt: skip
             bar.update(round(count * dt, 6))
-    return records_of(state)
+
+        for step, count in Pacer(head, estimate):
+            advance(step, count)
+        tally = CrossingTally(state.last_up)
+        for step, count in Pacer(tail_steps, estimate):
+            for part in range(0, count, per_segment):
+                advance(head + step + part, min(per_segment, count - part))
+                tally.see(state.last_up)
+    return records_of(state), tally.rate()
 
 
 def _to_dataset(
-    ensemble: Ensemble, rec: Records, grid_dt: float, window: float, settings
+    ensemble: Ensemble, rec: Records, rates: np.ndarray, grid_dt: float, window: float, settings
 ) -> xr.Dataset:
     n_rec = rec.r.shape[1]
     time = np.arange(n_rec) * grid_dt
@@ -330,6 +398,15 @@ def _to_dataset(
             ("run", "metronome"),
             ensemble.l2,
             {"units": "m", "long_name": "slider position L2"},
+        ),
+        "tick_rate_bpm": (
+            ("run", "metronome"),
+            rates,
+            {
+                "units": "BPM",
+                "long_name": f"ticks per minute measured over the final "
+                f"{settings['tick_rate_span']:g} s (NaN for a flagged run)",
+            },
         ),
     }
     if rec.theta is not None:

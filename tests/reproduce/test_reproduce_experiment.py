@@ -49,7 +49,11 @@ def test_comparison_pairs_each_folder_with_the_simulation(tmp_path, monkeypatch)
 
     def analyze(paths):
         seen.append(list(paths))
-        return xr.Dataset(attrs={"r_eq": 0.25 + 0.5 * len(seen)})
+        r = 0.25 + 0.5 * len(seen)
+        # two logs whose own equilibrium r is r -+ 0.1: their std is 0.1 * sqrt(2)
+        r_runs = np.array([[r - 0.1] * 4, [r + 0.1] * 4])
+        return xr.Dataset({"r_runs": (("log", "time"), r_runs)}, coords={"time": np.arange(4.0)},
+                          attrs={"r_eq": r, "equilibrium_window": 1.0})  # fmt: skip
 
     fake = types.ModuleType("metrosync.lightgate")
     fake.analyze = analyze
@@ -57,6 +61,7 @@ def test_comparison_pairs_each_folder_with_the_simulation(tmp_path, monkeypatch)
     ds = compare_experiment(_layout(tmp_path / "exp", bpms=(160, 192, 200)), _simulated())
     assert [len(p) for p in seen] == [2, 2, 2]
     np.testing.assert_allclose(ds.r_exp, [0.75, 1.25, 1.75])
+    np.testing.assert_allclose(ds.r_exp_std, 0.1 * np.sqrt(2))  # Fig. 9's error bar in r_exp
     np.testing.assert_allclose(ds.r_sim.values[:2], [0.5, 0.9])
     assert np.isnan(ds.r_sim.values[2])  # 200 BPM was not simulated
     paths = plot_comparison(ds, tmp_path / "fig9")

@@ -11,7 +11,7 @@ from metrosync.show.plots import plot_run
 def test_plot_run_draws_four_panels_and_marks_the_window(recorded_ds, tmp_path):
     fig = plot_run(recorded_ds, run=0)
     axes = fig.axes
-    assert [ax.get_ylabel() for ax in axes] == ["θ (rad)", "Φ_i − Φ_0", "φ (rad)", "r"]
+    assert [ax.get_ylabel() for ax in axes] == ["θ (rad)", r"$\Phi_i - \Phi_0$", "φ (rad)", "r"]
     assert len(axes[0].lines) == 7 and len(axes[1].lines) == 6
     spans = [p for p in axes[3].patches]
     assert len(spans) == 1

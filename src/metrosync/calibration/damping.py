@@ -56,8 +56,8 @@ def fit_c_theta(time, amplitude, *, metronome: Metronome, min_amplitude: float =
     return Estimate(
         name="c_theta", value=float(value), unit="kg m²/s",
         x=t, y=u, fit_x=fit_t, fit_y=intercept + slope * fit_t,
-        xlabel="t (s)", ylabel="u(A) (≈ ln A)",
-        title="c_θ from the free decay (drive off, rigid support)",
+        xlabel="t (s)", ylabel="log swing amplitude: u(A) ≈ ln(A / rad)",
+        title=r"$c_\theta$ from the free decay (drive off, rigid support)",
         details={"stderr": float(2 * inertia * np.sqrt(cov[0, 0])), "amplitudes": int(t.size),
                  "inertia": float(inertia)},
     )  # fmt: skip

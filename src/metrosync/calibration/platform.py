@@ -89,7 +89,7 @@ def fit_c_phi(amplitude: float, *, n: int = 7, bpm: float = 192.0, c_theta: floa
     return Estimate(
         name="c_phi", value=value, unit="kg m²/s",
         x=grid, y=values, fit_x=np.array([grid[0], grid[-1]]), fit_y=np.array([amplitude] * 2),
-        xlabel="c_φ (kg m²/s)", ylabel="disk amplitude (rad)",
-        title=f"c_φ from the synchronized disk's amplitude (N = {n}, {bpm} BPM)",
+        xlabel=r"$c_\varphi$ (kg m²/s)", ylabel="disk amplitude (rad)",
+        title=rf"$c_\varphi$ from the synchronized disk's amplitude (N = {n}, {bpm} BPM)",
         details={"sensitivity": float(sensitivity), "error_gain": 1.0 / abs(sensitivity)},
     )  # fmt: skip

@@ -22,6 +22,7 @@ import warnings
 
 from .. import interrupts
 from .._files import recording_writes
+from .._version import __version__
 from ..errors import MetrosyncError
 
 #: Subcommand modules, in the order ``--help`` lists them.
@@ -38,6 +39,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Simulate and measure the synchronization of metronomes on a rotating disk.",
         epilog="`metrosync COMMAND --help` describes each command.",
     )
+    parser.add_argument("--version", action="version", version=f"metrosync {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in SUBCOMMANDS:
         importlib.import_module(f"{__name__}.{name}").register(subparsers)

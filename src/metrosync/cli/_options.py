@@ -56,15 +56,32 @@ def add_aliases(parser: argparse.ArgumentParser, **names: str) -> None:
     parser.set_defaults(_aliases={**(parser.get_default("_aliases") or {}), **names})
 
 
+#: The command line's spread of natural frequencies, BPM: the paper's σ (Tables 1–2).
+#: `metrosync.simulate` defaults to 0 instead (see its docstring).
+CLI_SIGMA_BPM = 0.75
+
+
 def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> None:
-    """Options that define an ensemble run, shared by `simulate` and friends."""
+    """Options that define an ensemble run, shared by `simulate` and friends.
+
+    ``--sigma`` and ``--runs`` default to None and are resolved by `ensemble_defaults`:
+    one metronome, or explicit initial conditions, imply σ = 0 (and one run) unless given.
+    """
     g = parser.add_argument_group("ensemble")
     g.add_argument("--n", type=int, default=7, help="metronomes on the disk")
-    g.add_argument("--bpm", type=float, default=192.0, help="nominal beat frequency, BPM")
+    g.add_argument("--bpm", type=float, default=192.0,
+                   help="nominal beat frequency, BPM; it tunes the small-swing frequency, so "
+                   "at the default swing a metronome ticks slower (192 BPM: about 184.6 "
+                   "ticks a minute)")  # fmt: skip
     g.add_argument(
-        "--sigma", type=float, default=0.75, help="spread (std) of the natural frequencies, BPM"
-    )
-    g.add_argument("--runs", type=int, default=runs, help="independent runs")
+        "--sigma", type=float, default=None,
+        help=f"spread (std) of the natural frequencies, BPM (default: {CLI_SIGMA_BPM}, the "
+        f"paper's; 0 with --n 1 or --theta0)",
+    )  # fmt: skip
+    more = "; 1 with --n 1 or --theta0" if runs > 1 else ""
+    g.add_argument("--runs", type=int, default=None,
+                   help=f"independent runs (default: {runs}{more})")  # fmt: skip
+    parser.set_defaults(_runs_default=runs)
     g.add_argument("--duration", type=float, default=600.0, help="simulated time, s")
     g.add_argument("--dt", type=float, default=0.01, help="time step, s")
     g.add_argument("--seed", type=int, default=0, help="random seed")
@@ -130,20 +147,55 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
         record_every="--save-every",
         equilibrium_window="--window",
         changes="--set",
+        l2_bounds="--set l2_bounds=LOW,HIGH",
+        l1="--set l1=METRES",
     )
 
 
-def parse_changes(items: list[str]) -> dict[str, float]:
-    """``--set NAME=VALUE`` items as a dict of numbers."""
-    changes = {}
+def ensemble_defaults(args) -> tuple[float, int, dict[str, str]]:
+    """σ (BPM) and runs for ``args``, and ``{"sigma": why, "runs": why}`` for each
+    default that was adapted.
+
+    A single metronome has no spread to draw and no phase to differ by, and explicit
+    initial conditions (``--theta0``) describe one experiment: both take σ = 0 and one
+    run unless given, rather than silently drawing frequencies and repeating the start.
+    """
+    why = ""
+    if args.theta0 is not None:
+        why = "explicit --theta0"
+    elif args.n == 1:
+        why = "one metronome"
+    sigma = args.sigma if args.sigma is not None else (0.0 if why else CLI_SIGMA_BPM)
+    runs = args.runs if args.runs is not None else (1 if why else args._runs_default)
+    adapted = {name: why for name in ("sigma", "runs") if why and getattr(args, name) is None}
+    return sigma, runs, adapted
+
+
+#: Model parameters that take two numbers (``--set l2_bounds=0,0.12``).
+PAIR_PARAMETERS = ("l2_bounds",)
+
+
+def parse_changes(items: list[str]) -> dict[str, float | tuple[float, ...]]:
+    """``--set NAME=VALUE`` items as a dict of numbers; ``A,B`` gives a pair
+    (``--set l2_bounds=0,0.12``)."""
+    changes: dict[str, float | tuple[float, ...]] = {}
     for item in items:
         name, sep, value = item.partition("=")
         try:
-            changes[name.strip()] = float(value)
+            parts = [float(part) for part in value.split(",")]
         except ValueError:
             sep = ""
         if not sep:
-            raise ParameterError(f"`--set` expects NAME=VALUE with a number, got {item!r}.")
+            raise ParameterError(
+                f"`--set` expects NAME=VALUE with a number (or LOW,HIGH for `l2_bounds`), "
+                f"got {item!r}."
+            )
+        name = name.strip()
+        pair = name in PAIR_PARAMETERS
+        if len(parts) != (2 if pair else 1):
+            want = "two numbers LOW,HIGH" if pair else "one number"
+            raise ParameterError(f"`--set {name}` takes {want}, got {value!r}.")
+        changes[name] = tuple(parts) if pair else parts[0]
     return changes
 
 
@@ -158,11 +210,12 @@ def simulate_from_args(args, **extra):
             UserWarning,
             stacklevel=2,
         )
+    sigma, runs, _ = ensemble_defaults(args)
     return simulate(
         args.n,
         args.bpm,
-        sigma_bpm=args.sigma,
-        runs=args.runs,
+        sigma_bpm=sigma,
+        runs=runs,
         duration=args.duration,
         dt=args.dt,
         seed=args.seed,

@@ -66,7 +66,7 @@ def register(subparsers) -> None:
                      help="follow a LOG that is still being written (by `metrosync record` or "
                      "a terminal program), with a live panel; at Ctrl-C analyse it and write "
                      "--out/--plot")  # fmt: skip
-    add_aliases(parser, equilibrium_window="--window")
+    add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt")
     add_audio_options(parser)
     parser.set_defaults(func=run)
 
@@ -106,11 +106,13 @@ def summary(ds) -> str:
     lines = [
         f"metrosync analyze: {ds.sizes['log']} log(s), {ds.sizes['metronome']} metronomes, "
         f"common span {float(ds.time[0]):.1f} .. {float(ds.time[-1]):.1f} s",
-        "  metronome  frequency (BPM)  period jitter (ms, mean over logs)",
+        "  metronome  frequency (BPM)  period jitter (ms, mean over logs)  passes bridged",
     ]
     jitter = ds.period_jitter.mean("log").values * 1e3
-    for m, f, j in zip(ds.metronome.values, ds.frequency_bpm.values, jitter, strict=True):
-        lines.append(f"  {int(m):9d}  {f:15.3f}  {j:8.3f}")
+    bridged = ds.passes_bridged.sum("log").values
+    rows = zip(ds.metronome.values, ds.frequency_bpm.values, jitter, bridged, strict=True)
+    for m, f, j, b in rows:
+        lines.append(f"  {int(m):9d}  {f:15.3f}  {j:34.3f}  {int(b):14d}")
     lines += [
         f"  sigma = {a['sigma_bpm']:.4f} BPM ({a['sigma_beats_per_tick']:.3g} beats per tick)",
         f"  equilibrium r (last {a['equilibrium_window']:.1f} s): {a['r_eq']:.4f}",

@@ -80,6 +80,10 @@ def run(args) -> int:
         print(f"  {n:>6}  {cells[0]:>25}  {cells[1]:>25}")
     a = result.attrs
     for m in METHODS:
+        note = a[f"fit_note_{m}"]
+        if note:  # an extrapolation the data do not support is not printed as a result
+            print(f"  N -> inf ({m}): not extrapolated: {note}")
+            continue
         print(
             f"  N -> inf ({m}): omega_c = {a[f'omega_c_inf_{m}']:.2f} +- "
             f"{a[f'omega_c_inf_{m}_err']:.2f} BPM, fit {a[f'fit_form_{m}']} "

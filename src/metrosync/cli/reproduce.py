@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ..errors import ParameterError
 from ._options import add_aliases
 
 
@@ -76,6 +77,13 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from ..paper import reproduce
     from ..paper.runner import StudyIncomplete
+    from ._io import check_output
+
+    # Refuse an unwritable output folder before any study runs (REPORT.md stands for
+    # every file written there).
+    if args.out.exists() and not args.out.is_dir():
+        raise ParameterError(f"`--out` {str(args.out)!r} is a file; give a folder.")
+    check_output(args.out / "REPORT.md", "--out")
 
     try:
         rep = reproduce(

@@ -17,6 +17,8 @@ GRID_OPTIONS = {
     "duration": "simulated time, s",
     "dt": "time step, s",
     "seed": "sweep seed (a list gives independent replicas)",
+    "amplitude": "start amplitude at random phases, rad (default: the steady swing "
+    "2M/(pi c_theta); needed where --drive is 0)",
     "drive": "escapement impulse M, N m s",
     "c-theta": "pendulum friction, kg m2/s",
     "c-phi": "disk friction, kg m2/s",
@@ -55,7 +57,7 @@ def register(subparsers) -> None:
     o.add_argument("--workers", type=int, default=None, help="workers of --scheduler local")
     o.add_argument("--retry-failed", action="store_true", help="recompute points stored as failed")
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
-    add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers")
+    add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers", scheduler="--scheduler")
     parser.set_defaults(func=run)
 
 
@@ -98,8 +100,10 @@ def grid_from_args(args):
 
 def run(args) -> int:
     from ..sweeps import sweep
+    from ..sweeps.executors import check_scheduler
 
     check_output(args.out, "--out", suffixes=NETCDF)
+    check_scheduler(args.scheduler, args.workers)
     grid = grid_from_args(args)
     store = args.store if args.store is not None else args.out.with_suffix(".points")
     check_output(store / "log.jsonl", "--store")

@@ -141,6 +141,8 @@ class Records:
     theta_dot: np.ndarray | None = None
     phi: np.ndarray | None = None
     phi_dot: np.ndarray | None = None
+    #: per run, N lists of upward-crossing times (integrators that keep them all).
+    crossings: list | None = None
 
 
 def records_of(state: StepState) -> Records:

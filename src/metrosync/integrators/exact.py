@@ -54,12 +54,14 @@ def integrate(
         theta_dot=np.full(shape + (n,), np.nan) if trajectories else None,
         phi=np.full(shape, np.nan) if trajectories else None,
         phi_dot=np.full(shape, np.nan) if trajectories else None,
+        crossings=[],
     )
     for b in range(runs):
         samples, upcrossings, status = _integrate_run(
             sys.run(b), theta0[b], theta_dot0[b], phi_dot0[b], grid, duration, overturn_angle
         )
         out.status[b] = status
+        out.crossings.append(upcrossings)
         th, thd = samples[:, 1 : n + 1], samples[:, n + 2 :]
         out.r[b] = order_parameter(analytic_phase(th, thd, sys.omega[b]))
         out.r_crossing[b] = crossing_order(upcrossings, grid)

@@ -14,6 +14,10 @@ experiments. The dataset holds
     passes_kept, passes_dropped, lines_skipped, counter_wraps, records_lost
                                            counts per log
                                            (and metronome)
+    passes_bridged, intervals_irregular (log, metronome)   missed passes bridged
+                                           (an interval of k periods counts k) and
+                                           intervals off the period grid; a warning
+                                           names each gate that has any
     direction_ambiguous, interrupted_level (log, metronome)   what the cleaning
                                            and the reader found about each gate
     path               (log)               the log files
@@ -26,6 +30,7 @@ options used, and the reading and cleaning reports.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -137,8 +142,16 @@ def analyze_logs(
         spans.append((max(s for s, _ in ch_spans), min(e for _, e in ch_spans)))
     grid = ph.common_grid(spans, grid_dt)
     if grid.size < 2:
+        start, end = max(s for s, _ in spans), min(e for _, e in spans)
+        shown = ", ".join(f"{s:.3f} .. {e:.3f}" for s, e in spans)
+        if end > start:  # there is a common span; the grid is too coarse for it
+            raise ParameterError(
+                f"`grid_dt` = {grid_dt:g} s leaves fewer than two grid times in the logs' "
+                f"common span {start:.3f} .. {end:.3f} s; give `grid_dt` <= "
+                f"{(end - start) / 2:.3g} s."
+            )
         raise AnalysisError(
-            f"the logs share no common span where every gate has a phase (spans {spans} s); "
+            f"the logs share no common span where every gate has a phase (spans {shown} s); "
             f"analyse them separately or leave out a gate that stops early (`channels=`)."
         )
     r_runs = np.stack([ph.order_on_grid([(c.kept, c.cycles) for c in chans], grid)
@@ -147,6 +160,10 @@ def analyze_logs(
     freq = np.array([[ph.mean_frequency_bpm(c.kept, c.cycles) for c in chans] for chans in per_log])
     jitter = np.array([[ph.period_jitter(c.kept, c.cycles) for c in chans] for chans in per_log])
     kept = np.array([[c.kept.size for c in chans] for chans in per_log])
+    bridged = np.array([[c.bridged for c in chans] for chans in per_log])
+    irregular = np.array([[c.irregular for c in chans] for chans in per_log])
+    extra = np.array([[c.dropped.get("duplicate", 0) for c in chans] for chans in per_log])
+    _warn_missed_passes([log.source for log in logs], chosen, bridged, extra, irregular, kept)
     dropped = np.array([[sum(c.dropped.values()) for c in chans] for chans in per_log])
     ambiguous = np.array([[c.direction_ambiguous for c in chans] for chans in per_log])
     levels = np.array([log.interrupted_level[chosen] for log in logs], dtype=np.int8)
@@ -177,6 +194,12 @@ def analyze_logs(
                         {"long_name": "passes kept (one per period, one direction)"}),
         "passes_dropped": (("log", "metronome"), dropped,
                            {"long_name": "passes and interruptions dropped by the cleaning"}),
+        "passes_bridged": (("log", "metronome"), bridged,
+                           {"long_name": "missed passes bridged (an interval of k periods "
+                                         "counts k)"}),
+        "intervals_irregular": (("log", "metronome"), irregular,
+                                {"long_name": "intervals more than 1/4 period off a whole "
+                                              "number of periods"}),
         "direction_ambiguous": (("log", "metronome"), ambiguous.astype(np.int8),
                                 {"long_name": "1: gate too central to tell the directions"}),
         "interrupted_level": (("log", "metronome"), levels,
@@ -217,6 +240,28 @@ def analyze_logs(
         },
         attrs=attrs,
     )
+
+
+def _warn_missed_passes(sources, chosen, bridged, extra, irregular, kept) -> None:
+    """One warning per log whose gates missed passes, saw extra ones, or irregular
+    intervals: the frequency and jitter of those gates rest on bridged data."""
+    for path, b_row, e_row, i_row, k_row in zip(sources, bridged, extra, irregular, kept,
+                                                strict=True):  # fmt: skip
+        gates = []
+        for gate, b, e, i, k in zip(chosen, b_row, e_row, i_row, k_row, strict=True):
+            found = [f"{n} {what}" for n, what in ((b, "missed passes bridged"),
+                     (e, "extra passes dropped"), (i, "irregular intervals")) if n]  # fmt: skip
+            if found:
+                periods = max(int(k) - 1 + int(b), 1)
+                gates.append(f"gate {gate}: {', '.join(found)} in {periods} periods")
+        if gates:
+            warnings.warn(
+                f"{path}: {'; '.join(gates)}. Frequencies and period jitter there rest on "
+                f"bridged passes: a gate near the end of the swing misses passes when the "
+                f"swing shrinks; mount it nearer the centre (passes_bridged in the dataset).",
+                UserWarning,
+                stacklevel=3,
+            )
 
 
 def _channels(channels, k: int) -> list[int]:

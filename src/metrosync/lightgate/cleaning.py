@@ -25,8 +25,13 @@ The steps:
    a short interval, or opens a long one, is the period's second pass and is dropped.
    A pass with contradictory neighbours is dropped as ambiguous, one with no
    classifiable neighbour as isolated.
-5. *Periods.* Consecutive kept passes about k ≥ 2 periods apart (missed passes)
-   count as k periods; kept passes much closer than a period are duplicates.
+5. *Periods.* Against the median interval between kept passes (a run's period: most
+   intervals are one period), a kept pass closer than 3/4 of it to the previous one
+   is an extra (a duplicate), and an interval of about k ≥ 2 periods (missed passes)
+   counts as k periods: the k − 1 missed passes are *bridged*. The median is used,
+   not a local one, because where passes go missing the local intervals are mostly
+   gaps. Intervals more than 1/4 period off a whole number are *irregular* (a gate
+   that misses passes near the end of the swing also mixes up their directions).
 
 When s and l differ by less than ``min_asymmetry`` (a centred gate), the direction
 cannot be told: the channel is flagged, and every other pass is kept from the
@@ -76,6 +81,8 @@ class ChannelPasses:
     merged : open flickers closed inside interruptions.
     asymmetry : median (l - s)/(l + s) of the pass intervals, NaN if unknown.
     direction_ambiguous : True when the gate is too central to tell the directions apart.
+    bridged : missed passes bridged (the sum of ``cycles - 1``).
+    irregular : intervals between kept passes more than 1/4 period off a whole number.
     """
 
     kept: np.ndarray
@@ -85,11 +92,17 @@ class ChannelPasses:
     merged: int = 0
     asymmetry: float = float("nan")
     direction_ambiguous: bool = False
+    bridged: int = 0
+    irregular: int = 0
 
     def summary(self) -> str:
-        """One line: passes kept, dropped by reason, flickers closed, direction flag."""
+        """One line: passes kept, dropped by reason, flickers closed, bridged, flags."""
         why = ", ".join(f"{n} {r}" for r, n in self.dropped.items() if n) or "none"
         extra = f", {self.merged} flickers closed" if self.merged else ""
+        if self.bridged:
+            extra += f", {self.bridged} missed passes bridged"
+        if self.irregular:
+            extra += f", {self.irregular} irregular intervals"
         flag = " [direction ambiguous: gate too central]" if self.direction_ambiguous else ""
         return f"kept {self.kept.size}, dropped {sum(self.dropped.values())} ({why}){extra}{flag}"
 
@@ -202,9 +215,9 @@ def _select(
     if not asym >= min_asymmetry:
         kept, second = passes[0::2], passes[1::2]
         dropped["second pass"] += second.size
-        cycles = np.maximum(np.rint(np.diff(kept) / period[0::2][: kept.size - 1]), 1)
+        kept, cycles, bridged, irregular = _count_periods(kept, dropped)
         return ChannelPasses(
-            kept, second, cycles.astype(np.int64), dict(dropped), merged, asym, True
+            kept, second, cycles, dict(dropped), merged, asym, True, bridged, irregular
         )
 
     # Interval classes: 0 odd (too short), 1 short, 2 long, 3 gap.
@@ -221,18 +234,30 @@ def _select(
     dropped["ambiguous"] += int(((opens > 0) & (closes > 0)).sum())
     dropped["isolated"] += int(((opens == 0) & (closes == 0)).sum())
     dropped["second pass"] += int(is_second.sum())
-    kept_idx = np.flatnonzero(is_kept)
-    # Local period at each kept pass: the median of the pair sums around it.
-    local = period[np.minimum(kept_idx, d.size - 1)]
-    keep = np.ones(kept_idx.size, dtype=bool)
+    kept, cycles, bridged, irregular = _count_periods(passes[is_kept], dropped)
+    return ChannelPasses(
+        kept, passes[is_second], cycles, dict(dropped), merged, asym, False, bridged, irregular
+    )
+
+
+def _count_periods(kept: np.ndarray, dropped: Counter):
+    """Drop extra passes and count the periods between the rest (step 5).
+
+    Returns (kept, cycles (P-1,), bridged, irregular); extras count as "duplicate".
+    """
+    if kept.size < 2:
+        return kept, np.ones(max(kept.size - 1, 0), dtype=np.int64), 0, 0
+    period = float(np.median(np.diff(kept)))
+    keep = np.ones(kept.size, dtype=bool)
     last = 0
-    for j in range(1, kept_idx.size):
-        if passes[kept_idx[j]] - passes[kept_idx[last]] < 0.5 * local[last]:
+    for j in range(1, kept.size):
+        if kept[j] - kept[last] < 0.75 * period:
             keep[j] = False
         else:
             last = j
     dropped["duplicate"] += int((~keep).sum())
-    kept_idx, local = kept_idx[keep], local[keep]
-    kept = passes[kept_idx]
-    cycles = np.maximum(np.rint(np.diff(kept) / local[:-1]), 1).astype(np.int64)
-    return ChannelPasses(kept, passes[is_second], cycles, dict(dropped), merged, asym, False)
+    kept = kept[keep]
+    ratio = np.diff(kept) / period
+    cycles = np.maximum(np.rint(ratio), 1).astype(np.int64)
+    irregular = int((np.abs(ratio - cycles) > 0.25).sum())
+    return kept, cycles, int((cycles - 1).sum()), irregular

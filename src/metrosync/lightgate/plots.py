@@ -23,5 +23,5 @@ def plot_analysis(ds, path: Path | str | None = None):
         f"light gate: {ds.sizes['metronome']} metronomes, σ = {ds.attrs['sigma_bpm']:.3f} BPM"
     )
     order_axes(ax, t[-1], ds.attrs["equilibrium_window"], xlabel="t since first record (s)",
-               window_label=f"r_eq = {ds.attrs['r_eq']:.3f}")  # fmt: skip
+               window_label=rf"$r_\mathrm{{eq}}$ = {ds.attrs['r_eq']:.3f}")  # fmt: skip
     return finish_figure(fig, path)

@@ -2,7 +2,10 @@
 
 Contract: `gate_edges` finds when a bob enters and leaves a beam; `format_log`
 turns the edges of up to 8 metronomes into the text of a capture; `write_logs`
-writes one log per run of a `simulate` dataset that holds trajectories.
+writes one log per run of a `simulate` dataset that holds trajectories, and warns
+when a bob never or rarely reaches its beam (fewer passes than half its swings
+through the vertical): such a log holds few or no passes, and the analysis of it
+bridges missed ones.
 
 Physics of the gate: the beam is interrupted while the bob is inside it,
 |θ − offset| < width/2 (angles in rad). Between the recorded samples θ(t) is the
@@ -19,6 +22,7 @@ apart; for offset > 0 the kept passes are those with θ increasing.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -167,6 +171,11 @@ def format_log(time, theta, theta_dot, gate: LightGate = LightGate()) -> str:
 
     time : (T,) s, from 0.   theta, theta_dot : (T, N) with N <= 8.
     """
+    return _capture(time, theta, theta_dot, gate)[0]
+
+
+def _capture(time, theta, theta_dot, gate: LightGate) -> tuple[str, np.ndarray]:
+    """The capture's text and the number of passes (entries into the beam) per gate."""
     theta = np.asarray(theta, dtype=float)
     theta_dot = np.asarray(theta_dot, dtype=float)
     if theta.ndim != 2 or theta.shape != theta_dot.shape or theta.shape[0] != len(time):
@@ -193,6 +202,7 @@ def format_log(time, theta, theta_dot, gate: LightGate = LightGate()) -> str:
         all_t.append(times)
         all_ch.append(np.full(times.size, i))
         all_in.append(entering)
+    passes = np.array([int(np.count_nonzero(e)) for e in all_in])
     times = np.concatenate(all_t)
     channel = np.concatenate(all_ch)
     entering = np.concatenate(all_in)
@@ -207,7 +217,7 @@ def format_log(time, theta, theta_dot, gate: LightGate = LightGate()) -> str:
     for ch, ent, value in zip(channel[order], entering[order], shown, strict=True):
         state[ch] = ent
         lines.append(_line(state, flip, int(value)))
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n", passes
 
 
 def _line(state: np.ndarray, flip: bool, value: int) -> str:
@@ -233,8 +243,33 @@ def write_logs(
     directory.mkdir(parents=True, exist_ok=True)
     time = ds.time.values
     paths = []
+    rare = []
     for b in range(ds.sizes["run"]):
-        text = format_log(time, ds.theta.values[:, b, :], ds.theta_dot.values[:, b, :],
-                          LightGate(**{**vars(gate), "seed": gate.seed + b}))  # fmt: skip
+        theta = ds.theta.values[:, b, :]
+        text, passes = _capture(time, theta, ds.theta_dot.values[:, b, :],
+                                LightGate(**{**vars(gate), "seed": gate.seed + b}))  # fmt: skip
         paths.append(write_text(text, directory / f"{prefix}{b:03d}.log"))
+        # A bob that reaches the beam passes it about once per swing through the vertical.
+        swings = np.count_nonzero(np.diff(np.signbit(theta), axis=0), axis=0)
+        for i in np.flatnonzero(passes < 0.5 * swings):
+            rare.append((b, int(i), int(passes[i]), int(swings[i]),
+                         float(np.nanmax(np.abs(theta[:, i])))))  # fmt: skip
+    if rare:
+        _warn_unreached(rare, gate, ds.sizes["run"] * ds.sizes["metronome"])
     return paths
+
+
+def _warn_unreached(rare: list[tuple[int, int, int, int, float]], gate: LightGate, total: int):
+    never = sum(1 for _, _, passes, _, _ in rare if passes == 0)
+    b, i, passes, swings, swing = rare[0]
+    beam = (gate.offset - gate.width / 2, gate.offset + gate.width / 2)
+    warnings.warn(
+        f"the light gate at `offset` = {gate.offset:g} rad (beam {beam[0]:.3g} .. "
+        f"{beam[1]:.3g} rad) is reached rarely or never in {len(rare)} of {total} metronome "
+        f"runs ({never} never): e.g. run {b}, metronome {i} passed it {passes} times in "
+        f"{swings} swings through the vertical, swinging up to {swing:.3g} rad. Those logs "
+        f"hold few or no passes; choose an `offset` well inside the swing (the default is "
+        f"0.1 rad).",
+        UserWarning,
+        stacklevel=3,
+    )

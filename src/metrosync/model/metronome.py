@@ -18,7 +18,7 @@ closed form.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -94,6 +94,35 @@ class MetronomeDesign:
         lo, hi = self.l2_bounds
         return (float(self.with_l2(hi).natural_bpm), float(self.with_l2(lo).natural_bpm))
 
+    def out_of_range(self, name: str, bpm: float) -> str:
+        """The message for ``bpm`` (given as ``name``) outside `bpm_range`, with a fix
+        that works: the `l2_bounds` that reach it, or why no slider position does."""
+        low, high = self.bpm_range()
+        lo, hi = self.l2_bounds
+        text = (
+            f"`{name}` = {bpm:.6g} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+            f"of this metronome design (slider L2 in {self.l2_bounds} m). Choose a BPM in range"
+        )
+        if bpm > high and lo == 0:
+            # The slider at the pivot is the fastest setting: no bounds reach further.
+            return text + (
+                f"; no slider position beats faster than {high:.2f} BPM (L2 = 0), so a faster "
+                f"metronome needs a shorter rod `l1`."
+            )
+        inverted = self.w1 * self.l1 / self.w2 if self.w2 > 0 else math.inf
+        wide = replace(self, l2_bounds=(0.0, min(inverted * (1 - 1e-9), 1e3)))
+        try:
+            needed = float(wide.l2_for_bpm(bpm))
+        except ParameterError:
+            return text + "."
+        # Round outward to 4 digits, staying short of the inverted pendulum.
+        if bpm < low:
+            edge = math.ceil(needed * 1e4) / 1e4
+            bounds = (lo, edge if edge < inverted else needed)
+        else:
+            bounds = (math.floor(needed * 1e4) / 1e4, hi)
+        return text + f", or widen `l2_bounds` to ({bounds[0]:g}, {bounds[1]:g}) m."
+
     def l2_for_bpm(self, bpm):
         """Slider position ``L2`` (m) that tunes the metronome to ``bpm``.
 
@@ -106,12 +135,7 @@ class MetronomeDesign:
         low, high = self.bpm_range()
         bad = (bpm_arr < low) | (bpm_arr > high)
         if np.any(bad):
-            worst = bpm_arr[bad].flat[0]
-            raise ParameterError(
-                f"`bpm` = {worst:.6g} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
-                f"of this metronome design (slider L2 in {self.l2_bounds} m). Choose a BPM in "
-                f"range, or widen `l2_bounds`."
-            )
+            raise ParameterError(self.out_of_range("bpm", float(bpm_arr[bad].flat[0])))
         w1, w2, l1, g = self.w1, self.w2, self.l1, self.g
         m = w1 + w2
         a = w1 * l1

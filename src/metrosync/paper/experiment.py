@@ -1,8 +1,10 @@
 """Fig. 9: simulated against measured equilibrium r, from folders of light-gate logs.
 
 Contract: ``DIR`` holds one sub-folder per nominal ω₀, named by its BPM (``DIR/192/``),
-each with the logger captures ``*.txt`` of that ω₀. `find_experiment` checks that
-layout up front (so a long reproduction never fails at its end); `compare_experiment`
+each with the logger captures of that ω₀: every file in it that is not hidden (``*.txt``
+from the logger, ``*.log`` from ``metrosync simulate --lightgate-dir``, any name the
+reader accepts). `find_experiment` reads each capture up front (so a long
+reproduction never fails at its end on a stray file); `compare_experiment`
 analyses each folder with `metrosync.lightgate.analyze` (whose result carries the
 equilibrium r averaged over the logs in ``attrs["r_eq"]``) and pairs it with the
 simulated N = 7 equilibrium r at the same ω₀ from the Fig. 8 (top) study.
@@ -31,15 +33,31 @@ def find_experiment(directory: Path) -> dict[float, list[Path]]:
             bpm = float(sub.name)
         except ValueError:
             continue  # folders not named by a BPM are not ω₀ data
-        logs = sorted(sub.glob("*.txt"))
+        logs = sorted(p for p in sub.iterdir() if p.is_file() and not p.name.startswith("."))
         if logs:
             found[bpm] = logs
     if not found:
         raise ParameterError(
-            f"`--experiment` {str(directory)!r} holds no folder named by a BPM with *.txt logs; "
-            f"expected e.g. {str(directory / '192' / 'run01.txt')!r}."
+            f"`--experiment` {str(directory)!r} holds no folder named by a BPM with light-gate "
+            f"logs; expected e.g. {str(directory / '192' / 'run01.txt')!r} (or run01.log)."
         )
+    _check_captures([path for paths in found.values() for path in paths])
     return found
+
+
+def _check_captures(paths: list[Path]) -> None:
+    """Read every capture once, so a file the reader refuses stops the run at its start."""
+    from ..errors import LogFormatError
+    from ..lightgate.reader import read_log
+
+    for path in paths:
+        try:
+            read_log(path)
+        except LogFormatError as error:
+            raise ParameterError(
+                f"`--experiment`: {str(path)!r} is not a light-gate capture ({error}); move it "
+                f"out of the folder."
+            ) from None
 
 
 def lightgate_analyze():
@@ -65,13 +83,22 @@ def compare_experiment(directory: Path, simulated: xr.Dataset) -> xr.Dataset:
 
     Returns
     -------
-    Dataset over ``bpm`` with ``r_exp``, ``n_logs``, ``r_sim``, ``sigma_r_sim``; r_sim is
-    NaN for an ω₀ the simulation did not cover.
+    Dataset over ``bpm`` with ``r_exp``, ``r_exp_std`` (σ of the logs' own equilibrium
+    r, NaN for one log), ``n_logs``, ``r_sim``, ``sigma_r_sim``; r_sim is NaN for an ω₀
+    the simulation did not cover.
     """
+    from ..observables.order import equilibrium_order
+
     analyze = lightgate_analyze()
     logs = find_experiment(directory)
     bpms = sorted(logs)
-    r_exp = [float(analyze(logs[b]).attrs["r_eq"]) for b in bpms]
+    r_exp, r_exp_std = [], []
+    for b in bpms:
+        measured = analyze(logs[b])
+        r_exp.append(float(measured.attrs["r_eq"]))
+        per_log = equilibrium_order(measured.r_runs.values.T, measured.time.values,
+                                    measured.attrs["equilibrium_window"])  # fmt: skip
+        r_exp_std.append(float(np.std(per_log, ddof=1)) if per_log.size > 1 else np.nan)
     sim_bpm = np.asarray(simulated.bpm.values, dtype=float)
     r_sim, s_sim = [], []
     for b in bpms:
@@ -81,6 +108,7 @@ def compare_experiment(directory: Path, simulated: xr.Dataset) -> xr.Dataset:
     return xr.Dataset(
         {
             "r_exp": ("bpm", r_exp, {"long_name": "measured equilibrium r (mean over logs)"}),
+            "r_exp_std": ("bpm", r_exp_std, {"long_name": "std over logs of their equilibrium r"}),
             "n_logs": ("bpm", [len(logs[b]) for b in bpms]),
             "r_sim": ("bpm", r_sim, {"long_name": "simulated equilibrium r, N = 7"}),
             "sigma_r_sim": ("bpm", s_sim),

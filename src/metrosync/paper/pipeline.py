@@ -49,7 +49,7 @@ from .studies import (
 
 NO_EXPERIMENT = (
     "no light-gate data was given. Run `metrosync reproduce --experiment DIR` with one "
-    "folder of logs per ω₀ (DIR/160/*.txt, DIR/192/*.txt, …) to compare with experiment."
+    "folder of logs per ω₀ (DIR/160/*.txt or *.log, DIR/192/…) to compare with experiment."
 )
 
 

@@ -41,6 +41,12 @@ def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0)
     index = first + stride * np.arange(int(math.ceil((last - first) / stride)) + 1)
     index = index[index < run.time.size]
     if index.size < 2:
+        if last - first >= 1:  # the window has the records; thinning took them away
+            lowest = 1.0 / ((last - first) * run.record_interval)
+            raise ParameterError(
+                f"`max_rate` = {max_rate:g} records/s keeps fewer than two records of the "
+                f"window [{start:g}, {end:g}] s; give `max_rate` >= {_round_up(lowest)}."
+            )
         raise ParameterError(
             f"the window [{start:g}, {end:g}] s holds fewer than two records; widen it."
         )
@@ -103,3 +109,9 @@ def write_page(ds, path: Path | str, *, run: int = 0, **options) -> Path:
     `page_data`. The write is atomic. Returns the path.
     """
     return write_text(render_page(RecordedRun.from_dataset(ds, run), **options), path)
+
+
+def _round_up(value: float, digits: int = 3) -> str:
+    """``value`` rounded up to ``digits`` significant digits, as text."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - digits + 1)
+    return f"{math.ceil(value / scale - 1e-9) * scale:.{digits}g}"

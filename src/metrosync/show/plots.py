@@ -26,6 +26,12 @@ def _colour(i: int):
     return matplotlib.colormaps["tab10"](i % 10)
 
 
+def _legend_beside(ax, **options) -> None:
+    """A legend to the right of the axes, where it covers no curve."""
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=7,
+              **options)  # fmt: skip
+
+
 def plot_angles(run: RecordedRun, ax, *, start=None, end=None) -> None:
     """θ_i(t) of every metronome, rad."""
     keep = _keep(run, start, end)
@@ -33,7 +39,7 @@ def plot_angles(run: RecordedRun, ax, *, start=None, end=None) -> None:
         ax.plot(run.time[keep], run.theta[keep, i], lw=0.6, color=_colour(i), label=f"{i}")
     ax.set_ylabel("θ (rad)")
     if run.n <= 10:
-        ax.legend(title="metronome", fontsize=7, title_fontsize=7, ncol=run.n, loc="upper right")
+        _legend_beside(ax, title="metronome", title_fontsize=7)
 
 
 def plot_phase_differences(run: RecordedRun, ax, *, start=None, end=None) -> None:
@@ -45,7 +51,7 @@ def plot_phase_differences(run: RecordedRun, ax, *, start=None, end=None) -> Non
         ax.plot(run.time[keep], diff[:, i - 1], ".", ms=1.2, color=_colour(i))
     ax.set_ylim(-np.pi, np.pi)
     ax.set_yticks([-np.pi, 0, np.pi], ["−π", "0", "π"])
-    ax.set_ylabel("Φ_i − Φ_0")
+    ax.set_ylabel(r"$\Phi_i - \Phi_0$")
 
 
 def plot_disk_angle(run: RecordedRun, ax, *, start=None, end=None) -> None:
@@ -67,10 +73,10 @@ def plot_run_order(run: RecordedRun, ax, *, start=None, end=None) -> None:
         ax.axvspan(t_end - window, t_end, color="0.9", zorder=0, label="equilibrium window")
         if math.isfinite(run.r_eq):
             ax.hlines(run.r_eq, t_end - window, t_end, colors="C3", lw=1.5,
-                      label=f"r_eq = {run.r_eq:.3f}")  # fmt: skip
+                      label=rf"$r_\mathrm{{eq}}$ = {run.r_eq:.3f}")  # fmt: skip
     ax.set_ylim(0, 1.02)
     ax.set_ylabel("r")
-    ax.legend(loc="lower right", fontsize=7)
+    _legend_beside(ax)
 
 
 def plot_run(ds, path: Path | str | None = None, *, run: int = 0, start=None, end=None):
@@ -92,7 +98,7 @@ def plot_run(ds, path: Path | str | None = None, *, run: int = 0, start=None, en
 
     recorded = RecordedRun.from_dataset(ds, run)
     start, end = recorded.window(start, end)
-    fig = new_figure(path, figsize=(8, 9), layout="constrained")
+    fig = new_figure(path, figsize=(9.5, 9), layout="constrained")
     axes = fig.subplots(4, 1, sharex=True)
     for draw, ax in zip(
         (plot_angles, plot_phase_differences, plot_disk_angle, plot_run_order), axes, strict=True

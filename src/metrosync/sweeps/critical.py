@@ -16,6 +16,9 @@ error is the standard deviation of the replicas.
 `extrapolate` fits ω_c(N) = ω_c∞ + a·N^(−ν) (weighted by the bootstrap errors, which
 are floored at 1 % of the grid step, the estimators' resolution). With only three
 sizes ν is fixed to 1 (ω_c linear in 1/N); with fewer there is no extrapolation.
+`judge` says why a fit is not to be trusted: ω_c∞ outside the swept grid (the data
+say nothing there), an uncertainty over half the grid, or an exponent at the fit's
+bound; `critical_frequency` stores that as ``fit_note_<method>`` ('' = trusted).
 All frequencies are in BPM.
 """
 
@@ -39,6 +42,8 @@ METHODS = ("peak", "rise")
 SLOPE_WINDOW = 5
 #: Resampled values per bootstrap batch.
 BATCH_VALUES = 2_000_000
+#: Bounds of the free exponent ν in the N → ∞ fit.
+NU_BOUNDS = (0.05, 5.0)
 
 
 def _refined_argmax(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -174,7 +179,8 @@ def extrapolate(
                 warnings.simplefilter("error", OptimizeWarning)
                 popt, pcov = curve_fit(
                     lambda x, w, a, nu: w + a * x ** (-nu), n, omega_c, p0=p0, sigma=sigma,
-                    absolute_sigma=True, bounds=([-np.inf, -np.inf, 0.05], [np.inf, np.inf, 5.0]),
+                    absolute_sigma=True,
+                    bounds=([-np.inf, -np.inf, NU_BOUNDS[0]], [np.inf, np.inf, NU_BOUNDS[1]]),
                     maxfev=20000,
                 )  # fmt: skip
             if np.all(np.isfinite(pcov)):
@@ -192,6 +198,33 @@ def extrapolate(
             float(coef[0]), float(math.sqrt(cov[0, 0])), float(coef[1]), 1.0, "omega_inf + a/N"
         )
     return Extrapolation(math.nan, math.nan, math.nan, math.nan, "none (fewer than 3 sizes)")
+
+
+def judge(fit: Extrapolation, bpm: np.ndarray, sizes: int) -> str:
+    """Why the extrapolation ``fit`` is not to be trusted, or '' when it is.
+
+    bpm : the swept grid (BPM).   sizes : how many N had a finite ω_c.
+    """
+    low, high = float(np.min(bpm)), float(np.max(bpm))
+    if not np.isfinite(fit.omega_inf):
+        return f"needs at least 3 sizes N with an estimate, got {sizes}; sweep more N"
+    if not low <= fit.omega_inf <= high:
+        return (
+            f"the fit gives {fit.omega_inf:.1f} +- {fit.omega_inf_err:.1f} BPM, outside the "
+            f"swept grid {low:g} .. {high:g} BPM where the data say nothing; widen the --bpm "
+            f"range or add larger N"
+        )
+    if not fit.omega_inf_err <= (high - low) / 2:
+        return (
+            f"the fit gives {fit.omega_inf:.1f} +- {fit.omega_inf_err:.1f} BPM, uncertain by "
+            f"more than half the grid; add runs or larger N"
+        )
+    if fit.form.endswith("**-nu") and not NU_BOUNDS[0] * 1.01 < fit.nu < NU_BOUNDS[1] * 0.99:
+        return (
+            f"the exponent nu = {fit.nu:.3g} sits at the fit's bound {NU_BOUNDS}, so the form "
+            f"does not describe these sizes; add larger N"
+        )
+    return ""
 
 
 def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) -> xr.Dataset:
@@ -272,6 +305,7 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
                 f"fit_a_{m}": fit.a,
                 f"fit_nu_{m}": fit.nu,
                 f"fit_form_{m}": fit.form,
+                f"fit_note_{m}": judge(fit, bpm, int(np.isfinite(central[m]).sum())),
             }
         )
     coords = {
@@ -285,6 +319,7 @@ def plot_critical(result: xr.Dataset, path=None):
     """r̄(ω₀) and σ_r(ω₀) for every N with ω_c marked, and ω_c against N with the fit.
 
     result : a `critical_frequency` dataset.   path : write the figure there when given.
+    Error bands are clipped to the swept grid; a fit with a ``fit_note`` is not drawn.
     Returns the figure.
     """
     import matplotlib
@@ -302,24 +337,37 @@ def plot_critical(result: xr.Dataset, path=None):
         for ax, m, style in ((axes[0], "rise", "--"), (axes[1], "peak", ":")):
             wc, err = float(one[f"omega_c_{m}"]), float(one[f"omega_c_{m}_err"])
             ax.axvline(wc, color=color, ls=style, lw=1)
-            ax.axvspan(wc - err, wc + err, color=color, alpha=0.12, lw=0)
-    axes[0].set(xlabel="ω₀ (BPM)", ylabel="r (mean over runs)", title="ω_c from steepest rise")
-    axes[1].set(xlabel="ω₀ (BPM)", ylabel="σ_r", title="ω_c from the σ_r peak")
+            # The data end with the grid; so does what they say about ω_c.
+            lo, hi = max(wc - err, bpm.min()), min(wc + err, bpm.max())
+            if hi > lo:
+                ax.axvspan(lo, hi, color=color, alpha=0.12, lw=0)
+    for ax in axes[:2]:
+        ax.set_xlim(bpm.min() - 0.02 * np.ptp(bpm), bpm.max() + 0.02 * np.ptp(bpm))
+    axes[0].set(xlabel=r"$\omega_0$ (BPM)", ylabel="r (mean over runs)",
+                title=r"$\omega_c$ from the steepest rise")  # fmt: skip
+    axes[1].set(xlabel=r"$\omega_0$ (BPM)", ylabel=r"$\sigma_r$ (spread of r over runs)",
+                title=r"$\omega_c$ from the $\sigma_r$ peak")  # fmt: skip
     axes[0].legend(loc="upper left", fontsize=8)
     ax = axes[2]
     n = result.n.values.astype(float)
-    for m, marker in (("peak", "o"), ("rise", "s")):
+    for k, (m, marker) in enumerate((("peak", "o"), ("rise", "s"))):
         bars = ax.errorbar(n, result[f"omega_c_{m}"], yerr=result[f"omega_c_{m}_err"],
                            fmt=marker, capsize=3, label=f"{m}")  # fmt: skip
         color = bars[0].get_color()
-        w, a, nu = (result.attrs[f"{k}_{m}"] for k in ("omega_c_inf", "fit_a", "fit_nu"))
-        if np.isfinite(w):
-            grid = np.geomspace(n.min(), n.max() * 4, 100)
-            ax.plot(grid, w + a * grid ** (-nu), lw=1, color=color)
-            err = result.attrs[f"omega_c_inf_{m}_err"]
-            ax.axhline(w, ls="--", lw=0.8, color=color)
-            ax.annotate(f"{m}: ω_c∞ = {w:.1f} ± {err:.1f}", (0.4, 0.95 - 0.07 * (m == "rise")),
+        w, a, nu = (result.attrs[f"{key}_{m}"] for key in ("omega_c_inf", "fit_a", "fit_nu"))
+        note = result.attrs.get(f"fit_note_{m}", "")
+        where = (0.03, 0.97 - 0.07 * k)
+        if note or not np.isfinite(w):
+            ax.annotate(f"{m}: no N → ∞ value (see the printed reason)", where,
                         xycoords="axes fraction", fontsize=8, va="top")  # fmt: skip
-    ax.set(xscale="log", xlabel="N", ylabel="ω_c (BPM)", title="finite-size extrapolation")
+            continue
+        grid = np.geomspace(n.min(), n.max() * 4, 100)
+        ax.plot(grid, w + a * grid ** (-nu), lw=1, color=color)
+        err = result.attrs[f"omega_c_inf_{m}_err"]
+        ax.axhline(w, ls="--", lw=0.8, color=color)
+        ax.annotate(rf"{m}: $\omega_{{c,\infty}}$ = {w:.1f} ± {err:.1f} BPM", where,
+                    xycoords="axes fraction", fontsize=8, va="top")  # fmt: skip
+    ax.set(xscale="log", xlabel="N (metronomes)", ylabel=r"$\omega_c$ (BPM)",
+           title="finite-size extrapolation")  # fmt: skip
     ax.legend(loc="lower right", fontsize=8)
     return finish_figure(fig, path)

@@ -91,12 +91,17 @@ def run_point(spec: PointSpec, threads: int | None = None):
 
 def check_scheduler(scheduler: str | None, n_workers: int | None) -> None:
     """Refuse an unknown ``scheduler`` or a ``n_workers`` it cannot use, before any work."""
-    if scheduler is not None and scheduler != "local" and not scheduler.startswith("tcp://"):
+    if scheduler is not None and (
+        not isinstance(scheduler, str)
+        or (scheduler != "local" and not scheduler.startswith("tcp://"))
+    ):
         raise ParameterError(
             "`scheduler` must be None (in process), 'local' or 'tcp://HOST:PORT', "
             f"got {scheduler!r}."
         )
-    if n_workers is not None and (isinstance(n_workers, bool) or n_workers < 1):
+    if n_workers is not None and (
+        isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1
+    ):
         raise ParameterError(f"`n_workers` must be an integer >= 1, got {n_workers!r}.")
     if n_workers is not None and scheduler != "local":
         where = "in process" if scheduler is None else "on an existing cluster"

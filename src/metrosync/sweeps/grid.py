@@ -42,6 +42,8 @@ ENSEMBLE_SETTINGS: dict[str, tuple[type, Any]] = {
     "duration": (float, 600.0),
     "dt": (float, 0.01),
     "seed": (int, 0),
+    # None: the steady swing 2M/(π c_θ); needed where that is 0 or infinite.
+    "amplitude": (float, None),
 }
 #: Model parameters that can be swept or fixed (routed through ``simulate(changes=)``).
 MODEL_PARAMETERS = tuple(
@@ -61,6 +63,7 @@ ALIASES = {
     "seeds": "seed",
 }
 UNITS = {
+    "amplitude": "rad",
     "bpm": "BPM",
     "sigma_bpm": "BPM",
     "duration": "s",
@@ -127,6 +130,8 @@ def _convert(name: str, value: Any) -> int | float:
         raise ParameterError(f"`{name}` must be > 0 s, got {value!r}.")
     if name == "sigma_bpm" and number < 0:
         raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {value!r}.")
+    if name == "amplitude" and number < 0:
+        raise ParameterError(f"`amplitude` must be >= 0 rad, got {value!r}.")
     # 12 significant digits undo float drift of ranges (0.1*3 -> 0.3) so values hash stably.
     return float(f"{number:.12g}")
 
@@ -222,7 +227,7 @@ class Grid:
                 raise ParameterError(f"`{name}` is both swept and fixed; keep one.")
             (fixed[name],) = parse_values(name, value)
         for name, (_, default) in ENSEMBLE_SETTINGS.items():
-            if name not in axes and name not in fixed:
+            if name not in axes and name not in fixed and (default is not None or name == "seed"):
                 fixed[name] = self.seed if name == "seed" else default
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "fixed", fixed)
@@ -233,8 +238,20 @@ class Grid:
         """Build every distinct parameter set once, so bad values fail before any work."""
         swept_model = [name for name in self.axes if name in MODEL_PARAMETERS]
         bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed["bpm"],)
+        started = "amplitude" in self.axes or "amplitude" in self.fixed
         for values in itertools.product(*(self.axes[name] for name in swept_model)):
-            params = self.model_parameters(dict(zip(swept_model, values, strict=True)))
+            where = dict(zip(swept_model, values, strict=True))
+            params = self.model_parameters(where)
+            swing = params.steady_amplitude
+            if not started and not (math.isfinite(swing) and swing > 0):
+                at = f" at {where}" if where else ""
+                raise ParameterError(
+                    f"the default start amplitude is the steady swing 2M/(pi c_theta) = {swing:g} "
+                    f"rad{at} (`drive` = {params.metronome.drive:g}, `c_theta` = "
+                    f"{params.metronome.c_theta:g}), so no run could start there. Give a start "
+                    f"amplitude: `amplitude` (--amplitude 0.5, or amplitude = 0.5 under [fixed] "
+                    f"in the grid file)."
+                )
             low, high = params.metronome.bpm_range()
             bad = [b for b in bpms if not low <= b <= high]
             if bad:
@@ -319,6 +336,8 @@ class Grid:
             "record_every": self.record_every,
             "equilibrium_window": self.equilibrium_window,
         }
+        if values.get("amplitude") is not None:  # absent otherwise: earlier keys stay valid
+            kwargs["amplitude"] = values["amplitude"]
         keep = "r_eq+r" if self.keep_r else "r_eq"
         return make_point(kwargs, keep=keep, index=index, coords=coords)
 

@@ -28,12 +28,13 @@ import numpy as np
 import xarray as xr
 
 from .._files import write_netcdf
-from ..status import STATUS_ABSENT
+from ..status import STATUS_ABSENT, STATUS_FAILED
 from ..status import SWEEP_FLAG_MEANINGS as FLAG_MEANINGS
 from .grid import UNITS, Grid
 
 #: What each parameter is, for the coordinates of a merged sweep.
 LONG_NAMES = {
+    "amplitude": "start amplitude at random phases",
     "n": "metronomes on the disk",
     "bpm": "nominal beat frequency",
     "sigma_bpm": "spread (std) of the natural frequencies",
@@ -173,7 +174,8 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         "flag_masks": np.array(list(FLAG_MEANINGS), dtype=np.int8),
         "flag_meanings": " ".join(FLAG_MEANINGS.values()),
     }
-    flagged = ((status > 0).sum(axis=-1)).astype(np.int64)
+    # A failed point has no runs to flag: its runs carry STATUS_FAILED, counted apart.
+    flagged = ((status > 0) & ((status & STATUS_FAILED) == 0)).sum(axis=-1).astype(np.int64)
     data: dict[str, Any] = {
         "r_eq": ((*dims, "run"), r_eq, {"long_name": "equilibrium r per run (crossing phases)"}),
         "r_eq_analytic": (
@@ -184,7 +186,11 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         "status": ((*dims, "run"), status, flags),
         "r_eq_mean": (dims, mean, {"long_name": "equilibrium r, mean over runs"}),
         "r_eq_std": (dims, std, {"long_name": "sigma_r: std of equilibrium r over runs"}),
-        "n_flagged": (dims, flagged, {"long_name": "runs with a nonzero status"}),
+        "n_flagged": (
+            dims,
+            flagged,
+            {"long_name": "runs flagged overturned or diverged (not counting failed points)"},
+        ),
         "seed": (dims, seed, {"long_name": "seed passed to simulate for this point"}),
         "error": (dims, error.astype(str), {"long_name": "why the point has no result ('' = ok)"}),
     }

@@ -10,6 +10,7 @@ interrupted sweep and gives the same dataset as an uninterrupted one.
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import warnings
 from collections.abc import Mapping
@@ -22,7 +23,7 @@ import xarray as xr
 from ..budget import Budget, simulation_budget
 from ..errors import Interrupted, OverturnWarning, ParameterError
 from ..simulate import record_stride
-from .executors import Execution, execute
+from .executors import Execution, check_scheduler, execute
 from .grid import MODEL_PARAMETERS, Grid
 from .store import PointStore, merge, write_dataset
 
@@ -66,16 +67,25 @@ class SweepResult:
         """Human-readable report: points computed and reused, throughput, failures."""
         ex = self.execution
         ds = self.dataset
+        error = ds.error.values
+        failed = int(((error != "") & (error != "missing")).sum())
+        missing = int((error == "missing").sum())
+        simulated = int((ds.status.values[error == ""] >= 0).sum())
+        flagged = int(ds.n_flagged.sum())
         lines = [
             f"metrosync sweep: {self.grid.size} points over {', '.join(self.grid.axes)}; "
             f"{len(ex.computed)} computed, {self.reused} reused from {self.store}",
             f"  {ex.seconds:.2f} s wall, {ex.work:.3g} oscillator-steps, "
             f"{ex.throughput:.3g} oscillator-steps/s",
-            f"  runs flagged (overturned/diverged): {int(ds.n_flagged.sum())}",
+            f"  runs flagged (overturned/diverged): {flagged} of {simulated} run(s) simulated"
+            + ("; their r is not meaningful (status bits: metrosync.status)" if flagged else ""),
         ]
         failures = self.failures()
         if failures:
-            lines.append(f"  {len(failures)} point(s) without a result:")
+            lines.append(
+                f"  {len(failures)} point(s) without a result: {failed} failed (the simulation "
+                f"raised; its runs are not counted above), {missing} missing (not computed yet):"
+            )
             for coords, message in failures[:20]:
                 where = ", ".join(f"{k}={v}" for k, v in coords.items())
                 lines.append(f"    {where}: {message}")
@@ -121,6 +131,7 @@ def sweep(
     """
     import sys
 
+    check_scheduler(scheduler, n_workers)
     if not isinstance(grid, Grid):
         grid = Grid(axes=grid, fixed=fixed or {}, **grid_options)
     elif fixed or grid_options:
@@ -194,6 +205,16 @@ def sweep_budget(specs, todo, *, scheduler=None, n_workers=None) -> Budget:
 
 
 def _warn_overturn(grid: Grid) -> None:
+    starts = grid.axes.get("amplitude", (grid.fixed.get("amplitude"),))
+    high = [a for a in starts if a is not None and a > math.pi / 2]
+    if high:
+        warnings.warn(
+            f"`amplitude` = {high[0]:g} rad starts the pendulums past pi/2: they overturn at "
+            f"once; such runs are flagged in `status` and their r is not meaningful.",
+            OverturnWarning,
+            stacklevel=3,
+        )
+        return
     swept = [name for name in grid.axes if name in MODEL_PARAMETERS]
     for values in itertools.product(*(grid.axes[name] for name in swept)):
         params = grid.model_parameters(dict(zip(swept, values, strict=True)))
