@@ -8,11 +8,11 @@ Contract: pure functions over arrays.
 * r(t) = |(1/N) Σ_j e^{iΦ_j(t)}| on a uniform grid t = k·dt over the span where
   every channel has a phase.
 * A metronome's mean frequency is 120 beats per period over the time between its
-  first and last kept pass (two beats per period, MODEL-NOTES §1); its period jitter
+  first and last kept pass (two beats per period, docs/model.md §6.1); its period jitter
   is the standard deviation of the single-period intervals.
 * σ is the sample standard deviation (ddof=1) of the metronomes' mean frequencies,
   in BPM, and also in the paper's table unit read as beats per logger tick
-  (MODEL-NOTES §4): σ_tick = σ_BPM / 60 · tick.
+  (docs/model.md §6.4): σ_tick = σ_BPM / 60 · tick.
 """
 
 from __future__ import annotations
