@@ -137,3 +137,26 @@ def test_options_that_would_be_ignored_are_not_silent(capsys):
     argv = ["simulate", "--integrator", "exact", "--backend", "numpy", "--n", "2", "--runs", "1"]
     assert main([*argv, "--duration", "0.2"]) == 0
     assert "`--backend numpy` applies to `--integrator verlet` only" in capsys.readouterr().err
+
+
+def test_a_warning_raised_twice_is_shown_once(monkeypatch, capsys):
+    import warnings
+
+    from metrosync import cli
+
+    def twice(args) -> int:
+        for _ in range(2):  # as a size check before the work and again inside it
+            warnings.warn("the animation is estimated to take about 15 min", stacklevel=2)
+        warnings.warn("something else", stacklevel=2)
+        return 0
+
+    parser = cli.build_parser()
+    args = parser.parse_args(["presets"])
+    args.func = twice
+    monkeypatch.setattr(cli.argparse.ArgumentParser, "parse_args", lambda self, argv=None: args)
+    assert cli.main(["presets"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        "metrosync presets: warning: the animation is estimated to take about 15 min",
+        "metrosync presets: warning: something else",
+    ]

@@ -36,6 +36,13 @@ CHILD = textwrap.dedent(
 )
 
 
+#: How soon an interrupt must end the process. Generous, so that a loaded machine's slow
+#: interpreter shutdown does not fail the test; every interrupted job below would run for
+#: minutes uninterrupted, so the bound still tells "stopped at the next check" from
+#: "stopped at the end".
+PROMPT = 15.0
+
+
 def interrupt_child(tmp_path: Path, argv: list[str], *, ready, settle: float = 1.0):
     """Start the CLI with ``argv``, wait until ``ready()``, send SIGINT; return
     (exit status, stderr, seconds from the signal to the exit)."""
@@ -54,19 +61,22 @@ def interrupt_child(tmp_path: Path, argv: list[str], *, ready, settle: float = 1
     sent = time.monotonic()
     child.send_signal(signal.SIGINT)
     _, err = child.communicate(timeout=60)
-    return child.returncode, err, time.monotonic() - sent
+    # Long jobs warn first that they are long; what the interrupt says is the last line.
+    lines = err.splitlines(keepends=True)
+    assert all("warning: " in line for line in lines[:-1]), err
+    return child.returncode, "".join(lines[-1:]), time.monotonic() - sent
 
 
 def test_ctrl_c_in_a_long_kernel_run_of_simulate(tmp_path):
     out = tmp_path / "out"
-    # 4000 runs x 60000 steps, recorded every 20000 steps: before chunks were timed,
-    # one compiled call ran for a whole record interval (several seconds).
-    argv = ["simulate", "--runs", "4000", "--duration", "600", "--save-every", "20000",
+    # 4000 runs x 600000 steps (minutes of work), recorded every 200000 steps: before
+    # chunks were timed, one compiled call ran for a whole record interval.
+    argv = ["simulate", "--runs", "4000", "--duration", "6000", "--save-every", "200000",
             "--out", str(out / "r.nc"), "--plot", str(out / "r.png")]  # fmt: skip
     code, err, seconds = interrupt_child(tmp_path, argv, ready=lambda: True)
     assert code == 130
     assert err == "metrosync simulate: interrupted: nothing was written\n"
-    assert seconds < 5.0, f"took {seconds:.1f} s to stop"
+    assert seconds < PROMPT, f"took {seconds:.1f} s to stop"
     assert not out.exists() or list(out.iterdir()) == []
 
 
@@ -85,7 +95,7 @@ def test_ctrl_c_in_an_in_process_sweep_says_what_was_kept(tmp_path):
         f"command again to resume\n"
     )
     assert 1 <= kept < 5
-    assert seconds < 5.0, f"took {seconds:.1f} s to stop"
+    assert seconds < PROMPT, f"took {seconds:.1f} s to stop"
     assert not (tmp_path / "sw.nc").exists()
     assert not list(tmp_path.rglob("*partial*"))
 
@@ -107,7 +117,7 @@ def test_ctrl_c_in_a_dask_sweep_stops_the_cluster_quietly(tmp_path):
         r"again to resume\n",
         err,
     ), err
-    assert seconds < 10.0, f"took {seconds:.1f} s to stop"
+    assert seconds < PROMPT, f"took {seconds:.1f} s to stop"
 
 
 def test_a_lost_interrupt_is_raised_again_at_the_next_check(capsys):
@@ -144,8 +154,8 @@ def test_reproduce_says_how_many_points_it_kept(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     ("argv", "name"),
     [
-        (["animate", "--duration", "120", "--speedup", "1", "--dpi", "40"], "a.gif"),
-        (["listen", "--duration", "3000"], "t.wav"),
+        (["animate", "--duration", "1200", "--speedup", "1", "--dpi", "40"], "a.gif"),
+        (["listen", "--duration", "3500", "--speedup", "1"], "t.wav"),
     ],
 )
 def test_ctrl_c_while_writing_leaves_no_partial_file(tmp_path, argv, name):
@@ -157,5 +167,5 @@ def test_ctrl_c_while_writing_leaves_no_partial_file(tmp_path, argv, name):
     )  # fmt: skip
     assert code == 130
     assert err == f"metrosync {argv[0]}: interrupted: nothing was written\n"
-    assert seconds < 5.0
+    assert seconds < PROMPT, f"took {seconds:.1f} s to stop"
     assert list(out.iterdir()) == []

@@ -89,9 +89,15 @@ def _run(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
 
+    shown: set[str] = set()
+
     def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+        # A check may run once before the work and again inside it (animate's size
+        # check): the user hears each warning once, wherever it was raised.
         text = name_options(str(message), getattr(args, "_aliases", None) or {})
-        print(f"metrosync {args.command}: warning: {text}", file=sys.stderr)
+        if text not in shown:
+            shown.add(text)
+            print(f"metrosync {args.command}: warning: {text}", file=sys.stderr)
 
     try:
         with warnings.catch_warnings():
