@@ -12,31 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations
+from ..equations import SystemArrays, accelerations, disk_torque
 from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
-
-#: The arrays every fixed-step kernel takes, by name and in order: state (B, N) and (B,),
-#: constants of `SystemArrays`, then records and trajectories (after the step settings).
-STATE_FIELDS = (
-    "theta", "theta_dot", "phi", "phi_dot", "acc_theta", "acc_phi", "p_phi", "force_phi",
-    "last_up", "status",
-)  # fmt: skip
-SYSTEM_FIELDS = (
-    "mh", "mgh", "inertia", "c_theta", "drive", "omega", "radius", "c_phi", "total_inertia",
-)  # fmt: skip
-RECORD_FIELDS = ("r", "cross_re", "cross_im", "cross_count")
-TRAJECTORY_FIELDS = ("traj_theta", "traj_theta_dot", "traj_phi", "traj_phi_dot")
-
-
-def kernel_arguments(state, sys, *, dt, step0, n_steps, record_every, overturn_angle) -> tuple:
-    """The positional arguments of every CPU kernel's ``advance``, in their order."""
-    return (
-        *(getattr(state, name) for name in STATE_FIELDS),
-        *(getattr(sys, name) for name in SYSTEM_FIELDS),
-        float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
-        *(getattr(state, name) for name in RECORD_FIELDS + TRAJECTORY_FIELDS),
-    )  # fmt: skip
+from ._abi import Recording, State
 
 
 @dataclass
@@ -47,7 +26,8 @@ class StepState:
     phi, phi_dot, acc_phi : (B,)
     p_phi : (B,) the disk's angular momentum (J + R²Σm) φ̇ + R Σ m h cos θ θ̇, carried as
         state so that it changes only by the external torque impulse.
-    force_phi : (B,) external torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄.
+    force_phi : (B,) torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄 + τ(t)
+        (`equations.disk_torque`).
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
     r : (B, n_rec) analytic-phase order parameter at each record.
@@ -108,7 +88,7 @@ class StepState:
             acc_theta=np.ascontiguousarray(acc_theta),
             acc_phi=np.ascontiguousarray(acc_phi),
             p_phi=p_phi,
-            force_phi=-sys.c_phi * phi_dot,
+            force_phi=disk_torque(sys, phi_dot, no_kick, 0.0),
             last_up=np.full((b, n), -1.0),
             status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
             r=np.full((b, n_records), np.nan),
@@ -120,6 +100,14 @@ class StepState:
             traj_phi=np.full(traj_shape[:2], np.nan),
             traj_phi_dot=np.full(traj_shape[:2], np.nan),
         )
+
+    def kernel_state(self) -> State:
+        """The state arrays as the kernels take them (the same arrays, not copies)."""
+        return State(*(getattr(self, name) for name in State._fields))
+
+    def kernel_recording(self) -> Recording:
+        """The record buffers as the kernels take them (the same arrays)."""
+        return Recording(*(getattr(self, name) for name in Recording._fields))
 
     def crossing_order(self) -> np.ndarray:
         """r from crossing-interpolated phases, (B, n_rec); NaN where some metronome
