@@ -16,46 +16,17 @@ form satisfies them.
 
 All arrays broadcast over leading "batch" axes: per-metronome arrays have shape
 (..., N), per-run arrays shape (...). ``kick`` is the escapement torque 𝕄_i (N m) in
-force form; the integrators supply ±M/dt or 0.
+force form; the integrators supply ±M/dt or 0. The constants come as `SystemArrays`
+(defined with their builder in `model.system`, re-exported here).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from .model.system import SystemArrays
 
-@dataclass(frozen=True)
-class SystemArrays:
-    """Per-run and per-metronome constants of an ensemble, in SI units.
-
-    Shapes: per-metronome fields (B, N), per-run fields (B,).
-
-    mh : m_i h_i.   mgh : m_i g h_i.   inertia : m_i h_i² + J_i.
-    c_theta, drive : friction c_θ and escapement impulse M of each metronome.
-    omega : small-amplitude natural frequency on a rigid support, rad/s.
-    radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
-    in eq. (metron2a)); ``inf`` pins the disk.
-    """
-
-    mh: np.ndarray
-    mgh: np.ndarray
-    inertia: np.ndarray
-    c_theta: np.ndarray
-    drive: np.ndarray
-    omega: np.ndarray
-    radius: np.ndarray
-    c_phi: np.ndarray
-    total_inertia: np.ndarray
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.mh.shape  # type: ignore[return-value]
-
-    def run(self, b: int) -> SystemArrays:
-        """The constants of run ``b`` alone, as a batch of one."""
-        return SystemArrays(**{k: v[b : b + 1] for k, v in vars(self).items()})
+__all__ = ["SystemArrays", "accelerations", "applied_torque", "disk_torque", "residuals"]
 
 
 def applied_torque(sys: SystemArrays, t) -> np.ndarray:

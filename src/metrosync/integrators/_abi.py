@@ -30,7 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..equations import SystemArrays
+from ..model.system import SystemArrays
 
 
 class State(NamedTuple):

@@ -27,8 +27,9 @@ _checked = False
 STAMP_NAME = "metrosync-kernels.stamp"
 HERE = Path(__file__).resolve().parent
 #: Modules outside this package whose source the compiled kernels depend on: the
-#: status bits they freeze, and the system constants their argument list is made of.
-STAMPED_OUTSIDE = ("status.py", "equations.py")
+#: status bits they freeze, and the system constants their argument list is made of
+#: (`SystemArrays`, in model/system.py, re-exported by equations.py).
+STAMPED_OUTSIDE = ("status.py", "equations.py", "model/system.py")
 
 
 def stamped_sources() -> list[Path]:

@@ -251,13 +251,7 @@ class Grid:
         bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed["bpm"],)
         for values in itertools.product(*(self.axes[name] for name in swept_model)):
             params = self.model_parameters(dict(zip(swept_model, values, strict=True)))
-            low, high = params.metronome.bpm_range()
-            bad = [b for b in bpms if not low <= b <= high]
-            if bad:
-                raise ParameterError(
-                    f"`bpm` = {bad[0]!r} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
-                    f"of the metronome design; narrow the `bpm` axis."
-                )
+            params.metronome.check_tunable(bpms, fix="Narrow the `bpm` axis.")
 
     @classmethod
     def from_toml(cls, path: str | Path, **overrides) -> Grid:
