@@ -28,16 +28,13 @@ import xarray as xr
 from ._version import __version__
 from .ensemble import Ensemble, build_ensemble, check_time_step
 from .errors import ParameterError
-from .integrators import INTEGRATORS
-from .integrators import reference as numpy_backend
-from .integrators import verlet as numba_backend
+from .integrators import BACKENDS, get_integrator
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
 from .progress import progress_bar
 from .status import STATUS_MEANINGS
 
-BACKENDS = {"numba": numba_backend, "numpy": numpy_backend, "gpu": None}  # gpu: imported on use
 #: Oscillator-steps per chunk between progress updates.
 CHUNK_WORK = 4_000_000
 
@@ -77,10 +74,11 @@ def simulate(
     seed : seed of every random choice; the result is a pure function of the inputs.
     preset : ``"default"``, ``"boda2013"`` or a `ModelParameters`.
     changes : model parameters to change by name, e.g. ``{"drive": 1e-4, "c_phi": 0}``.
-    integrator : ``"verlet"`` (the paper's scheme) or ``"exact"`` (reference).
-    backend : for ``verlet``, ``"numba"`` (compiled, parallel over runs), ``"numpy"``
-        (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through numba.cuda; no
-        trajectories yet).
+    integrator : a name from `metrosync.integrators.REGISTRY`: ``"verlet"`` (the
+        paper's scheme) or ``"exact"`` (reference).
+    backend : for a fixed-step integrator, ``"numba"`` (compiled, parallel over runs),
+        ``"numpy"`` (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through
+        numba.cuda; no trajectories yet); see `metrosync.integrators.BACKENDS`.
     frequencies_bpm, metronomes, amplitude, theta0, theta_dot0 : see `build_ensemble`.
     record_every : record every this many steps; default the step count of 0.1 s.
     trajectories : also keep θ, θ̇, φ, φ̇ at each record.
@@ -96,10 +94,7 @@ def simulate(
     params = get_preset(preset, warn=not changes)
     if changes:
         params = get_preset(params.with_changes(**changes))
-    if integrator not in INTEGRATORS:
-        raise ParameterError(
-            f"unknown `integrator` {integrator!r}; choose one of {list(INTEGRATORS)}."
-        )
+    scheme = get_integrator(integrator)
     if backend not in BACKENDS:
         raise ParameterError(f"unknown `backend` {backend!r}; choose one of {sorted(BACKENDS)}.")
     if not (math.isfinite(duration) and duration > 0):
@@ -142,17 +137,15 @@ def simulate(
         )
     show = _sys.stderr.isatty() if progress is None else progress
 
-    if integrator == "verlet":
-        kernel = _backend_module(backend, trajectories)
+    if scheme.fixed_step:
+        kernel = scheme.stepper(backend, trajectories=trajectories)
         records = _run_fixed_step(
             ensemble, kernel, dt, n_steps, record_every, n_records, trajectories,
             overturn_angle, show,
         )  # fmt: skip
     else:
-        from .integrators import exact  # scipy's solvers load only when asked for
-
         with progress_bar(total=ensemble.runs, unit="run", enabled=show) as bar:
-            records = exact.integrate(
+            records = scheme.integrate(
                 ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi_dot0,
                 duration=n_steps * dt, grid_dt=record_every * dt, n_records=n_records,
                 trajectories=trajectories, overturn_angle=overturn_angle,
@@ -169,31 +162,12 @@ def simulate(
         "dt": dt,
         "seed": "none" if seed is None else seed,
         "integrator": integrator,
-        "backend": backend if integrator == "verlet" else "scipy",
+        "backend": backend if scheme.fixed_step else scheme.backends[0],
         "record_every": record_every,
         "equilibrium_window": window,
         "overturn_angle": overturn_angle,
     }
     return _to_dataset(ensemble, records, record_every * dt, window, settings)
-
-
-def _backend_module(backend: str, trajectories: bool):
-    if backend != "gpu":
-        return BACKENDS[backend]
-    from .integrators import kernel_cuda
-
-    if not kernel_cuda.gpu_available():
-        raise ParameterError(
-            "`backend` 'gpu' needs an NVIDIA GPU with a working CUDA driver, and numba found "
-            "none (numba.cuda.is_available() is False). Install the driver and "
-            "`pip install metrosync[gpu]` on a GPU machine, or use backend='numba'."
-        )
-    if trajectories:
-        raise ParameterError(
-            "`backend` 'gpu' does not record trajectories yet; use backend='numba' with "
-            "`trajectories=True` (or `--save-every`)."
-        )
-    return kernel_cuda
 
 
 def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, trajectories,
