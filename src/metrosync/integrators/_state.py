@@ -20,7 +20,9 @@ from ._abi import Recording, State
 
 @dataclass
 class StepState:
-    """State (B runs × N metronomes) and record buffers, advanced in place.
+    """State (B runs × N metronomes) and record buffers, advanced in place: the
+    kernels' `State` and `Recording` tuples, whose fields read as attributes
+    (``step_state.theta`` is ``step_state.state.theta``).
 
     theta, theta_dot, acc_theta : (B, N)
     phi, phi_dot, acc_phi : (B,)
@@ -36,24 +38,16 @@ class StepState:
     traj_* : trajectories (B, n_rec, N) and (B, n_rec), or (0, 0, 0) placeholders.
     """
 
-    theta: np.ndarray
-    theta_dot: np.ndarray
-    phi: np.ndarray
-    phi_dot: np.ndarray
-    acc_theta: np.ndarray
-    acc_phi: np.ndarray
-    p_phi: np.ndarray
-    force_phi: np.ndarray
-    last_up: np.ndarray
-    status: np.ndarray
-    r: np.ndarray
-    cross_re: np.ndarray
-    cross_im: np.ndarray
-    cross_count: np.ndarray
-    traj_theta: np.ndarray
-    traj_theta_dot: np.ndarray
-    traj_phi: np.ndarray
-    traj_phi_dot: np.ndarray
+    state: State
+    recording: Recording
+
+    def __getattr__(self, name: str):
+        # Called only for names the dataclass itself lacks; vars() rather than
+        # attributes, so that an instance without fields yet (copy, pickle) does not recurse.
+        for part in (vars(self).get("state"), vars(self).get("recording")):
+            if part is not None and name in part._fields:
+                return getattr(part, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @classmethod
     def start(
@@ -80,7 +74,7 @@ class StepState:
             p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
         finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
-        return cls(
+        state = State(
             theta=theta,
             theta_dot=theta_dot,
             phi=np.array(phi0, dtype=float),
@@ -91,6 +85,8 @@ class StepState:
             force_phi=disk_torque(sys, phi_dot, no_kick, 0.0),
             last_up=np.full((b, n), -1.0),
             status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
+        )
+        recording = Recording(
             r=np.full((b, n_records), np.nan),
             cross_re=np.zeros((b, n_records)),
             cross_im=np.zeros((b, n_records)),
@@ -100,14 +96,15 @@ class StepState:
             traj_phi=np.full(traj_shape[:2], np.nan),
             traj_phi_dot=np.full(traj_shape[:2], np.nan),
         )
+        return cls(state, recording)
 
     def kernel_state(self) -> State:
         """The state arrays as the kernels take them (the same arrays, not copies)."""
-        return State(*(getattr(self, name) for name in State._fields))
+        return self.state
 
     def kernel_recording(self) -> Recording:
         """The record buffers as the kernels take them (the same arrays)."""
-        return Recording(*(getattr(self, name) for name in Recording._fields))
+        return self.recording
 
     def crossing_order(self) -> np.ndarray:
         """r from crossing-interpolated phases, (B, n_rec); NaN where some metronome

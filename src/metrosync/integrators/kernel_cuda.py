@@ -92,12 +92,9 @@ def _block_sum(red, k, tid, nt):
 
 @cuda.jit
 def advance(st, c, settings, rec, scratch):
-    theta, theta_dot, acc_theta = st.theta, st.theta_dot, st.acc_theta
-    phi, phi_dot, acc_phi, p_phi, force_phi = st.phi, st.phi_dot, st.acc_phi, st.p_phi, st.force_phi  # fmt: skip  # noqa: E501
-    last_up, status = st.last_up, st.status
-    r, cross_re, cross_im, cross_count = rec.r, rec.cross_re, rec.cross_im, rec.cross_count
-    dt, step0, n_steps = settings.dt, settings.step0, settings.n_steps
-    record_every, overturn_angle = settings.record_every, settings.overturn_angle
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count = rec[:4]  # no trajectories on the GPU yet
+    dt, step0, n_steps, record_every, overturn_angle = settings
     th_new, rest, q = scratch
     b = cuda.blockIdx.x
     tid = cuda.threadIdx.x

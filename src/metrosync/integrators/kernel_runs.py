@@ -61,13 +61,9 @@ def advance(st, c, settings, rec):
     """Same contract as the other kernels; the state uses the usual (B, N) layout and is
     transposed into blocks here, once per call; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, acc_theta = st.theta, st.theta_dot, st.acc_theta
-    phi, phi_dot, acc_phi, p_phi, force_phi = st.phi, st.phi_dot, st.acc_phi, st.p_phi, st.force_phi  # fmt: skip  # noqa: E501
-    last_up, status = st.last_up, st.status
-    r, cross_re, cross_im, cross_count = rec.r, rec.cross_re, rec.cross_im, rec.cross_count
-    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec.traj_theta, rec.traj_theta_dot, rec.traj_phi, rec.traj_phi_dot  # fmt: skip  # noqa: E501
-    dt, step0, n_steps = settings.dt, settings.step0, settings.n_steps
-    record_every, overturn_angle = settings.record_every, settings.overturn_angle
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
     n_rec = r.shape[1]
