@@ -2,7 +2,8 @@
 
 For each (B runs, N metronomes) it times, in one process:
   * the kernel `simulate` uses (layout chosen from N), over the full duration;
-  * the previous kernel (scalar loop, libm trig), over the same duration;
+  * the previous kernel (scalar loop, libm trig; `kernel_scalar.py` beside this
+    script), over the same duration;
   * the plain NumPy implementation of the same scheme, over fewer steps (its rate does
     not depend on the step count);
 and prints the rates with the ratios. Compilation is excluded (a warm-up call first);
@@ -23,6 +24,7 @@ import platform
 import time
 
 import numba
+from kernel_scalar import advance_state as previous_kernel
 
 from metrosync import build_ensemble, get_preset
 from metrosync.integrators import reference, verlet
@@ -30,7 +32,8 @@ from metrosync.integrators._state import StepState
 
 
 def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
-    """Oscillator-steps per second of one timed call (``layout=None``: NumPy)."""
+    """Oscillator-steps per second of one timed call (``layout``: a layout of the
+    package's kernel, ``"previous"`` for the scalar baseline, or None for NumPy)."""
     state = StepState.start(
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
         n_records=steps // 10 + 1, trajectories=False,
@@ -39,6 +42,8 @@ def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
     start = time.perf_counter()
     if layout is None:
         reference.advance_state(state, ensemble.system, **options)
+    elif layout == "previous":
+        previous_kernel(state, ensemble.system, **options)
     else:
         verlet.advance_state(state, ensemble.system, layout=layout, **options)
     return ensemble.runs * ensemble.n * steps / (time.perf_counter() - start)
@@ -77,7 +82,7 @@ def main() -> None:
         ens = ensemble_of(b, n)
         layout = verlet.choose_layout(n, b)
         fast = best(ens, steps, args.dt, layout, args.repeats)
-        previous = best(ens, steps, args.dt, "scalar", args.repeats)
+        previous = best(ens, steps, args.dt, "previous", args.repeats)
         slow = rate(ens, args.baseline_steps, args.dt, None)
         print(f"{b:>6} {n:>6} {layout:>12} {fast:>10.3e} {previous:>10.3e} {slow:>10.3e} "
               f"{fast / previous:>11.1f} {fast / slow:>9.0f}")  # fmt: skip

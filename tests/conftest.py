@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from metrosync import build_ensemble, get_preset
+from metrosync.equations import SystemArrays
 
 
 @pytest.fixture
@@ -15,3 +16,27 @@ def small_ensemble():
 @pytest.fixture
 def rng():
     return np.random.default_rng(20131)
+
+
+@pytest.fixture
+def random_system(rng):
+    """A factory of random, physically sensible `SystemArrays` of B runs × N metronomes."""
+
+    def make(b=4, n=6):
+        mass = rng.uniform(0.02, 0.05, (b, n))
+        h = rng.uniform(0.005, 0.03, (b, n))
+        j = rng.uniform(1e-5, 1e-4, (b, n))
+        radius = rng.uniform(0.1, 0.5, b)
+        return SystemArrays(
+            mh=mass * h,
+            mgh=mass * 9.81 * h,
+            inertia=mass * h**2 + j,
+            c_theta=rng.uniform(0, 1e-4, (b, n)),
+            drive=rng.uniform(0, 1e-3, (b, n)),
+            omega=np.ones((b, n)),
+            radius=radius,
+            c_phi=rng.uniform(0, 1e-4, b),
+            total_inertia=rng.uniform(0.05, 0.5, b) + radius**2 * mass.sum(axis=1),
+        )
+
+    return make

@@ -5,27 +5,9 @@ import numpy as np
 from metrosync.equations import SystemArrays, accelerations, residuals
 
 
-def random_system(rng, b=4, n=6):
-    mass = rng.uniform(0.02, 0.05, (b, n))
-    h = rng.uniform(0.005, 0.03, (b, n))
-    j = rng.uniform(1e-5, 1e-4, (b, n))
-    radius = rng.uniform(0.1, 0.5, b)
-    return SystemArrays(
-        mh=mass * h,
-        mgh=mass * 9.81 * h,
-        inertia=mass * h**2 + j,
-        c_theta=rng.uniform(0, 1e-4, (b, n)),
-        drive=rng.uniform(0, 1e-3, (b, n)),
-        omega=np.ones((b, n)),
-        radius=radius,
-        c_phi=rng.uniform(0, 1e-4, b),
-        total_inertia=rng.uniform(0.05, 0.5, b) + radius**2 * mass.sum(axis=1),
-    )
-
-
-def test_solved_form_solves_the_equations_of_motion(rng):
+def test_solved_form_solves_the_equations_of_motion(rng, random_system):
     for _ in range(20):
-        sys = random_system(rng)
+        sys = random_system()
         shape = sys.shape
         theta = rng.uniform(-np.pi, np.pi, shape)
         theta_dot = rng.normal(0, 5, shape)
@@ -38,8 +20,8 @@ def test_solved_form_solves_the_equations_of_motion(rng):
         np.testing.assert_allclose(pendulum, 0, atol=1e-12 * scale)
 
 
-def test_residuals_detect_wrong_accelerations(rng):
-    sys = random_system(rng)
+def test_residuals_detect_wrong_accelerations(rng, random_system):
+    sys = random_system()
     theta = rng.uniform(-1, 1, sys.shape)
     zeros = np.zeros(sys.shape)
     phi_ddot, theta_ddot = accelerations(sys, theta, zeros, np.zeros(4), zeros)
@@ -47,8 +29,8 @@ def test_residuals_detect_wrong_accelerations(rng):
     assert np.max(np.abs(disk)) > 1e-8
 
 
-def test_rigid_support_leaves_the_disk_still(rng):
-    sys = random_system(rng)
+def test_rigid_support_leaves_the_disk_still(rng, random_system):
+    sys = random_system()
     sys = SystemArrays(**{**vars(sys), "total_inertia": np.full(4, np.inf)})
     theta = rng.uniform(-1, 1, sys.shape)
     zeros = np.zeros(sys.shape)

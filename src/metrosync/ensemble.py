@@ -7,7 +7,8 @@ initial state. Everything random comes from one seed through independent streams
 (frequencies, phases), so changing σ never changes the initial phases.
 
 In the model the metronomes differ only through their slider position L2⁽ⁱ⁾ (paper
-§7): a drawn natural frequency is realised by tuning L2 to it.
+§7): a drawn natural frequency is realised by tuning L2 to it. The constants
+themselves come from `model.system.system_arrays`.
 """
 
 from __future__ import annotations
@@ -18,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .equations import SystemArrays
 from .errors import ParameterError, describe
-from .model import Metronome, ModelParameters
+from .model import Metronome, ModelParameters, SystemArrays, omega_to_bpm, system_arrays
+from .model.system import PER_METRONOME
 
 #: The coarsest step accepted: a period must span at least this many steps.
 MIN_STEPS_PER_PERIOD = 10
@@ -86,7 +87,7 @@ def build_ensemble(
     metronomes : explicit, fully specified metronomes (shape (N,)): every parameter
         per metronome, the same in every run (``n`` must be N or None, ``sigma_bpm`` 0).
     amplitude : swing amplitude (rad) of the random-phase start; default the
-        energy-balance amplitude 2M/(π c_θ) (MODEL-NOTES §6).
+        energy-balance amplitude 2M/(π c_θ) (docs/model.md §6.5).
     theta0, theta_dot0 : explicit initial angles and angular velocities, (N,) or (B, N).
     phi_dot0 : initial angular velocity of the disk.
     """
@@ -107,6 +108,7 @@ def build_ensemble(
             f"`sigma_bpm` must be >= 0 BPM, got {describe(sigma_bpm)}; give a number "
             f"(0 tunes every metronome to the nominal `bpm`)."
         )
+    per_metronome = None
     if metronomes is not None:
         metronomes = list(metronomes)
         if not metronomes:
@@ -114,69 +116,31 @@ def build_ensemble(
         _require_explicit("metronomes", len(metronomes), n, sigma_bpm)
         n = len(metronomes)
         l2 = np.broadcast_to([m.l2 for m in metronomes], (runs, n)).copy()
-        per = {
-            name: np.broadcast_to([getattr(m.design, name) for m in metronomes], (runs, n)).copy()
-            for name in ("w1", "w2", "l1", "c_theta", "drive", "g")
+        per_metronome = {
+            name: np.broadcast_to([getattr(m.design, name) for m in metronomes], (runs, n))
+            for name in PER_METRONOME
         }
     else:
         if frequencies_bpm is not None:
             freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
             _require_explicit("frequencies_bpm", freq.shape[1], n, sigma_bpm)
             n = freq.shape[1]
-            low, high = design.bpm_range()
-            outside = np.argwhere((freq < low) | (freq > high))
-            if outside.size:
-                # Name the entry as the caller wrote it: a list of N, or a (runs, N) table.
-                at = outside[0] if np.ndim(frequencies_bpm) == 2 else outside[0][1:]
-                where = "".join(f"[{int(k)}]" for k in at)
-                raise ParameterError(
-                    design.out_of_range(f"frequencies_bpm{where}", float(freq[tuple(outside[0])]))
-                )
+            design.check_tunable(np.asarray(frequencies_bpm, dtype=float), name="frequencies_bpm")
         else:
             n = _require_count("n", n)
             if bpm is None or not math.isfinite(float(bpm)):
                 raise ParameterError(f"`bpm` must be a finite number, got {bpm!r}.")
-            low, high = design.bpm_range()
-            if not low <= float(bpm) <= high:
-                raise ParameterError(design.out_of_range("bpm", float(bpm)))
+            design.check_tunable(bpm)
             freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
-            if np.any((freq < low) | (freq > high)):
-                raise ParameterError(
-                    f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency "
-                    f"({freq[(freq < low) | (freq > high)][0]:.2f} BPM) falls outside the tunable "
-                    f"range [{low:.2f}, {high:.2f}] BPM; lower `sigma_bpm` or move `bpm` inward."
-                )
+            design.check_tunable(
+                freq,
+                what=f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency "
+                "({value:.2f} BPM)",
+                fix="Lower `sigma_bpm` or move `bpm` inward.",
+            )
         l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
-        per = {
-            name: np.full((runs, n), float(getattr(design, name)))
-            for name in ("w1", "w2", "l1", "c_theta", "drive", "g")
-        }
-
-    mass = per["w1"] + per["w2"]
-    h = (per["w1"] * per["l1"] - per["w2"] * l2) / mass
-    if np.any(h <= 0):
-        raise ParameterError(
-            "a metronome has h <= 0 (its centre of mass is above the pivot, so the pendulum "
-            "is inverted); lower its slider `l2` below w1*l1/w2."
-        )
-    j_i = per["w1"] * per["l1"] ** 2 + per["w2"] * l2**2
-    inertia = mass * h**2 + j_i
-    omega = np.sqrt(mass * per["g"] * h / inertia)
-    platform = params.platform
-    disk = np.full(runs, platform.disk_inertia(n))
-    radius = np.full(runs, platform.radius)
-    total = disk + radius**2 * mass.sum(axis=1)
-    system = SystemArrays(
-        mh=mass * h,
-        mgh=mass * per["g"] * h,
-        inertia=inertia,
-        c_theta=per["c_theta"],
-        drive=per["drive"],
-        omega=omega,
-        radius=radius,
-        c_phi=np.full(runs, platform.c_phi),
-        total_inertia=total,
-    )
+    system, disk = system_arrays(params, l2, per_metronome)
+    omega = system.omega
 
     phases = phase_rng.uniform(0.0, 2 * np.pi, size=(runs, n))
     if theta0 is not None:
@@ -214,7 +178,7 @@ def build_ensemble(
         params=params,
         system=system,
         l2=l2,
-        frequency_bpm=60.0 * omega / np.pi,
+        frequency_bpm=omega_to_bpm(omega),
         disk_inertia=disk,
         theta0=th0,
         theta_dot0=thd0,

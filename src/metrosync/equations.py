@@ -5,57 +5,42 @@ The contract: `accelerations` evaluates the solved form, eqs. (eqm1) and (eqm2),
     φ̈  = [R Σ m_i h_i θ̇_i² sin θ_i − c_φ φ̇ − Σ 𝕄_i + A + B − C] / D
     θ̈_i = [𝕄_i − m_i R φ̈ h_i cos θ_i − m_i g h_i sin θ_i − c_θ θ̇_i] / (m_i h_i² + J_i)
 
-with A, B, C, D as in the paper (generalised to a mass m_i per metronome). It is the
-one vectorised definition shared by the NumPy reference integrator and the accurate
-``exact`` integrator; the compiled kernel fuses the same arithmetic into one loop and
-is tested against this function. `residuals` evaluates the unsolved equations
-(metron2a) and (metron2) so that a test can check that the solved form satisfies them.
+with A, B, C, D as in the paper (generalised to a mass m_i per metronome), and
+−c_φ φ̇ − Σ𝕄_i + τ(t) the torque on the disk from outside the pendulums (`disk_torque`;
+τ(t), `applied_torque`, is none in the current model). It is the one vectorised
+definition shared by the NumPy reference integrator and the accurate ``exact``
+integrator; the compiled kernels call the scalar form of the same forces in
+`integrators._physics`, and tests hold the two equal. `residuals` evaluates the
+unsolved equations (metron2a) and (metron2) so that a test can check that the solved
+form satisfies them.
 
 All arrays broadcast over leading "batch" axes: per-metronome arrays have shape
 (..., N), per-run arrays shape (...). ``kick`` is the escapement torque 𝕄_i (N m) in
-force form; the integrators supply ±M/dt or 0.
+force form; the integrators supply ±M/dt or 0. The constants come as `SystemArrays`
+(defined with their builder in `model.system`, re-exported here).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from .model.system import SystemArrays
 
-@dataclass(frozen=True)
-class SystemArrays:
-    """Per-run and per-metronome constants of an ensemble, in SI units.
-
-    Shapes: per-metronome fields (B, N), per-run fields (B,).
-
-    mh : m_i h_i.   mgh : m_i g h_i.   inertia : m_i h_i² + J_i.
-    c_theta, drive : friction c_θ and escapement impulse M of each metronome.
-    omega : small-amplitude natural frequency on a rigid support, rad/s.
-    radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
-    in eq. (metron2a)); ``inf`` pins the disk.
-    """
-
-    mh: np.ndarray
-    mgh: np.ndarray
-    inertia: np.ndarray
-    c_theta: np.ndarray
-    drive: np.ndarray
-    omega: np.ndarray
-    radius: np.ndarray
-    c_phi: np.ndarray
-    total_inertia: np.ndarray
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.mh.shape  # type: ignore[return-value]
-
-    def run(self, b: int) -> SystemArrays:
-        """The constants of run ``b`` alone, as a batch of one."""
-        return SystemArrays(**{k: v[b : b + 1] for k, v in vars(self).items()})
+__all__ = ["SystemArrays", "accelerations", "applied_torque", "disk_torque", "residuals"]
 
 
-def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
+def applied_torque(sys: SystemArrays, t) -> np.ndarray:
+    """External torque τ(t) on the disk (N m), (B,): none in the current model."""
+    return np.zeros(np.shape(sys.radius))
+
+
+def disk_torque(sys: SystemArrays, phi_dot, kick, t=0.0):
+    """Torque on the disk from outside the pendulums' swing, (B,): bearing friction,
+    the escapement's reaction and the applied torque, −c_φ φ̇ − Σ𝕄_i + τ(t)."""
+    return -sys.c_phi * phi_dot - np.sum(kick, axis=-1) + applied_torque(sys, t)
+
+
+def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
     """Solved equations of motion, eqs. (eqm1)–(eqm2).
 
     Parameters
@@ -63,6 +48,7 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
     sys : per-run (B,) and per-metronome (B, N) constants.
     theta, theta_dot, kick : arrays (B, N).
     phi_dot : array (B,).
+    t : time, s (for the applied torque).
 
     Returns
     -------
@@ -78,8 +64,7 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
     d_sum = (radius * sys.mh) ** 2 / sys.inertia * cos_t**2
     numerator = (
         sys.radius * np.sum(sys.mh * theta_dot**2 * sin_t, axis=-1)
-        - sys.c_phi * phi_dot
-        - np.sum(kick, axis=-1)
+        + disk_torque(sys, phi_dot, kick, t)
         + np.sum(a_sum + b_sum - c_sum, axis=-1)
     )
     denominator = sys.total_inertia - np.sum(d_sum, axis=-1)  # D
@@ -93,7 +78,7 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick):
     return phi_ddot, theta_ddot
 
 
-def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot):
+def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t=0.0):
     """Left minus right of the unsolved equations (metron2a) and (metron2).
 
     Returns (disk residual (B,), pendulum residuals (B, N)); both vanish for
@@ -105,8 +90,7 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     disk = (
         sys.total_inertia * phi_ddot
         + sys.radius * np.sum(sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t), axis=-1)
-        + sys.c_phi * phi_dot
-        + np.sum(kick, axis=-1)
+        - disk_torque(sys, phi_dot, kick, t)
     )
     pendulum = (
         sys.inertia * theta_ddot

@@ -36,9 +36,7 @@ from ._version import __version__
 from .budget import simulation_budget
 from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
 from .errors import OverturnWarning, ParameterError
-from .integrators import INTEGRATORS
-from .integrators import reference as numpy_backend
-from .integrators import verlet as numba_backend
+from .integrators import BACKENDS, get_integrator
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
 from .observables.order import ensemble_statistics, equilibrium_order
@@ -47,7 +45,6 @@ from .pacing import Pacer
 from .progress import progress_bar
 from .status import STATUS_MEANINGS
 
-BACKENDS = {"numba": numba_backend, "numpy": numpy_backend, "gpu": None}  # gpu: imported on use
 #: Time between records of r(t) when `record_every` is not given, s.
 RECORD_SECONDS = 0.1
 #: Most records of r(t) per run when `record_every` is not given: a longer run records
@@ -99,10 +96,11 @@ def simulate(
     seed : seed of every random choice; the result is a pure function of the inputs.
     preset : ``"default"``, ``"boda2013"`` or a `ModelParameters`.
     changes : model parameters to change by name, e.g. ``{"drive": 1e-4, "c_phi": 0}``.
-    integrator : ``"verlet"`` (the paper's scheme) or ``"exact"`` (reference).
-    backend : for ``verlet``, ``"numba"`` (compiled, parallel over runs), ``"numpy"``
-        (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through numba.cuda; no
-        trajectories yet).
+    integrator : a name from `metrosync.integrators.REGISTRY`: ``"verlet"`` (the
+        paper's scheme) or ``"exact"`` (reference).
+    backend : for a fixed-step integrator, ``"numba"`` (compiled, parallel over runs),
+        ``"numpy"`` (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through
+        numba.cuda; no trajectories yet); see `metrosync.integrators.BACKENDS`.
     frequencies_bpm, metronomes, amplitude, theta0, theta_dot0 : see `build_ensemble`.
     record_every : record every this many steps; default the step count of 0.1 s, or
         the stride that keeps `MAX_RECORDS` records when 0.1 s would give more (the
@@ -126,10 +124,7 @@ def simulate(
     params = get_preset(preset, warn=not changes)
     if changes:
         params = get_preset(params.with_changes(**changes))
-    if integrator not in INTEGRATORS:
-        raise ParameterError(
-            f"unknown `integrator` {integrator!r}; choose one of {list(INTEGRATORS)}."
-        )
+    scheme = get_integrator(integrator)
     if backend not in BACKENDS:
         raise ParameterError(f"unknown `backend` {backend!r}; choose one of {sorted(BACKENDS)}.")
     if not (math.isfinite(duration) and duration > 0):
@@ -186,17 +181,15 @@ def simulate(
     longest_period = float(2 * np.pi / np.min(ensemble.system.omega))
     tail_steps = min(n_steps, math.ceil(tail_span(window, longest_period) / dt))
 
-    if integrator == "verlet":
-        kernel = _backend_module(backend, trajectories)
+    if scheme.fixed_step:
+        kernel = scheme.stepper(backend, trajectories=trajectories)
         records, rates = _run_fixed_step(
-            ensemble, kernel, dt, n_steps, record_every, n_records, trajectories,
+            ensemble, kernel, backend, dt, n_steps, record_every, n_records, trajectories,
             overturn_angle, show, tail_steps,
         )  # fmt: skip
     else:
-        from .integrators import exact  # scipy's solvers load only when asked for
-
         with progress_bar(total=ensemble.runs, unit="run", enabled=show) as bar:
-            records = exact.integrate(
+            records = scheme.integrate(
                 ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi_dot0,
                 duration=n_steps * dt, grid_dt=record_every * dt, n_records=n_records,
                 trajectories=trajectories, overturn_angle=overturn_angle,
@@ -217,7 +210,7 @@ def simulate(
         "dt": dt,
         "seed": "none" if seed is None else seed,
         "integrator": integrator,
-        "backend": backend if integrator == "verlet" else "scipy",
+        "backend": backend if scheme.fixed_step else scheme.backends[0],
         "record_every": record_every,
         "record_interval": record_every * dt,
         "record_every_reason": record_reason,
@@ -302,26 +295,8 @@ def _request_size(n, runs, frequencies_bpm, metronomes, theta0) -> tuple[int, in
     return (n, runs) if n >= 1 and runs >= 1 else None
 
 
-def _backend_module(backend: str, trajectories: bool):
-    if backend != "gpu":
-        return BACKENDS[backend]
-    from .integrators import kernel_cuda
 
-    if not kernel_cuda.gpu_available():
-        raise ParameterError(
-            "`backend` 'gpu' needs an NVIDIA GPU with a working CUDA driver, and numba found "
-            "none (numba.cuda.is_available() is False). Install the driver and "
-            "`pip install metrosync[gpu]` on a GPU machine, or use backend='numba'."
-        )
-    if trajectories:
-        raise ParameterError(
-            "`backend` 'gpu' does not record trajectories yet; use backend='numba' with "
-            "`trajectories=True` (or `--save-every`)."
-        )
-    return kernel_cuda
-
-
-def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, trajectories,
+def _run_fixed_step(ensemble, kernel, backend, dt, n_steps, record_every, n_records, trajectories,
                     overturn_angle, show, tail_steps) -> tuple[Records, np.ndarray]:  # fmt: skip
     """Advance in paced chunks; the last ``tail_steps`` go in segments shorter than half
     the shortest period, to count ticks (`CrossingTally`). Returns the records and the
@@ -334,14 +309,14 @@ def _run_fixed_step(ensemble, backend, dt, n_steps, record_every, n_records, tra
     # the progress bar act promptly whatever the problem size (see `metrosync.pacing`).
     estimate = simulation_budget(
         n=ensemble.n, runs=ensemble.runs, steps=1, records=1, trajectories=False,
-        backend="numpy" if backend is numpy_backend else "numba",
+        backend="numpy" if backend == "numpy" else "numba",
     ).seconds  # fmt: skip
     per_segment = max(1, int(ensemble.shortest_period() / 2 / dt))
     head = n_steps - tail_steps
     with progress_bar(total=round(n_steps * dt, 6), unit="s", enabled=show) as bar:
 
         def advance(step: int, count: int) -> None:
-            backend.advance_state(
+            kernel.advance_state(
                 state, ensemble.system, dt=dt, step0=step, n_steps=count,
                 record_every=record_every, overturn_angle=overturn_angle,
             )  # fmt: skip

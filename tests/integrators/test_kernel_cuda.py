@@ -33,6 +33,17 @@ for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r"):
     np.testing.assert_allclose(getattr(gpu, name), getattr(ref, name), rtol=0, atol=1e-9)
 np.testing.assert_allclose(gpu.crossing_order(), ref.crossing_order(), atol=1e-9)
 np.testing.assert_array_equal(gpu.status, ref.status)
+
+# A run that diverges at its start records nothing, as in every CPU backend.
+theta_dot0 = np.zeros((2, 3))
+theta_dot0[1, 0] = 1e200
+ens = build_ensemble(3, 192.0, params=get_preset("default"), runs=2, seed=3,
+                     theta0=np.full((2, 3), 0.3), theta_dot0=theta_dot0)
+gpu = run(kernel_cuda.advance_state, threads=4)
+ref = run(reference.advance_state)
+assert ref.status[1] & 2 and np.isnan(ref.r[1]).all()
+np.testing.assert_array_equal(gpu.status, ref.status)
+np.testing.assert_allclose(gpu.r, ref.r, rtol=0, atol=1e-9)  # NaN in the same places
 print("ok")
 """
 

@@ -5,6 +5,7 @@ import os
 import re
 import subprocess
 import sys
+from functools import partial
 from pathlib import Path
 
 import numba as nb
@@ -13,8 +14,10 @@ import pytest
 
 from metrosync import build_ensemble, get_preset
 from metrosync.integrators import kernel_oscillators, kernel_runs, reference, verlet
-from metrosync.integrators._state import StepState, kernel_arguments
+from metrosync.integrators._abi import constants_of, settings_of
+from metrosync.integrators._state import StepState
 from metrosync.integrators.trig import REDUCTION_LIMIT, sincos
+from metrosync.status import STATUS_DIVERGED
 
 
 def run(advance, ens, steps, **kwargs):
@@ -27,7 +30,7 @@ def run(advance, ens, steps, **kwargs):
     return state
 
 
-@pytest.mark.parametrize("layout", sorted(verlet.KERNELS))
+@pytest.mark.parametrize("layout", sorted(verlet.LAYOUTS))
 @pytest.mark.parametrize("n, runs", [(3, 11), (20, 3)])  # 11 runs: a partly filled block
 def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs):
     ens = build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=runs, seed=7)
@@ -37,6 +40,20 @@ def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs):
         np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
     np.testing.assert_allclose(got.crossing_order(), ref.crossing_order(), atol=1e-10)
     np.testing.assert_array_equal(got.status, ref.status)
+
+
+@pytest.mark.parametrize("layout", sorted(verlet.LAYOUTS))
+def test_a_run_diverged_from_the_start_records_nothing_in_any_layout(layout):
+    theta_dot0 = np.zeros((3, 4))
+    theta_dot0[1, 2] = 1e200  # θ̇² overflows in the very first force evaluation
+    ens = build_ensemble(4, 192.0, params=get_preset("default"), runs=3, seed=2,
+                         theta0=np.full((3, 4), 0.3), theta_dot0=theta_dot0)  # fmt: skip
+    ref = run(reference.advance_state, ens, 30)
+    got = run(verlet.advance_state, ens, 30, layout=layout)
+    assert ref.status[1] & STATUS_DIVERGED and np.isnan(ref.r[1]).all()
+    np.testing.assert_array_equal(got.status, ref.status)
+    for name in ("r", "traj_theta"):  # NaN (the same places) where nothing was recorded
+        np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
 
 
 def test_layout_follows_the_problem():
@@ -75,8 +92,9 @@ def packed_double_ops(module, fastmath, ens):
     state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                             n_records=2, trajectories=False)  # fmt: skip
     fresh = nb.njit(parallel=True, fastmath=fastmath)(module.advance.py_func)
-    fresh(*kernel_arguments(state, ens.system, dt=0.01, step0=0, n_steps=10, record_every=10,
-                            overturn_angle=1.5))  # fmt: skip
+    settings = settings_of(dt=0.01, step0=0, n_steps=10, record_every=10, overturn_angle=1.5)
+    constants = module.arrange(constants_of(ens.system, 0.01))
+    fresh(state.kernel_state(), constants, settings, state.kernel_recording())
     asm = "\n".join(fresh.inspect_asm().values())
     return len(re.findall(r"\tv\w+pd\t[^\n]*%[yz]mm", asm))
 
@@ -130,14 +148,16 @@ def test_every_layout_gives_the_same_ensemble_statistics():
     ens = build_ensemble(7, 184.0, params=get_preset("default"), sigma_bpm=0.75, runs=48, seed=2)
     steps = 30_000  # 300 s
     stats = {}
-    for layout in sorted(verlet.KERNELS):
+    backends = {layout: partial(verlet.advance_state, layout=layout) for layout in verlet.LAYOUTS}
+    backends["numpy"] = reference.advance_state
+    for name, advance in backends.items():
         state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                                 n_records=steps // 10 + 1, trajectories=False)  # fmt: skip
-        verlet.advance_state(state, ens.system, dt=0.01, step0=0, n_steps=steps, record_every=10,
-                             overturn_angle=math.pi / 2, layout=layout)  # fmt: skip
+        advance(state, ens.system, dt=0.01, step0=0, n_steps=steps, record_every=10,
+                overturn_angle=math.pi / 2)  # fmt: skip
         time = np.arange(steps // 10 + 1) * 0.1
-        stats[layout] = ensemble_statistics(equilibrium_order(state.crossing_order().T, time, 75.0))
-    mean_ref, spread_ref = stats["scalar"]
+        stats[name] = ensemble_statistics(equilibrium_order(state.crossing_order().T, time, 75.0))
+    mean_ref, spread_ref = stats["numpy"]
     standard_error = spread_ref / np.sqrt(ens.runs)
     for layout, (mean, spread) in stats.items():
         assert abs(mean - mean_ref) < 3 * standard_error, (layout, stats)

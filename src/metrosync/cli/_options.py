@@ -13,6 +13,7 @@ import math
 import warnings
 
 from ..errors import ParameterError
+from ..integrators import BACKENDS, REGISTRY, get_integrator, integrator_names
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -96,16 +97,17 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
     )
     g.add_argument(
         "--integrator",
-        choices=("verlet", "exact"),
-        default="verlet",
-        help="the paper's fixed-step scheme, or the accurate reference",
+        choices=integrator_names(),
+        default=integrator_names()[0],
+        help="; ".join(f"{i.name}: {i.summary}" for i in REGISTRY.values()),
     )
     g.add_argument(
         "--backend",
-        choices=("numba", "numpy", "gpu"),
+        choices=tuple(BACKENDS),
         default=None,
-        help="for verlet: compiled CPU kernel, the plain NumPy reference (slow), or an "
-        "NVIDIA GPU (default: numba)",
+        help="for a fixed-step integrator: "
+        + "; ".join(f"{name}: {what}" for name, what in BACKENDS.items())
+        + " (default: numba)",
     )
     g.add_argument(
         "--amplitude",
@@ -203,7 +205,7 @@ def simulate_from_args(args, **extra):
     """Run `metrosync.simulate` with the ensemble options of ``args``."""
     from ..simulate import simulate
 
-    if args.backend is not None and args.integrator != "verlet":
+    if args.backend is not None and not get_integrator(args.integrator).fixed_step:
         warnings.warn(
             f"`--backend {args.backend}` applies to `--integrator verlet` only; "
             f"`--integrator {args.integrator}` ignores it.",

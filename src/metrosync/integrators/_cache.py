@@ -2,9 +2,11 @@
 kernel recompiled), never loaded.
 
 numba invalidates a cached function only when its own source file changes, not when
-a function it inlines from another file does (`trig.sincos`, `_kernel_parts`). A stamp
-holding the hash of every kernel source file sits beside the cache; when it does not
-match, every cached kernel of this package is removed.
+a function it inlines from another file does (`_physics`, `_kernel_parts`,
+`trig.sincos`), nor when a global it froze at compile time changes (the bits of
+`metrosync.status`). A stamp holding the hash of every module of this package, and of
+the modules outside it that the kernels depend on (`STAMPED_OUTSIDE`), sits beside
+the cache; when it does not match, every cached function of this package is removed.
 
 numba raises on a truncated or corrupt cache file instead of recompiling. Before the
 first kernel call, `heal_compile_cache` reads each of this package's cache files the
@@ -22,21 +24,28 @@ from pathlib import Path
 import numba
 
 _checked = False
-OUR_MODULES = ("kernel_", "trig.", "_kernel_parts.")
 STAMP_NAME = "metrosync-kernels.stamp"
+HERE = Path(__file__).resolve().parent
+#: Modules outside this package whose source the compiled kernels depend on: the
+#: status bits they freeze, and the system constants their argument list is made of
+#: (`SystemArrays`, in model/system.py, re-exported by equations.py).
+STAMPED_OUTSIDE = ("status.py", "equations.py", "model/system.py")
+
+
+def stamped_sources() -> list[Path]:
+    """Every source file the stamp covers."""
+    return sorted(HERE.glob("*.py")) + [HERE.parent / name for name in STAMPED_OUTSIDE]
 
 
 def source_stamp() -> str:
-    here = Path(__file__).resolve().parent
     digest = hashlib.sha256()
-    for path in sorted(here.glob("*.py")):
+    for path in stamped_sources():
         digest.update(path.name.encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()
 
 
 def cache_dirs() -> list[Path]:
-    here = Path(__file__).resolve().parent
-    dirs = [here / "__pycache__"]
+    dirs = [HERE / "__pycache__"]
     override = numba.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR")
     if override:
         dirs.append(Path(override))
@@ -93,9 +102,14 @@ def heal_compile_cache() -> list[Path]:
 
 def _ours(path: Path) -> bool:
     # numba names the folder after the source folder ("integrators_<hash>" under
-    # NUMBA_CACHE_DIR) and each file after the module and function.
+    # NUMBA_CACHE_DIR) and each file after the module and function: any module of
+    # this package may hold compiled functions, today or after a rename.
     in_our_folder = path.parent.name == "__pycache__" or path.parent.name.startswith("integrators")
-    return in_our_folder and path.name.startswith(OUR_MODULES)
+    return in_our_folder and path.name.startswith(_our_prefixes())
+
+
+def _our_prefixes() -> tuple[str, ...]:
+    return tuple(path.stem + "." for path in HERE.glob("*.py"))
 
 
 def _index_of(data_file: Path) -> Path | None:

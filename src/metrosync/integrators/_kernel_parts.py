@@ -1,6 +1,10 @@
-"""Compiled pieces shared by every fixed-step kernel: crossing-phase bookkeeping and
-the per-record observables. They run once per crossing or per record, never in the
-vectorized hot loop."""
+"""Compiled pieces shared by every fixed-step CPU kernel: the scheme's updates (see
+`verlet`), crossing-phase bookkeeping and the per-record observables.
+
+The forces are not here but in `_physics`. `drift` and `velocity` run in the
+vectorized hot loop (``inline="always"``, arithmetic only); the bookkeeping runs once
+per crossing or per record.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +15,32 @@ import numba as nb
 from .trig import sincos
 
 TWO_PI = 2.0 * math.pi
+
+
+@nb.njit(cache=True, inline="always")
+def drift(x, v, a, dt, dt2):
+    """Step 1 of the scheme: the new position x + v dt + a dt²/2 and the predicted
+    velocity v + a dt at which the forces are evaluated."""
+    return x + v * dt + 0.5 * a * dt2, v + a * dt
+
+
+@nb.njit(cache=True, inline="always")
+def velocity(v, a, a_next, dt):
+    """Step 4: the velocity after the step, v + (a + a') dt/2."""
+    return v + 0.5 * (a + a_next) * dt
+
+
+@nb.njit(cache=True, inline="always")
+def momentum(p_phi, force, force_next, dt, pinned):
+    """Step 5: the disk's angular momentum after the step, dp_φ/dt = F by the trapezoid
+    rule; a pinned disk keeps it (its mount takes the torque)."""
+    return p_phi if pinned else p_phi + 0.5 * (force + force_next) * dt
+
+
+@nb.njit(cache=True, inline="always")
+def upward(theta, theta_next):
+    """True when the step from ``theta`` to ``theta_next`` crosses 0 upwards."""
+    return (theta < 0.0) & (theta_next > 0.0)
 
 
 @nb.njit(cache=True, inline="always")

@@ -12,42 +12,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations
+from ..equations import SystemArrays, accelerations, disk_torque
 from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
-
-#: The arrays every fixed-step kernel takes, by name and in order: state (B, N) and (B,),
-#: constants of `SystemArrays`, then records and trajectories (after the step settings).
-STATE_FIELDS = (
-    "theta", "theta_dot", "phi", "phi_dot", "acc_theta", "acc_phi", "p_phi", "force_phi",
-    "last_up", "status",
-)  # fmt: skip
-SYSTEM_FIELDS = (
-    "mh", "mgh", "inertia", "c_theta", "drive", "omega", "radius", "c_phi", "total_inertia",
-)  # fmt: skip
-RECORD_FIELDS = ("r", "cross_re", "cross_im", "cross_count")
-TRAJECTORY_FIELDS = ("traj_theta", "traj_theta_dot", "traj_phi", "traj_phi_dot")
-
-
-def kernel_arguments(state, sys, *, dt, step0, n_steps, record_every, overturn_angle) -> tuple:
-    """The positional arguments of every CPU kernel's ``advance``, in their order."""
-    return (
-        *(getattr(state, name) for name in STATE_FIELDS),
-        *(getattr(sys, name) for name in SYSTEM_FIELDS),
-        float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
-        *(getattr(state, name) for name in RECORD_FIELDS + TRAJECTORY_FIELDS),
-    )  # fmt: skip
+from ._abi import Recording, State
 
 
 @dataclass
 class StepState:
-    """State (B runs × N metronomes) and record buffers, advanced in place.
+    """State (B runs × N metronomes) and record buffers, advanced in place: the
+    kernels' `State` and `Recording` tuples, whose fields read as attributes
+    (``step_state.theta`` is ``step_state.state.theta``).
 
     theta, theta_dot, acc_theta : (B, N)
     phi, phi_dot, acc_phi : (B,)
     p_phi : (B,) the disk's angular momentum (J + R²Σm) φ̇ + R Σ m h cos θ θ̇, carried as
         state so that it changes only by the external torque impulse.
-    force_phi : (B,) external torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄.
+    force_phi : (B,) torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄 + τ(t)
+        (`equations.disk_torque`).
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
     r : (B, n_rec) analytic-phase order parameter at each record.
@@ -56,24 +38,16 @@ class StepState:
     traj_* : trajectories (B, n_rec, N) and (B, n_rec), or (0, 0, 0) placeholders.
     """
 
-    theta: np.ndarray
-    theta_dot: np.ndarray
-    phi: np.ndarray
-    phi_dot: np.ndarray
-    acc_theta: np.ndarray
-    acc_phi: np.ndarray
-    p_phi: np.ndarray
-    force_phi: np.ndarray
-    last_up: np.ndarray
-    status: np.ndarray
-    r: np.ndarray
-    cross_re: np.ndarray
-    cross_im: np.ndarray
-    cross_count: np.ndarray
-    traj_theta: np.ndarray
-    traj_theta_dot: np.ndarray
-    traj_phi: np.ndarray
-    traj_phi_dot: np.ndarray
+    state: State
+    recording: Recording
+
+    def __getattr__(self, name: str):
+        # Called only for names the dataclass itself lacks; vars() rather than
+        # attributes, so that an instance without fields yet (copy, pickle) does not recurse.
+        for part in (vars(self).get("state"), vars(self).get("recording")):
+            if part is not None and name in part._fields:
+                return getattr(part, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @classmethod
     def start(
@@ -100,7 +74,7 @@ class StepState:
             p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
         finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
-        return cls(
+        state = State(
             theta=theta,
             theta_dot=theta_dot,
             phi=np.array(phi0, dtype=float),
@@ -108,9 +82,11 @@ class StepState:
             acc_theta=np.ascontiguousarray(acc_theta),
             acc_phi=np.ascontiguousarray(acc_phi),
             p_phi=p_phi,
-            force_phi=-sys.c_phi * phi_dot,
+            force_phi=disk_torque(sys, phi_dot, no_kick, 0.0),
             last_up=np.full((b, n), -1.0),
             status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
+        )
+        recording = Recording(
             r=np.full((b, n_records), np.nan),
             cross_re=np.zeros((b, n_records)),
             cross_im=np.zeros((b, n_records)),
@@ -120,6 +96,15 @@ class StepState:
             traj_phi=np.full(traj_shape[:2], np.nan),
             traj_phi_dot=np.full(traj_shape[:2], np.nan),
         )
+        return cls(state, recording)
+
+    def kernel_state(self) -> State:
+        """The state arrays as the kernels take them (the same arrays, not copies)."""
+        return self.state
+
+    def kernel_recording(self) -> Recording:
+        """The record buffers as the kernels take them (the same arrays)."""
+        return self.recording
 
     def crossing_order(self) -> np.ndarray:
         """r from crossing-interpolated phases, (B, n_rec); NaN where some metronome

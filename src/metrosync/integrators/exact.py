@@ -83,7 +83,7 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
 
     def rhs(t, y):
         th, thd, phd = y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
-        phdd, thdd = accelerations(sys, th, thd, phd, zero_kick)
+        phdd, thdd = accelerations(sys, th, thd, phd, zero_kick, t)
         return np.concatenate(([y[n + 1]], y[n + 2 :], phdd, thdd[0]))
 
     y = np.concatenate(([0.0], theta0, [0.0 if rigid else phi_dot0], theta_dot0))

@@ -5,10 +5,15 @@ two passes of the CPU kernels, with the sums of eqs. (eqm1)–(eqm2) reduced in 
 memory; thread 0 then computes φ̈ and the disk's update. A crossing's phase is added
 to the shared records with atomic adds. Everything is float64.
 
+The physics is not written here: the functions of `_physics` and the scheme's updates
+of `_kernel_parts` are compiled again, from the same Python source, as CUDA device
+functions (`device_function`). The kernel takes the CPU kernels' argument list
+(`_abi`: State, Constants, Settings, Recording) plus three scratch arrays.
+
 Status: verified in numba's CUDA simulator against the NumPy reference (see
 tests/integrators/test_kernel_cuda.py); not yet run or timed on a GPU. Known limits of
-this first version: one run per block (for small N most threads idle), and the state
-travels between host and device once per chunk of steps.
+this first version: one run per block (for small N most threads idle), the state
+travels between host and device once per chunk of steps, and no trajectories.
 """
 
 from __future__ import annotations
@@ -19,11 +24,32 @@ import numpy as np
 from numba import cuda, float64
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._state import RECORD_FIELDS, STATE_FIELDS, SYSTEM_FIELDS, StepState
+from . import _kernel_parts, _physics
+from ._abi import Constants, Recording, State, constants_of, settings_of
+from ._state import StepState
 
 #: Threads per block, a power of two; a block holds one run.
 MAX_THREADS = 256
 TWO_PI = 2.0 * math.pi
+
+
+def device_function(fn):
+    """The CUDA device function compiled from the Python source of the CPU function
+    ``fn`` (an ``inline="always"`` leaf of `_physics` or `_kernel_parts`)."""
+    return cuda.jit(device=True)(fn.py_func)
+
+
+escapement = device_function(_physics.escapement)
+pendulum_terms = device_function(_physics.pendulum_terms)
+disk_torque = device_function(_physics.disk_torque)
+applied_torque = device_function(_physics.applied_torque)
+disk_acceleration = device_function(_physics.disk_acceleration)
+theta_ddot = device_function(_physics.theta_ddot)
+disk_velocity = device_function(_physics.disk_velocity)
+drift = device_function(_kernel_parts.drift)
+velocity = device_function(_kernel_parts.velocity)
+momentum = device_function(_kernel_parts.momentum)
+upward = device_function(_kernel_parts.upward)
 
 
 def gpu_available() -> bool:
@@ -65,57 +91,45 @@ def _block_sum(red, k, tid, nt):
 
 
 @cuda.jit
-def advance(
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status,
-    mh, mgh, inertia, c_theta, drive, omega, radius, c_phi, total_inertia,
-    dt, step0, n_steps, record_every, overturn_angle,
-    r, cross_re, cross_im, cross_count, th_new, rest, q,
-):  # fmt: skip
+def advance(st, c, settings, rec, scratch):
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count = rec[:4]  # no trajectories on the GPU yet
+    dt, step0, n_steps, record_every, overturn_angle = settings
+    th_new, rest, q = scratch
     b = cuda.blockIdx.x
     tid = cuda.threadIdx.x
     nt = cuda.blockDim.x
     n = theta.shape[1]
     n_rec = r.shape[1]
     red = cuda.shared.array((4, MAX_THREADS), float64)
-    shared = cuda.shared.array(2, float64)
+    shared = cuda.shared.array(3, float64)
     dt2 = dt * dt
     grid_dt = record_every * dt
-    rad = radius[b]
     if step0 == 0:
-        _record(b, 0, theta, theta_dot, omega, r, red, tid, nt, status)
+        _record(b, 0, theta, theta_dot, c.omega, r, red, tid, nt, status)
     for s in range(step0, step0 + n_steps):
         cuda.syncthreads()
         if status[b] & STATUS_DIVERGED:
             break
         t_old = s * dt
-        phd_pred = phi_dot[b] + acc_phi[b] * dt
         sum_num = 0.0
         sum_den = 0.0
         sum_kick = 0.0
         over = 0.0
         for i in range(tid, n, nt):
             th = theta[b, i]
-            a = acc_theta[b, i]
-            tn = th + theta_dot[b, i] * dt + 0.5 * a * dt2
-            vp = theta_dot[b, i] + a * dt
-            kick = 0.0
-            if th < 0.0 and tn > 0.0:
-                kick = drive[b, i] / dt
+            tn, vp = drift(th, theta_dot[b, i], acc_theta[b, i], dt, dt2)
+            kick = escapement(c, (b, i), th, tn)
+            if upward(th, tn):
                 t_cross = t_old + dt * th / (th - tn)
                 if last_up[b, i] >= 0.0:
                     _add_crossing_phase(cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
                 last_up[b, i] = t_cross
-            elif th > 0.0 and tn < 0.0:
-                kick = -drive[b, i] / dt
             if abs(tn) > overturn_angle:
                 over = 1.0
-            sn = math.sin(tn)
-            cs = math.cos(tn)
-            inv_i = 1.0 / inertia[b, i]
-            res = (kick - mgh[b, i] * sn - c_theta[b, i] * vp) * inv_i
-            qi = mh[b, i] * cs
-            sum_num += mh[b, i] * vp * vp * sn - qi * res
-            sum_den += qi * qi * inv_i
+            res, qi, num, den = pendulum_terms(c, (b, i), kick, math.sin(tn), math.cos(tn), vp)
+            sum_num += num
+            sum_den += den
             sum_kick += kick
             th_new[b, i] = tn
             rest[b, i] = res
@@ -128,10 +142,12 @@ def advance(
         for k in range(4):
             _block_sum(red, k, tid, nt)
         if tid == 0:
-            force = -c_phi[b] * phd_pred - red[2, 0]
-            phdd = (rad * red[0, 0] + force) / (total_inertia[b] - rad * rad * red[1, 0])
+            phi_next, phd_pred = drift(phi[b], phi_dot[b], acc_phi[b], dt, dt2)
+            force = disk_torque(c, b, phd_pred, red[2, 0]) + applied_torque(c, b, (s + 1) * dt)
+            phdd = disk_acceleration(c, b, red[0, 0], red[1, 0], force)
             shared[0] = phdd
             shared[1] = force
+            shared[2] = phi_next
             if red[3, 0] > 0.0:
                 status[b] |= STATUS_OVERTURNED
             if not math.isfinite(phdd):
@@ -142,8 +158,8 @@ def advance(
         phdd = shared[0]
         sum_p = 0.0
         for i in range(tid, n, nt):
-            thdd = rest[b, i] - rad * q[b, i] / inertia[b, i] * phdd
-            v = theta_dot[b, i] + 0.5 * (acc_theta[b, i] + thdd) * dt
+            thdd = theta_ddot(c, (b, i), b, rest[b, i], q[b, i], phdd)
+            v = velocity(theta_dot[b, i], acc_theta[b, i], thdd, dt)
             theta_dot[b, i] = v
             theta[b, i] = th_new[b, i]
             acc_theta[b, i] = thdd
@@ -152,22 +168,24 @@ def advance(
         cuda.syncthreads()
         _block_sum(red, 0, tid, nt)
         if tid == 0:
-            phi[b] += phi_dot[b] * dt + 0.5 * acc_phi[b] * dt2
-            if math.isinf(total_inertia[b]):
-                phi_dot[b] = 0.0
-            else:
-                p_phi[b] += 0.5 * (force_phi[b] + shared[1]) * dt
-                phi_dot[b] = (p_phi[b] - rad * red[0, 0]) / total_inertia[b]
+            phi[b] = shared[2]
+            pinned = math.isinf(c.total_inertia[b])
+            p_phi[b] = momentum(p_phi[b], force_phi[b], shared[1], dt, pinned)
+            phi_dot[b] = disk_velocity(c, b, p_phi[b], red[0, 0])
             force_phi[b] = shared[1]
             acc_phi[b] = phdd
         cuda.syncthreads()
         if (s + 1) % record_every == 0:
-            _record(b, (s + 1) // record_every, theta, theta_dot, omega, r, red, tid, nt, status)
+            _record(b, (s + 1) // record_every, theta, theta_dot, c.omega, r, red, tid, nt, status)
 
 
 @cuda.jit(device=True)
 def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status):
-    """r from the analytic phases, reduced over the block; thread 0 stores it."""
+    """r from the analytic phases, reduced over the block; thread 0 stores it. A run
+    that has diverged records nothing, as in every other backend (the test is the
+    same for all threads of the block, so none waits alone at a barrier)."""
+    if status[b] & STATUS_DIVERGED:
+        return
     n = theta.shape[1]
     re = 0.0
     im = 0.0
@@ -198,13 +216,19 @@ def advance_state(
     if state.traj_theta.shape[0]:
         raise NotImplementedError("trajectories are not recorded by the GPU backend yet")
     b, n = state.theta.shape
-    dev = {name: cuda.to_device(getattr(state, name)) for name in STATE_FIELDS + RECORD_FIELDS}
-    consts = [cuda.to_device(np.ascontiguousarray(getattr(sys, name))) for name in SYSTEM_FIELDS]
-    scratch = [cuda.device_array((b, n)) for _ in range(3)]
-    advance[b, threads or threads_for(n)](
-        *(dev[name] for name in STATE_FIELDS), *consts,
-        float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
-        *(dev[name] for name in RECORD_FIELDS), *scratch,
+    st = State(*(cuda.to_device(a) for a in state.kernel_state()))
+    constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))
+    kept = state.kernel_recording()
+    # Trajectory fields: placeholders that the kernel never reads.
+    rec = Recording(
+        *(cuda.to_device(a) for a in kept[:4]),
+        *(cuda.device_array((1,) * np.ndim(a)) for a in kept[4:]),
+    )
+    scratch = tuple(cuda.device_array((b, n)) for _ in range(3))
+    settings = settings_of(
+        dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
+        overturn_angle=overturn_angle,
     )  # fmt: skip
-    for name in STATE_FIELDS + RECORD_FIELDS:
-        dev[name].copy_to_host(getattr(state, name))
+    advance[b, threads or threads_for(n)](st, constants, settings, rec, scratch)
+    for device, host in zip(st + rec[:4], state.kernel_state() + kept[:4], strict=True):
+        device.copy_to_host(host)

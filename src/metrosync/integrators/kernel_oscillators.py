@@ -8,6 +8,9 @@ crossing to book, an overturn, an angle beyond the trig reduction's range) are
 detected by cheap reductions in the first pass and handled in a scalar pass after
 it. Reductions may be reassociated (``fastmath`` reassoc): the result differs from
 the plain reference by rounding only, and is the same for any thread count.
+
+Only loops and memory order live here: the forces come from `_physics`, the scheme's
+updates and the bookkeeping from `_kernel_parts`.
 """
 
 from __future__ import annotations
@@ -18,20 +21,41 @@ import numba as nb
 import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._kernel_parts import analytic_order, save_state, upward_crossing
-from .trig import REDUCTION_LIMIT, sincos
+from ._kernel_parts import (
+    analytic_order,
+    drift,
+    momentum,
+    save_state,
+    upward,
+    upward_crossing,
+    velocity,
+)
+from ._physics import (
+    applied_torque,
+    disk_acceleration,
+    disk_torque,
+    disk_velocity,
+    escapement,
+    pendulum_terms,
+    theta_ddot,
+)
+from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 FASTMATH = {"reassoc", "contract"}
 
 
+def arrange(constants):
+    """The constants in this layout's memory order: as built, (B, N) and (B,)."""
+    return constants
+
+
 @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-def advance(
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status,
-    mh, mgh, inertia, c_theta, drive, omega, radius, c_phi, total_inertia,
-    dt, step0, n_steps, record_every, overturn_angle,
-    r, cross_re, cross_im, cross_count,
-    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot,
-):  # fmt: skip
+def advance(st, c, settings, rec):
+    """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
+    # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
     save = traj_theta.shape[0] > 0
@@ -42,51 +66,19 @@ def advance(
         rest = np.empty(n)
         q = np.empty(n)
         crossed = np.empty(n, dtype=np.bool_)
-        inv_i = np.empty(n)
-        kick_dt = np.empty(n)
-        for i in range(n):
-            inv_i[i] = 1.0 / inertia[b, i]
-            kick_dt[i] = drive[b, i] / dt
-        rigid = math.isinf(total_inertia[b])
-        rad = radius[b]
+        pinned = math.isinf(c.total_inertia[b])
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
-            r[b, 0] = analytic_order(theta[b], theta_dot[b], omega[b])
+            r[b, 0] = analytic_order(theta[b], theta_dot[b], c.omega[b])
             if save:
                 save_state(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
-            phd_pred = phi_dot[b] + acc_phi[b] * dt
-            sum_num = 0.0
-            sum_den = 0.0
-            sum_kick = 0.0
-            n_up = 0
-            n_over = 0
-            n_far = 0
-            for i in range(n):  # vectorized pass
-                th = theta[b, i]
-                a = acc_theta[b, i]
-                tn = th + theta_dot[b, i] * dt + 0.5 * a * dt2
-                vp = theta_dot[b, i] + a * dt
-                up = (th < 0.0) & (tn > 0.0)
-                down = (th > 0.0) & (tn < 0.0)
-                kick = kick_dt[i] if up else (-kick_dt[i] if down else 0.0)
-                n_up += 1 if up else 0
-                crossed[i] = up
-                n_over += 1 if abs(tn) > overturn_angle else 0
-                n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
-                sn, cs = sincos(tn)
-                res = (kick - mgh[b, i] * sn - c_theta[b, i] * vp) * inv_i[i]
-                qi = mh[b, i] * cs
-                sum_num += mh[b, i] * vp * vp * sn - qi * res
-                sum_den += qi * qi * inv_i[i]
-                sum_kick += kick
-                th_new[i] = tn
-                rest[i] = res
-                q[i] = qi
-            if n_far > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sum_num, sum_den = _libm_pass(b, n, th_new, dt, kick_dt, theta, theta_dot, acc_theta, mh, mgh, c_theta, inv_i, rest, q)  # fmt: skip  # noqa: E501
+            sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, sincos)  # fmt: skip  # noqa: E501
+            if sums[5] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
+                sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, libm_sincos)  # fmt: skip  # noqa: E501
+            sum_num, sum_den, sum_kick, n_up, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
             if n_up > 0:
@@ -99,52 +91,61 @@ def advance(
                         n_up -= 1
                         if n_up == 0:
                             break
-            force = -c_phi[b] * phd_pred - sum_kick
-            phdd = (rad * sum_num + force) / (total_inertia[b] - rad * rad * sum_den)
+            phi_next, phd_pred = drift(phi[b], phi_dot[b], acc_phi[b], dt, dt2)
+            force = disk_torque(c, b, phd_pred, sum_kick) + applied_torque(c, b, (s + 1) * dt)
+            phdd = disk_acceleration(c, b, sum_num, sum_den, force)
             if not math.isfinite(phdd):
                 status[b] |= STATUS_DIVERGED
                 break
-            phi[b] += phi_dot[b] * dt + 0.5 * acc_phi[b] * dt2
+            phi[b] = phi_next
             sum_p = 0.0
             for i in range(n):  # vectorized pass
-                thdd = rest[i] - rad * q[i] * inv_i[i] * phdd
-                v = theta_dot[b, i] + 0.5 * (acc_theta[b, i] + thdd) * dt
+                thdd = theta_ddot(c, (b, i), b, rest[i], q[i], phdd)
+                v = velocity(theta_dot[b, i], acc_theta[b, i], thdd, dt)
                 theta_dot[b, i] = v
                 theta[b, i] = th_new[i]
                 acc_theta[b, i] = thdd
                 sum_p += q[i] * v
-            if rigid:
-                phi_dot[b] = 0.0
-            else:
-                p_phi[b] += 0.5 * (force_phi[b] + force) * dt
-                phi_dot[b] = (p_phi[b] - rad * sum_p) / total_inertia[b]
+            p_phi[b] = momentum(p_phi[b], force_phi[b], force, dt, pinned)
+            phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
             force_phi[b] = force
             acc_phi[b] = phdd
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
-                r[b, k] = analytic_order(theta[b], theta_dot[b], omega[b])
+                r[b, k] = analytic_order(theta[b], theta_dot[b], c.omega[b])
                 if save:
                     save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
 
 
-@nb.njit(cache=True)
-def _libm_pass(b, n, th_new, dt, kick_dt, theta, theta_dot, acc_theta, mh, mgh, c_theta, inv_i, rest, q):  # fmt: skip  # noqa: E501
-    """Redo the first pass with libm trig, for angles beyond the fast reduction."""
+@nb.njit(cache=True, inline="always")
+def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, th_new, rest, q, crossed, trig):  # fmt: skip  # noqa: E501
+    """New angles, kicks and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s metronomes
+    (rows ``theta``, ``theta_dot``, ``acc``), with ``trig`` = the vectorizable `sincos`
+    or, for far-wound angles, libm's. Returns the three sums and the counts of upward
+    crossings, overturned and far-wound angles."""
     sum_num = 0.0
     sum_den = 0.0
-    for i in range(n):
-        th = theta[b, i]
-        tn = th_new[i]
-        vp = theta_dot[b, i] + acc_theta[b, i] * dt
-        kick = kick_dt[i] if (th < 0.0 and tn > 0.0) else (-kick_dt[i] if (th > 0.0 and tn < 0.0) else 0.0)  # fmt: skip  # noqa: E501
-        sn = math.sin(tn)
-        cs = math.cos(tn)
-        res = (kick - mgh[b, i] * sn - c_theta[b, i] * vp) * inv_i[i]
-        qi = mh[b, i] * cs
-        sum_num += mh[b, i] * vp * vp * sn - qi * res
-        sum_den += qi * qi * inv_i[i]
+    sum_kick = 0.0
+    n_up = 0
+    n_over = 0
+    n_far = 0
+    for i in range(theta.shape[0]):  # vectorized
+        th = theta[i]
+        tn, vp = drift(th, theta_dot[i], acc[i], dt, dt2)
+        kick = escapement(c, (b, i), th, tn)
+        up = upward(th, tn)
+        n_up += 1 if up else 0
+        crossed[i] = up  # stored, not recomputed later: measurably faster (!)
+        n_over += 1 if abs(tn) > overturn_angle else 0
+        n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
+        sn, cs = trig(tn)
+        res, qi, num, den = pendulum_terms(c, (b, i), kick, sn, cs, vp)
+        sum_num += num
+        sum_den += den
+        sum_kick += kick
+        th_new[i] = tn
         rest[i] = res
         q[i] = qi
-    return sum_num, sum_den
+    return sum_num, sum_den, sum_kick, n_up, n_over, n_far

@@ -7,6 +7,11 @@ whole block at once. Sums over metronomes are per lane, so they are not reassoci
 and each run gets exactly the arithmetic of a scalar loop. Blocks are spread over
 threads. Rare events (crossings, overturns, far-wound angles) are detected by
 per-block reductions and handled in a scalar pass.
+
+Only loops and memory order live here: the forces come from `_physics`, the scheme's
+updates and the bookkeeping from `_kernel_parts`. The constants are blocked once per
+call by `arrange`, (block, N, LANES) and (block, LANES), so that `_physics` reads them
+at (block, i, lane) and (block, lane) with unit stride across the lanes.
 """
 
 from __future__ import annotations
@@ -17,23 +22,48 @@ import numba as nb
 import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._kernel_parts import analytic_order, upward_crossing
-from .trig import REDUCTION_LIMIT, sincos
+from ._kernel_parts import analytic_order, drift, momentum, upward, upward_crossing, velocity
+from ._physics import (
+    applied_torque,
+    disk_acceleration,
+    disk_torque,
+    disk_velocity,
+    escapement,
+    pendulum_terms,
+    theta_ddot,
+)
+from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 #: Runs per block: 8 doubles fill an AVX-512 register (two AVX2 registers).
 LANES = 32
 
 
+def arrange(constants):
+    """The constants blocked for this layout: per-metronome (B, N) → (block, N, LANES),
+    per-run (B,) → (block, LANES). Missing lanes of the last block repeat its last run
+    (they are computed, never written back)."""
+    runs = constants.radius.shape[0]
+    n_blocks = (runs + LANES - 1) // LANES
+    rows = np.minimum(np.arange(n_blocks * LANES), runs - 1)
+    blocked = {}
+    for name, values in constants._asdict().items():
+        padded = values[rows]
+        if values.ndim == 1:
+            blocked[name] = np.ascontiguousarray(padded.reshape(n_blocks, LANES))
+        else:
+            shape = (n_blocks, LANES, values.shape[1])
+            blocked[name] = np.ascontiguousarray(padded.reshape(shape).transpose(0, 2, 1))
+    return type(constants)(**blocked)
+
+
 @nb.njit(parallel=True, cache=True)
-def advance(
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status,
-    mh, mgh, inertia, c_theta, drive, omega, radius, c_phi, total_inertia,
-    dt, step0, n_steps, record_every, overturn_angle,
-    r, cross_re, cross_im, cross_count,
-    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot,
-):  # fmt: skip
-    """Same contract as the other kernels; arrays use the usual (B, N) layout and are
-    transposed into blocks here, once per call."""
+def advance(st, c, settings, rec):
+    """Same contract as the other kernels; the state uses the usual (B, N) layout and is
+    transposed into blocks here, once per call; ``c`` comes from `arrange`."""
+    # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
     n_rec = r.shape[1]
@@ -47,30 +77,17 @@ def advance(
         th = np.empty((n, LANES))
         thd = np.empty((n, LANES))
         acc = np.empty((n, LANES))
-        c_mh = np.empty((n, LANES))
-        c_mgh = np.empty((n, LANES))
-        c_inv = np.empty((n, LANES))
-        c_cth = np.empty((n, LANES))
-        c_kick = np.empty((n, LANES))
         for i in range(n):
             for w in range(LANES):
                 b = b0 + min(w, lanes - 1)
                 th[i, w] = theta[b, i]
                 thd[i, w] = theta_dot[b, i]
                 acc[i, w] = acc_theta[b, i]
-                c_mh[i, w] = mh[b, i]
-                c_mgh[i, w] = mgh[b, i]
-                c_inv[i, w] = 1.0 / inertia[b, i]
-                c_cth[i, w] = c_theta[b, i]
-                c_kick[i, w] = drive[b, i] / dt
         ph = np.empty(LANES)
         phd = np.empty(LANES)
         aph = np.empty(LANES)
         pp = np.empty(LANES)
         fph = np.empty(LANES)
-        rad = np.empty(LANES)
-        cph = np.empty(LANES)
-        jt = np.empty(LANES)
         alive = np.empty(LANES)
         for w in range(LANES):
             b = b0 + min(w, lanes - 1)
@@ -79,13 +96,11 @@ def advance(
             aph[w] = acc_phi[b]
             pp[w] = p_phi[b]
             fph[w] = force_phi[b]
-            rad[w] = radius[b]
-            cph[w] = c_phi[b]
-            jt[w] = total_inertia[b]
             alive[w] = 0.0 if status[b] & STATUS_DIVERGED else 1.0
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
+        ph_new = np.empty(LANES)
         phd_pred = np.empty(LANES)
         s_num = np.empty(LANES)
         s_den = np.empty(LANES)
@@ -99,39 +114,11 @@ def advance(
         if step0 == 0:
             for w in range(lanes):
                 if alive[w] > 0.0:
-                    _record(b0 + w, w, 0, th, thd, ph, phd, omega, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
-            n_far = 0
-            for w in range(LANES):
-                ups[w] = 0
-                overs[w] = 0
-                phd_pred[w] = phd[w] + aph[w] * dt
-                s_num[w] = 0.0
-                s_den[w] = 0.0
-                s_kick[w] = 0.0
-            for i in range(n):
-                for w in range(LANES):  # vectorized across runs
-                    t0 = th[i, w]
-                    a = acc[i, w]
-                    tn = t0 + thd[i, w] * dt + 0.5 * a * dt2
-                    vp = thd[i, w] + a * dt
-                    up = (t0 < 0.0) & (tn > 0.0)
-                    down = (t0 > 0.0) & (tn < 0.0)
-                    kick = c_kick[i, w] if up else (-c_kick[i, w] if down else 0.0)
-                    ups[w] += 1 if up else 0
-                    overs[w] += 1 if abs(tn) > overturn_angle else 0
-                    n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
-                    sn, cs = sincos(tn)
-                    res = (kick - c_mgh[i, w] * sn - c_cth[i, w] * vp) * c_inv[i, w]
-                    qi = c_mh[i, w] * cs
-                    s_num[w] += c_mh[i, w] * vp * vp * sn - qi * res
-                    s_den[w] += qi * qi * c_inv[i, w]
-                    s_kick[w] += kick
-                    tn_s[i, w] = tn
-                    rest[i, w] = res
-                    q[i, w] = qi
-            if n_far > 0:  # rare: redo the sums with libm trig
-                _libm_pass(n, th, thd, acc, tn_s, c_mh, c_mgh, c_cth, c_inv, c_kick, dt, rest, q, s_num, s_den)  # fmt: skip  # noqa: E501
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, sincos)  # fmt: skip  # noqa: E501
+            if n_far > 0:  # rare: redo the pass with libm trig
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, libm_sincos)  # fmt: skip  # noqa: E501
             t_old = s * dt
             for w in range(lanes):
                 if ups[w] > 0 or overs[w] > 0:
@@ -144,13 +131,15 @@ def advance(
                             break
                         t0 = th[i, w]
                         tn = tn_s[i, w]
-                        if t0 < 0.0 and tn > 0.0:
+                        if upward(t0, tn):
                             t_cross = t_old + dt * t0 / (t0 - tn)
                             upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
                             ups[w] -= 1
+            t_new = (s + 1) * dt
             for w in range(LANES):
-                force[w] = -cph[w] * phd_pred[w] - s_kick[w]
-                phdd[w] = (rad[w] * s_num[w] + force[w]) / (jt[w] - rad[w] * rad[w] * s_den[w])
+                ph_new[w], phd_pred[w] = drift(ph[w], phd[w], aph[w], dt, dt2)
+                force[w] = disk_torque(c, (blk, w), phd_pred[w], s_kick[w]) + applied_torque(c, (blk, w), t_new)  # fmt: skip  # noqa: E501
+                phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
             for w in range(lanes):
                 if alive[w] > 0.0 and not math.isfinite(phdd[w]):
@@ -159,20 +148,17 @@ def advance(
             for i in range(n):
                 for w in range(LANES):  # vectorized across runs
                     keep = alive[w] > 0.0
-                    thdd = rest[i, w] - rad[w] * q[i, w] * c_inv[i, w] * phdd[w]
-                    v = thd[i, w] + 0.5 * (acc[i, w] + thdd) * dt
+                    thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], phdd[w])
+                    v = velocity(thd[i, w], acc[i, w], thdd, dt)
                     thd[i, w] = v if keep else thd[i, w]
                     th[i, w] = tn_s[i, w] if keep else th[i, w]
                     acc[i, w] = thdd if keep else acc[i, w]
                     s_p[w] += q[i, w] * v
             for w in range(LANES):
                 if alive[w] > 0.0:
-                    ph[w] += phd[w] * dt + 0.5 * aph[w] * dt2
-                    if math.isinf(jt[w]):
-                        phd[w] = 0.0
-                    else:
-                        pp[w] += 0.5 * (fph[w] + force[w]) * dt
-                        phd[w] = (pp[w] - rad[w] * s_p[w]) / jt[w]
+                    ph[w] = ph_new[w]
+                    pp[w] = momentum(pp[w], fph[w], force[w], dt, math.isinf(c.total_inertia[blk, w]))  # fmt: skip  # noqa: E501
+                    phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
             until_record -= 1
@@ -181,7 +167,7 @@ def advance(
                 k = (s + 1) // record_every
                 for w in range(lanes):
                     if alive[w] > 0.0:
-                        _record(b0 + w, w, k, th, thd, ph, phd, omega, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for w in range(lanes):
             b = b0 + w
             for i in range(n):
@@ -195,31 +181,41 @@ def advance(
             force_phi[b] = fph[w]
 
 
-@nb.njit(cache=True)
-def _libm_pass(n, th, thd, acc, tn_s, c_mh, c_mgh, c_cth, c_inv, c_kick, dt, rest, q, s_num, s_den):  # fmt: skip  # noqa: E501
-    """Redo the first pass's trig and sums with libm, for far-wound angles."""
+@nb.njit(cache=True, inline="always")
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, trig):  # fmt: skip  # noqa: E501
+    """New angles, kicks and the per-lane sums of eqs. (eqm1)–(eqm2) for block ``blk``,
+    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's. Fills
+    the per-lane counts of upward crossings and overturns; returns the number of
+    far-wound angles."""
+    n_far = 0
     for w in range(th.shape[1]):
+        ups[w] = 0
+        overs[w] = 0
         s_num[w] = 0.0
         s_den[w] = 0.0
-    for i in range(n):
-        for w in range(th.shape[1]):
+        s_kick[w] = 0.0
+    for i in range(th.shape[0]):
+        for w in range(th.shape[1]):  # vectorized across runs
             t0 = th[i, w]
-            tn = tn_s[i, w]
-            vp = thd[i, w] + acc[i, w] * dt
-            kick = c_kick[i, w] if (t0 < 0.0 and tn > 0.0) else (-c_kick[i, w] if (t0 > 0.0 and tn < 0.0) else 0.0)  # fmt: skip  # noqa: E501
-            sn = math.sin(tn)
-            cs = math.cos(tn)
-            res = (kick - c_mgh[i, w] * sn - c_cth[i, w] * vp) * c_inv[i, w]
-            qi = c_mh[i, w] * cs
-            s_num[w] += c_mh[i, w] * vp * vp * sn - qi * res
-            s_den[w] += qi * qi * c_inv[i, w]
+            tn, vp = drift(t0, thd[i, w], acc[i, w], dt, dt2)
+            kick = escapement(c, (blk, i, w), t0, tn)
+            ups[w] += 1 if upward(t0, tn) else 0
+            overs[w] += 1 if abs(tn) > overturn_angle else 0
+            n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
+            sn, cs = trig(tn)
+            res, qi, num, den = pendulum_terms(c, (blk, i, w), kick, sn, cs, vp)
+            s_num[w] += num
+            s_den[w] += den
+            s_kick[w] += kick
+            tn_s[i, w] = tn
             rest[i, w] = res
             q[i, w] = qi
+    return n_far
 
 
 @nb.njit(cache=True, inline="always")
-def _record(b, w, k, th, thd, ph, phd, omega, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
-    r[b, k] = analytic_order(th[:, w], thd[:, w], omega[b])
+def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+    r[b, k] = analytic_order(th[:, w], thd[:, w], c.omega[blk, :, w])
     if save:
         for i in range(th.shape[0]):
             traj_theta[b, k, i] = th[i, w]

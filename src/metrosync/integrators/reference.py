@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations
+from ..equations import SystemArrays, accelerations, disk_torque
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._state import StepState
 
@@ -55,18 +55,20 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
             state.last_up[b, i] = t_cross
         overturned = np.any(np.abs(th_new) > overturn_angle, axis=1) & alive
         state.status[overturned] |= STATUS_OVERTURNED
-        phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, kick)
+        t_new = (s + 1) * dt
+        phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, kick, t_new)
         diverged = ~np.isfinite(phdd) & alive
         state.status[diverged] |= STATUS_DIVERGED
         ok = alive & ~diverged
-        force = -sys.c_phi * phd_pred - kick.sum(axis=1)
+        force = disk_torque(sys, phd_pred, kick, t_new)
         new_theta_dot = state.theta_dot + 0.5 * (acc + thdd) * dt
         coupling = sys.radius * np.sum(sys.mh * np.cos(th_new) * new_theta_dot, axis=1)
         new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt
         with np.errstate(invalid="ignore"):
             new_phi_dot = np.where(rigid, 0.0, (new_p - coupling) / sys.total_inertia)
         ok2 = ok[:, None]
-        state.phi[ok] += state.phi_dot[ok] * dt + 0.5 * state.acc_phi[ok] * dt * dt
+        phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * dt * dt
+        state.phi[ok] = phi_new[ok]
         state.theta[...] = np.where(ok2, th_new, th)
         state.theta_dot[...] = np.where(ok2, new_theta_dot, state.theta_dot)
         state.acc_theta[...] = np.where(ok2, thdd, acc)

@@ -61,3 +61,10 @@ def sincos(x):
     sin_x = -sin_x if q & 2 else sin_x
     cos_x = -cos_x if (q + 1) & 2 else cos_x
     return sin_x, cos_x
+
+
+@nb.njit(inline="always", cache=True)
+def libm_sincos(x):
+    """(sin x, cos x) from libm: the fallback beyond `REDUCTION_LIMIT`, with the same
+    calling convention as `sincos` so that a kernel can pass either to one loop."""
+    return math.sin(x), math.cos(x)

@@ -24,16 +24,14 @@ running sums of the crossing-interpolated phase (docs/model.md §7).
 
 from __future__ import annotations
 
-from . import kernel_oscillators, kernel_runs, kernel_scalar
+from . import kernel_oscillators, kernel_runs
+from ._abi import constants_of, settings_of
 from ._cache import heal_compile_cache
-from ._state import StepState, kernel_arguments
+from ._state import StepState
 
-#: Kernels by memory layout (see each module's docstring).
-KERNELS = {
-    "runs": kernel_runs.advance,
-    "oscillators": kernel_oscillators.advance,
-    "scalar": kernel_scalar.advance,
-}
+#: Kernel modules by memory layout (see each module's docstring): each has
+#: ``arrange(constants)`` and ``advance(state, constants, settings, recording)``.
+LAYOUTS = {"runs": kernel_runs, "oscillators": kernel_oscillators}
 #: Runs go innermost when a run has too few metronomes to fill vector registers and
 #: there are enough runs to fill a block; otherwise metronomes do. Both thresholds
 #: were measured with benchmarks/kernel.py on the 2-core AVX-512 machine.
@@ -55,15 +53,16 @@ def advance_state(
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from N)."""
     heal_compile_cache()
-    kernel = KERNELS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
-    kernel(
-        *kernel_arguments(
-            state,
-            sys,
+    kernel = LAYOUTS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
+    kernel.advance(
+        state.kernel_state(),
+        kernel.arrange(constants_of(sys, dt)),
+        settings_of(
             dt=dt,
             step0=step0,
             n_steps=n_steps,
             record_every=record_every,
             overturn_angle=overturn_angle,
-        )
+        ),
+        state.kernel_recording(),
     )

@@ -7,9 +7,15 @@ weight ``w2`` at ``L2`` above it. Following the paper,
 
 and the inertia that multiplies θ̈ in eq. (metron2) is ``m h² + J_i``. The paper calls
 ``J_i`` the moment "relative to the centre of mass" but computes it about the pivot;
-we keep the paper's expression as written (MODEL-NOTES "The system").
+we keep the paper's expression as written (docs/model.md §6.7).
 
-Tuning (MODEL-NOTES §1–2): one beat is half a period, so ω = π·BPM/60, and ``L2`` for
+These quantities are computed in one place, by array functions (`centre_of_mass`,
+`pivot_moment`, `pendulum_inertia`, `natural_omega`) that take scalars or arrays:
+`Metronome`'s properties call them for one metronome, `model.system` for a whole
+ensemble. `MetronomeDesign.check_tunable` is the one check (and message) that a BPM
+lies in the range the slider can reach.
+
+Tuning (docs/model.md §6.1–6.2): one beat is half a period, so ω = π·BPM/60, and ``L2`` for
 a nominal BPM inverts the model's own small-amplitude frequency on a rigid support,
 ω² = m g h / (m h² + J_i). That relation is quadratic in ``L2``, so it is solved in
 closed form.
@@ -22,7 +28,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import ParameterError, require_finite, require_positive
+from ..errors import ParameterError, describe, require_finite, require_positive
 
 STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
 
@@ -38,6 +44,29 @@ def bpm_to_omega(bpm):
 def omega_to_bpm(omega):
     """Inverse of `bpm_to_omega`."""
     return 60.0 * np.asarray(omega, dtype=float) / np.pi
+
+
+def centre_of_mass(w1, w2, l1, l2):
+    """h = (w1 L1 − w2 L2) / (w1 + w2): pivot to centre-of-mass distance, m (paper §4).
+    Scalars or arrays that broadcast."""
+    return (w1 * l1 - w2 * l2) / (w1 + w2)
+
+
+def pivot_moment(w1, w2, l1, l2):
+    """The paper's J_i = w1 L1² + w2 L2², kg m²."""
+    return w1 * l1**2 + w2 * l2**2
+
+
+def pendulum_inertia(w1, w2, l1, l2):
+    """m h² + J_i, the coefficient of θ̈ in eq. (metron2), kg m²."""
+    return (w1 + w2) * centre_of_mass(w1, w2, l1, l2) ** 2 + pivot_moment(w1, w2, l1, l2)
+
+
+def natural_omega(w1, w2, l1, l2, g):
+    """Small-amplitude angular frequency on a rigid support, ω = √(m g h / (m h² + J_i)),
+    rad/s. Needs h > 0."""
+    h = centre_of_mass(w1, w2, l1, l2)
+    return np.sqrt((w1 + w2) * g * h / pendulum_inertia(w1, w2, l1, l2))
 
 
 @dataclass(frozen=True)
@@ -123,19 +152,50 @@ class MetronomeDesign:
             bounds = (math.floor(needed * 1e4) / 1e4, hi)
         return text + f", or widen `l2_bounds` to ({bounds[0]:g}, {bounds[1]:g}) m."
 
+    def check_tunable(
+        self,
+        bpm,
+        *,
+        name: str = "bpm",
+        what: str | None = None,
+        fix: str | None = None,
+    ) -> None:
+        """Raise `ParameterError` unless every value of ``bpm`` is finite and within
+        `bpm_range`.
+
+        ``name`` is the argument as the caller wrote it; an out-of-range entry of an
+        array is named with its index (`frequencies_bpm[1]`), and the message offers
+        `l2_bounds` that would reach it (`out_of_range`). A caller whose values are not
+        the user's own (drawn frequencies, a sweep axis) gives ``what`` (``{value}`` is
+        the first value out of range) and ``fix`` instead.
+        """
+        bpm_arr = np.asarray(bpm, dtype=float)
+        if not np.all(np.isfinite(bpm_arr)):
+            raise ParameterError(f"`{name}` must be finite, got {describe(bpm)}.")
+        low, high = self.bpm_range()
+        bad = (bpm_arr < low) | (bpm_arr > high)
+        if not np.any(bad):
+            return
+        first = tuple(np.argwhere(bad)[0])
+        value = float(bpm_arr[first])
+        if what is None and fix is None:
+            where = "".join(f"[{int(k)}]" for k in first)
+            raise ParameterError(self.out_of_range(f"{name}{where}", value))
+        subject = what.format(value=value) if what else f"`{name}` = {value:.6g}"
+        raise ParameterError(
+            f"{subject} is outside the tunable range [{low:.2f}, {high:.2f}] BPM of this "
+            f"metronome design (slider L2 in {self.l2_bounds} m). "
+            f"{fix or 'Choose a BPM in range.'}"
+        )
+
     def l2_for_bpm(self, bpm):
         """Slider position ``L2`` (m) that tunes the metronome to ``bpm``.
 
         Solves ω²(m h² + J_i) = m g h, a quadratic in ``L2``, in closed form.
         Accepts scalars or arrays; raises `ParameterError` for BPM outside `bpm_range`.
         """
+        self.check_tunable(bpm)
         bpm_arr = np.asarray(bpm, dtype=float)
-        if not np.all(np.isfinite(bpm_arr)):
-            raise ParameterError(f"`bpm` must be finite, got {bpm!r}.")
-        low, high = self.bpm_range()
-        bad = (bpm_arr < low) | (bpm_arr > high)
-        if np.any(bad):
-            raise ParameterError(self.out_of_range("bpm", float(bpm_arr[bad].flat[0])))
         w1, w2, l1, g = self.w1, self.w2, self.l1, self.g
         m = w1 + w2
         a = w1 * l1
@@ -178,23 +238,25 @@ class Metronome:
     def h(self) -> float:
         """Pivot to centre-of-mass distance, m (paper §4)."""
         d = self.design
-        return (d.w1 * d.l1 - d.w2 * self.l2) / d.mass
+        return float(centre_of_mass(d.w1, d.w2, d.l1, self.l2))
 
     @property
     def j(self) -> float:
         """The paper's J_i = w1 L1² + w2 L2², kg m²."""
         d = self.design
-        return d.w1 * d.l1**2 + d.w2 * self.l2**2
+        return float(pivot_moment(d.w1, d.w2, d.l1, self.l2))
 
     @property
     def inertia(self) -> float:
         """The coefficient of θ̈ in eq. (metron2): m h² + J_i, kg m²."""
-        return self.mass * self.h**2 + self.j
+        d = self.design
+        return float(pendulum_inertia(d.w1, d.w2, d.l1, self.l2))
 
     @property
     def natural_omega(self) -> float:
         """Small-amplitude angular frequency on a rigid support, rad/s."""
-        return math.sqrt(self.mass * self.design.g * self.h / self.inertia)
+        d = self.design
+        return float(natural_omega(d.w1, d.w2, d.l1, self.l2, d.g))
 
     @property
     def natural_bpm(self) -> float:

@@ -252,13 +252,7 @@ class Grid:
                     f"amplitude: `amplitude` (--amplitude 0.5, or amplitude = 0.5 under [fixed] "
                     f"in the grid file)."
                 )
-            low, high = params.metronome.bpm_range()
-            bad = [b for b in bpms if not low <= b <= high]
-            if bad:
-                raise ParameterError(
-                    f"`bpm` = {bad[0]!r} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
-                    f"of the metronome design; narrow the `bpm` axis."
-                )
+            params.metronome.check_tunable(bpms, fix="Narrow the `bpm` axis.")
 
     @classmethod
     def from_toml(cls, path: str | Path, **overrides) -> Grid:

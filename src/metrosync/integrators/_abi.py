@@ -1,0 +1,89 @@
+"""The one argument list of every compiled fixed-step kernel: four NamedTuples.
+
+Every CPU layout and the GPU kernel is called as ``advance(state, constants, settings,
+recording)``; numba compiles a NamedTuple of arrays as a plain struct, so this costs
+nothing over positional arguments.
+
+``State``      what a step changes, (B, N) and (B,) arrays, updated in place.
+``Constants``  every field of `SystemArrays` (so a new model constant reaches the
+               kernels without touching this file), plus what each step reuses:
+               ``inv_inertia`` = 1/(m h² + J_i) and ``kick_rate`` = M/dt, the
+               escapement torque of the paper's discrete scheme. Per-metronome
+               fields are (B, N), per-run fields (B,); a layout may rearrange them
+               (`kernel_runs.arrange`), never rename them.
+``Settings``   the scalars of one call: step, first step, step count, record spacing,
+               overturn angle.
+``Recording``  the record buffers, (B, n_rec) and trajectories (B, n_rec, N), or
+               (0, 0, 0) placeholders when trajectories are not kept.
+
+numba issues 5872/7135/10338 (open in 0.68): a write through a NamedTuple field inside
+``prange`` can be silently lost. A kernel therefore unpacks every array it writes
+into a local name before its parallel loop; reading through a field is safe. The
+equivalence tests (every layout against the NumPy reference) guard this.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+from dataclasses import fields
+from typing import NamedTuple
+
+import numpy as np
+
+from ..model.system import SystemArrays
+
+
+class State(NamedTuple):
+    """Integration state, see `StepState` for the meaning of each field."""
+
+    theta: np.ndarray
+    theta_dot: np.ndarray
+    phi: np.ndarray
+    phi_dot: np.ndarray
+    acc_theta: np.ndarray
+    acc_phi: np.ndarray
+    p_phi: np.ndarray
+    force_phi: np.ndarray
+    last_up: np.ndarray
+    status: np.ndarray
+
+
+#: Fields of `Constants` that are not in `SystemArrays`: derived once per call.
+DERIVED_CONSTANTS = ("inv_inertia", "kick_rate")
+
+#: The model's constants as the kernels read them (generated from `SystemArrays`).
+Constants = namedtuple(
+    "Constants", [f.name for f in fields(SystemArrays)] + list(DERIVED_CONSTANTS)
+)
+
+
+class Settings(NamedTuple):
+    dt: float
+    step0: int
+    n_steps: int
+    record_every: int
+    overturn_angle: float
+
+
+class Recording(NamedTuple):
+    r: np.ndarray
+    cross_re: np.ndarray
+    cross_im: np.ndarray
+    cross_count: np.ndarray
+    traj_theta: np.ndarray
+    traj_theta_dot: np.ndarray
+    traj_phi: np.ndarray
+    traj_phi_dot: np.ndarray
+
+
+def constants_of(sys: SystemArrays, dt: float):
+    """The kernels' `Constants` for a step ``dt``: C-contiguous float arrays."""
+    arrays = {f.name: np.ascontiguousarray(getattr(sys, f.name), dtype=float) for f in fields(sys)}
+    # The same expressions as the NumPy reference (1/I is exact to rounding; M/dt too).
+    arrays["inv_inertia"] = 1.0 / arrays["inertia"]
+    arrays["kick_rate"] = arrays["drive"] / dt
+    return Constants(**arrays)
+
+
+def settings_of(*, dt, step0, n_steps, record_every, overturn_angle) -> Settings:
+    return Settings(float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle))

@@ -1,0 +1,107 @@
+"""The constants of an ensemble as arrays: `SystemArrays` and its one builder.
+
+Contract: `system_arrays` turns the model's parameters and the (B, N) slider positions
+(and, for explicitly given metronomes, per-metronome design values) into the per-run
+(B,) and per-metronome (B, N) constants that every integrator consumes. Every
+constant of a model term is computed here and nowhere else; the compiled kernels
+receive all of `SystemArrays` (`integrators._abi.Constants`), so a new term adds its
+field and its line here, its force to `integrators._physics` and to `equations`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from .metronome import centre_of_mass, natural_omega, pendulum_inertia
+from .presets import ModelParameters
+
+#: The design values that may differ per metronome (`MetronomeDesign` fields).
+PER_METRONOME = ("w1", "w2", "l1", "c_theta", "drive", "g")
+
+
+@dataclass(frozen=True)
+class SystemArrays:
+    """Per-run and per-metronome constants of an ensemble, in SI units.
+
+    Shapes: per-metronome fields (B, N), per-run fields (B,).
+
+    mh : m_i h_i.   mgh : m_i g h_i.   inertia : m_i h_i² + J_i.
+    c_theta, drive : friction c_θ and escapement impulse M of each metronome.
+    omega : small-amplitude natural frequency on a rigid support, rad/s.
+    radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
+    in eq. (metron2a)); ``inf`` pins the disk.
+    """
+
+    mh: np.ndarray
+    mgh: np.ndarray
+    inertia: np.ndarray
+    c_theta: np.ndarray
+    drive: np.ndarray
+    omega: np.ndarray
+    radius: np.ndarray
+    c_phi: np.ndarray
+    total_inertia: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.mh.shape  # type: ignore[return-value]
+
+    def run(self, b: int) -> SystemArrays:
+        """The constants of run ``b`` alone, as a batch of one."""
+        return SystemArrays(**{k: v[b : b + 1] for k, v in vars(self).items()})
+
+
+def system_arrays(
+    params: ModelParameters,
+    l2: np.ndarray,
+    per_metronome: Mapping[str, np.ndarray] | None = None,
+) -> tuple[SystemArrays, np.ndarray]:
+    """The constants of B runs × N metronomes.
+
+    Parameters
+    ----------
+    params : the model's parameters (design and platform).
+    l2 : (B, N) slider positions, m.
+    per_metronome : (B, N) arrays of the `PER_METRONOME` design values, for metronomes
+        given one by one; default ``params.metronome``'s values for every metronome.
+
+    Returns
+    -------
+    The `SystemArrays`, and the disk's own inertia J, (B,) kg m².
+    """
+    runs, n = l2.shape
+    design = params.metronome
+    values = {
+        name: np.broadcast_to(
+            per_metronome[name] if per_metronome is not None else getattr(design, name),
+            (runs, n),
+        )
+        for name in PER_METRONOME
+    }
+    w1, w2, l1, g = values["w1"], values["w2"], values["l1"], values["g"]
+    h = centre_of_mass(w1, w2, l1, l2)
+    if np.any(h <= 0):
+        raise ParameterError(
+            "a metronome has h <= 0 (its centre of mass is above the pivot, so the pendulum "
+            "is inverted); lower its slider `l2` below w1*l1/w2."
+        )
+    mass = w1 + w2
+    platform = params.platform
+    disk = np.full(runs, platform.disk_inertia(n))
+    radius = np.full(runs, platform.radius)
+    system = SystemArrays(
+        mh=mass * h,
+        mgh=mass * g * h,
+        inertia=pendulum_inertia(w1, w2, l1, l2),
+        c_theta=np.array(values["c_theta"], dtype=float),
+        drive=np.array(values["drive"], dtype=float),
+        omega=natural_omega(w1, w2, l1, l2, g),
+        radius=radius,
+        c_phi=np.full(runs, platform.c_phi),
+        total_inertia=disk + radius**2 * mass.sum(axis=1),
+    )
+    return system, disk
