@@ -125,7 +125,8 @@ def build_ensemble(
             freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
             _require_explicit("frequencies_bpm", freq.shape[1], n, sigma_bpm)
             n = freq.shape[1]
-            design.check_tunable(np.asarray(frequencies_bpm, dtype=float), name="frequencies_bpm")
+            written = np.asarray(frequencies_bpm, dtype=float)  # so an entry is named as written
+            design.check_tunable(written, name="frequencies_bpm", index=True)
         else:
             n = _require_count("n", n)
             if bpm is None or not math.isfinite(float(bpm)):

@@ -157,14 +157,16 @@ class MetronomeDesign:
         bpm,
         *,
         name: str = "bpm",
+        index: bool = False,
         what: str | None = None,
         fix: str | None = None,
     ) -> None:
         """Raise `ParameterError` unless every value of ``bpm`` is finite and within
         `bpm_range`.
 
-        ``name`` is the argument as the caller wrote it; an out-of-range entry of an
-        array is named with its index (`frequencies_bpm[1]`), and the message offers
+        ``name`` is the argument as the caller wrote it; with ``index``, an out-of-range
+        entry of an array the user wrote is named with its index (`frequencies_bpm[1]`;
+        not for a grid the program built). The message offers
         `l2_bounds` that would reach it (`out_of_range`). A caller whose values are not
         the user's own (drawn frequencies, a sweep axis) gives ``what`` (``{value}`` is
         the first value out of range) and ``fix`` instead.
@@ -179,7 +181,7 @@ class MetronomeDesign:
         first = tuple(np.argwhere(bad)[0])
         value = float(bpm_arr[first])
         if what is None and fix is None:
-            where = "".join(f"[{int(k)}]" for k in first)
+            where = "".join(f"[{int(k)}]" for k in first) if index else ""
             raise ParameterError(self.out_of_range(f"{name}{where}", value))
         subject = what.format(value=value) if what else f"`{name}` = {value:.6g}"
         raise ParameterError(
