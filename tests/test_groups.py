@@ -11,7 +11,7 @@ from metrosync.observables.order import analytic_phase, order_parameter
 
 
 def test_two_groups_20_bpm_apart_each_synchronize_while_the_global_r_stays_lower():
-    ds = simulate(None, None, groups=[(7, 184.0), (7, 200.0)], sigma_bpm=0.25, runs=8,
+    ds = simulate(None, None, groups=[(7, 184.0), (7, 204.0)], sigma_bpm=0.25, runs=8,
                   duration=300, seed=3)  # fmt: skip
     assert (ds.status == 0).all()
     r_eq_group = ds.r_eq_group.values  # (run, group)
@@ -89,13 +89,16 @@ def test_ungrouped_runs_have_no_group_variables():
     [
         ([], r"`groups` must be a non-empty list"),
         ("7@184", r"`groups` must be a non-empty list"),
-        ([(7,)], r"`groups\[0\]` must be \(n, bpm\)"),
-        ([(7, 184.0), (0, 200.0)], r"`groups\[1\]`: the count n must be an integer >= 1, got 0"),
-        ([(7.5, 184.0)], r"`groups\[0\]`: the count n must be an integer"),
-        ([(7, "fast")], r"`groups\[0\]`: `bpm` must be a finite number, got 'fast'"),
-        ([(7, 184.0, -1.0)], r"`groups\[0\]`: `sigma_bpm` must be >= 0 BPM, got -1.0"),
-        ([(7, 900.0)], r"`groups\[0\]` \(7@900:0\) has `bpm` 900.0, which is outside .* Move that"),
-        ([(7, 184.0, 400.0)], r"with `groups\[0\]` = 7@184:400, a drawn natural frequency"),
+        ([(7,)], r"`groups` entry 0 must be \(n, bpm\)"),
+        ([(7, 184.0), (0, 200.0)], r"`groups` entry 1: the count n must be an integer >= 1, got 0"),
+        ([(7.5, 184.0)], r"`groups` entry 0: the count n must be an integer"),
+        ([(7, "fast")], r"`groups` entry 0: `bpm` must be a finite number, got 'fast'"),
+        ([(7, 184.0, -1.0)], r"`groups` entry 0: `sigma_bpm` must be >= 0 BPM, got -1.0"),
+        (
+            [(7, 900.0)],
+            r"`groups` entry 0 \(7@900:0\) has BPM 900.0, which is outside .* Move that",
+        ),
+        ([(7, 184.0, 400.0)], r"with `groups` entry 0 \(7@184:400\), a drawn natural frequency"),
     ],
 )
 def test_bad_groups_name_the_entry_and_the_fix(groups, match):

@@ -137,7 +137,7 @@ def build_ensemble(
         for k, g in enumerate(groups):
             design.check_tunable(
                 g.bpm,
-                what=f"`groups[{k}]` ({g.label()}) has `bpm` {{value!r}}, which",
+                what=f"`groups` entry {k} ({g.label()}) has BPM {{value!r}}, which",
                 fix="Move that group's BPM into the range.",
             )
         n = sum(g.n for g in groups)
@@ -148,7 +148,7 @@ def build_ensemble(
         for k, (g, lo) in enumerate(zip(groups, group_bounds(groups), strict=False)):
             design.check_tunable(
                 freq[:, lo : lo + g.n],
-                what=f"with `groups[{k}]` = {g.label()}, a drawn natural frequency "
+                what=f"with `groups` entry {k} ({g.label()}), a drawn natural frequency "
                 "({value:.2f} BPM)",
                 fix="Lower that group's sigma or move its BPM inward.",
             )

@@ -52,7 +52,7 @@ def as_groups(groups, sigma_bpm: float) -> tuple[Group, ...]:
         )
     out = []
     for k, item in enumerate(groups):
-        where = f"`groups[{k}]`"
+        where = f"`groups` entry {k}"
         if isinstance(item, Group):
             item = (item.n, item.bpm, item.sigma_bpm)
         if (
