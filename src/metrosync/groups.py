@@ -2,12 +2,14 @@
 
 Contract: a `Group` is N metronomes whose natural frequencies are drawn from
 Normal(bpm, sigma_bpm), as one ungrouped ensemble's are. `as_groups` checks what a
-user gives ``simulate(groups=...)`` (tuples ``(n, bpm)`` or ``(n, bpm, sigma_bpm)``, or
-`Group`\\ s) and fills in the ensemble's spread where a group gives none;
-`parse_group` reads the command line's ``N@BPM[:SIGMA]``. Groups are laid out one after
-the other along the metronome axis, so group g is metronomes
-``group_bounds(groups)[g]`` to ``group_bounds(groups)[g + 1] - 1``; the kernels use
-these bounds to record each group's order parameter.
+user gives ``simulate(groups=...)`` (tuples ``(n, bpm)`` or ``(n, bpm, sigma_bpm)``,
+`Group` objects, or the command line's ``"N@BPM[:SIGMA]"``, which `parse_group` reads)
+and fills in the ensemble's spread where a group gives none. `shifted` moves every
+group after the first by an offset in BPM, the axis a sweep varies
+(``group_offset_bpm``). Groups are laid out one after the other along the metronome
+axis, so group g is metronomes ``group_bounds(groups)[g]`` to
+``group_bounds(groups)[g + 1] - 1``; the kernels use these bounds to record each
+group's order parameter.
 
 The paper's closing section names this study: "systems where the metronomes or groups
 of metronomes are fixed to different natural frequencies".
@@ -39,11 +41,12 @@ class Group:
         return text if self.sigma_bpm is None else f"{text}:{self.sigma_bpm:g}"
 
 
-def as_groups(groups, sigma_bpm: float) -> tuple[Group, ...]:
+def as_groups(groups, sigma_bpm: float | None) -> tuple[Group, ...]:
     """Checked groups from ``simulate(groups=...)``, each with its spread resolved.
 
-    ``groups`` : a non-empty sequence of `Group` or tuples ``(n, bpm)`` /
-    ``(n, bpm, sigma_bpm)``. ``sigma_bpm`` : the spread of groups that give none.
+    ``groups`` : a non-empty sequence of `Group`, tuples ``(n, bpm)`` /
+    ``(n, bpm, sigma_bpm)`` or texts ``"N@BPM[:SIGMA]"``. ``sigma_bpm`` : the spread
+    of groups that give none (None leaves it unset, for a sweep to fill per point).
     """
     if isinstance(groups, str | bytes) or not isinstance(groups, Sequence) or not groups:
         raise ParameterError(
@@ -53,6 +56,11 @@ def as_groups(groups, sigma_bpm: float) -> tuple[Group, ...]:
     out = []
     for k, item in enumerate(groups):
         where = f"`groups` entry {k}"
+        if isinstance(item, str):
+            try:
+                item = parse_group(item)
+            except ValueError as error:
+                raise ParameterError(f"{where}: {error}.") from None
         if isinstance(item, Group):
             item = (item.n, item.bpm, item.sigma_bpm)
         if (
@@ -67,8 +75,16 @@ def as_groups(groups, sigma_bpm: float) -> tuple[Group, ...]:
         sigma = rest[0] if rest and rest[0] is not None else sigma_bpm
         if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
             raise ParameterError(f"{where}: the count n must be an integer >= 1, got {n!r}.")
-        out.append(Group(int(n), _number(where, "bpm", bpm), _spread(where, sigma)))
+        spread = None if sigma is None else _spread(where, sigma)
+        out.append(Group(int(n), _number(where, "bpm", bpm), spread))
     return tuple(out)
+
+
+def shifted(groups: Sequence[Group], offset_bpm: float) -> tuple[Group, ...]:
+    """The groups with ``offset_bpm`` added to the BPM of every group after the first."""
+    return tuple(
+        g if k == 0 else Group(g.n, g.bpm + offset_bpm, g.sigma_bpm) for k, g in enumerate(groups)
+    )
 
 
 def parse_group(text: str) -> Group:
