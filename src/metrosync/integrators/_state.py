@@ -158,14 +158,17 @@ class Records:
 
 def records_of(state: StepState) -> Records:
     traj = state.traj_theta.shape[0] > 0
+    r_crossing = state.crossing_order()
+    grouped = state.group_start.size > 2
     return Records(
         r=state.r,
-        r_crossing=state.crossing_order(),
+        r_crossing=r_crossing,
         status=state.status,
         theta=state.traj_theta if traj else None,
         theta_dot=state.traj_theta_dot if traj else None,
         phi=state.traj_phi if traj else None,
         phi_dot=state.traj_phi_dot if traj else None,
+        # One group: views of the global records, no copies.
         r_group=state.group_order(),
-        r_crossing_group=state.group_crossing_order(),
+        r_crossing_group=state.group_crossing_order() if grouped else r_crossing[:, :, None],
     )
