@@ -135,7 +135,7 @@ class StepState:
 
     def group_order(self) -> np.ndarray:
         """Each group's analytic-phase r, (B, n_rec, G)."""
-        return self.r_group if self.r_group.shape[0] else self.r[:, :, None]
+        return self.r_group if self.group_start.size > 2 else self.r[:, :, None]
 
 
 @dataclass

@@ -192,7 +192,7 @@ def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status, r_group, gro
     value = _order(b, 0, theta.shape[1], theta, theta_dot, omega, red, tid, nt)
     if tid == 0:
         r[b, k] = value
-    if r_group.shape[0] > 0:
+    if group_start.shape[0] > 2:  # several groups
         for g in range(group_start.shape[0] - 1):
             lo = group_start[g]
             hi = group_start[g + 1]
@@ -236,11 +236,13 @@ def advance_state(
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
     constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))
     kept = state.kernel_recording()
-    # Trajectory fields: placeholders that the kernel never reads.
+    grouped = state.group_start.size > 2
+    # Trajectory fields, and r_group of one group: placeholders the kernel never reads.
     rec = Recording(
         *(cuda.to_device(a) for a in kept[:4]),
         *(cuda.device_array((1,) * np.ndim(a)) for a in kept[4:8]),
-        *(cuda.to_device(a) for a in kept[8:]),
+        cuda.to_device(kept.r_group) if grouped else cuda.device_array((1, 1, 1)),
+        cuda.to_device(kept.group_start),
     )
     scratch = tuple(cuda.device_array((b, n)) for _ in range(3))
     settings = settings_of(
@@ -248,5 +250,7 @@ def advance_state(
         overturn_angle=overturn_angle,
     )  # fmt: skip
     advance[b, threads or threads_for(n)](st, constants, settings, rec, scratch)
-    for device, host in zip(st + rec[:4] + rec[8:9], state.kernel_state() + kept[:4] + kept[8:9], strict=True):  # fmt: skip  # noqa: E501
+    back = st + rec[:4] + ((rec.r_group,) if grouped else ())
+    hosts = state.kernel_state() + kept[:4] + ((kept.r_group,) if grouped else ())
+    for device, host in zip(back, hosts, strict=True):
         device.copy_to_host(host)

@@ -60,7 +60,7 @@ def advance(st, c, settings, rec):
     n_runs, n = theta.shape
     n_rec = r.shape[1]
     save = traj_theta.shape[0] > 0
-    grouped = r_group.shape[0] > 0
+    grouped = group_start.shape[0] > 2  # several groups
     dt2 = dt * dt
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):

@@ -224,7 +224,7 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
 @nb.njit(cache=True, inline="always")
 def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start):  # fmt: skip  # noqa: E501
     r[b, k] = analytic_order(th[:, w], thd[:, w], c.omega[blk, :, w])
-    if r_group.shape[0] > 0:
+    if group_start.shape[0] > 2:  # several groups
         group_orders(r_group, b, k, th[:, w], thd[:, w], c.omega[blk, :, w], group_start)
     if save:
         for i in range(th.shape[0]):

@@ -97,7 +97,7 @@ def _record(state: StepState, k: int, omega: np.ndarray, which: np.ndarray) -> N
     unit = np.where(rho > 0, (x + 1j * y) / safe, 0.0)
     r = np.abs(unit.sum(axis=1)) / x.shape[1]
     state.r[which, k] = r[which]
-    if state.r_group.shape[0]:
+    if state.group_start.size > 2:  # several groups
         bounds = state.group_start
         for g, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
             state.r_group[which, k, g] = (np.abs(unit[:, lo:hi].sum(axis=1)) / (hi - lo))[which]
