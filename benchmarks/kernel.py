@@ -13,6 +13,11 @@ per oscillator-step as N and as B grow at fixed work, which should stay flat.
     python benchmarks/kernel.py                       # the (100, 7) and (100, 64) grid
     python benchmarks/kernel.py --scaling             # plus the N and B scaling curves
     python benchmarks/kernel.py --sizes 100x7 1000x64 --duration 200
+    NUMBA_NUM_THREADS=1 python benchmarks/kernel.py --cpu-time   # steadier on a busy machine
+
+``--cpu-time`` times the process's CPU time instead of the wall clock: on a machine
+shared with other jobs, time spent waiting for a core then does not count, so two
+versions can be compared to about 1 % (with one thread, CPU time is that thread's).
 """
 
 from __future__ import annotations
@@ -30,6 +35,9 @@ from metrosync import build_ensemble, get_preset
 from metrosync.integrators import reference, verlet
 from metrosync.integrators._state import StepState
 
+#: The clock the rates are timed with (`main` switches it for ``--cpu-time``).
+clock = time.perf_counter
+
 
 def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
     """Oscillator-steps per second of one timed call (``layout``: a layout of the
@@ -39,14 +47,14 @@ def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
         n_records=steps // 10 + 1, trajectories=False,
     )  # fmt: skip
     options = dict(dt=dt, step0=0, n_steps=steps, record_every=10, overturn_angle=math.pi / 2)
-    start = time.perf_counter()
+    start = clock()
     if layout is None:
         reference.advance_state(state, ensemble.system, **options)
     elif layout == "previous":
         previous_kernel(state, ensemble.system, **options)
     else:
         verlet.advance_state(state, ensemble.system, layout=layout, **options)
-    return ensemble.runs * ensemble.n * steps / (time.perf_counter() - start)
+    return ensemble.runs * ensemble.n * steps / (clock() - start)
 
 
 def best(ensemble, steps, dt, layout, repeats):
@@ -68,11 +76,17 @@ def main() -> None:
     parser.add_argument("--baseline-steps", type=int, default=300, help="steps for NumPy")
     parser.add_argument("--repeats", type=int, default=3, help="timings per figure (best kept)")
     parser.add_argument("--scaling", action="store_true", help="also the N and B scaling curves")
+    parser.add_argument("--cpu-time", action="store_true",
+                        help="time CPU time, not wall time (see above)")  # fmt: skip
     args = parser.parse_args()
+    if args.cpu_time:
+        global clock
+        clock = time.process_time
 
     print(f"machine: {platform.machine()} {platform.processor() or ''}, {os.cpu_count()} CPUs, "
           f"numba {numba.__version__}, {numba.get_num_threads()} threads")  # fmt: skip
-    print(f"dt = {args.dt} s; kernels over {args.duration:g} s; NumPy over "
+    print(f"rates from {'CPU time' if args.cpu_time else 'wall time'}; "
+          f"dt = {args.dt} s; kernels over {args.duration:g} s; NumPy over "
           f"{args.baseline_steps} steps; rates in oscillator-steps/s")  # fmt: skip
     header = f"{'B':>6} {'N':>6} {'layout':>12} {'kernel':>10} {'previous':>10} {'numpy':>10}"
     print(header + f" {'x previous':>11} {'x numpy':>9}")

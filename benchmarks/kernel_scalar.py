@@ -4,8 +4,10 @@ branches, all 32 arrays and settings as positional arguments.
 
 It is frozen as it was (not a layout of the package, and not kept in step with the
 model): `advance_state` has the package kernels' calling convention so that the
-benchmark can time it the same way. Compiled without numba's disk cache, so that a
-change in the package's shared pieces can never load a stale copy.
+benchmark can time it the same way (it follows the package's record buffers, whose
+crossing sums are per group, and books its crossings through the shared
+`upward_crossing`). Compiled without numba's disk cache, so that a change in the
+package's shared pieces can never load a stale copy.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ def advance(
     mh, mgh, inertia, c_theta, drive, omega, radius, c_phi, total_inertia,
     dt, step0, n_steps, record_every, overturn_angle,
     r, cross_re, cross_im, cross_count,
-    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot,
+    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, group_start,
 ):  # fmt: skip
     """Advance every run from step ``step0`` by ``n_steps`` steps, in place."""
     n_runs, n = theta.shape
@@ -61,7 +63,7 @@ def advance(
                 if th < 0.0 and tn > 0.0:
                     kick = drive[b, i] / dt
                     t_cross = t_old + dt * th / (th - tn)
-                    upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                    upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                 elif th > 0.0 and tn < 0.0:
                     kick = -drive[b, i] / dt
                 if abs(tn) > overturn_angle:
@@ -122,4 +124,5 @@ def advance_state(state, sys, *, dt, step0, n_steps, record_every, overturn_angl
         float(dt), int(step0), int(n_steps), int(record_every), float(overturn_angle),
         state.r, state.cross_re, state.cross_im, state.cross_count,
         state.traj_theta, state.traj_theta_dot, state.traj_phi, state.traj_phi_dot,
+        state.group_start,
     )  # fmt: skip

@@ -1,7 +1,8 @@
 """Ensembles: B independent runs of N metronomes, their constants and initial state.
 
 Contract: `build_ensemble` turns user-level choices (N, nominal BPM, spread σ in BPM,
-explicit frequencies or metronomes, initial conditions, seed) into an `Ensemble`:
+or groups of their own N, BPM and σ (`metrosync.groups`), explicit frequencies or
+metronomes, initial conditions, seed) into an `Ensemble`:
 (B, N) slider positions and the `SystemArrays` every integrator consumes, plus the
 initial state. Everything random comes from one seed through independent streams
 (frequencies, phases), so changing σ never changes the initial phases.
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError, describe
+from .groups import Group, as_groups, group_bounds
 from .model import Metronome, ModelParameters, SystemArrays, omega_to_bpm, system_arrays
 from .model.system import PER_METRONOME
 
@@ -33,6 +35,7 @@ class Ensemble:
 
     l2, frequency_bpm, theta0, theta_dot0 : (B, N).   phi0, phi_dot0 : (B,).
     disk_inertia : (B,) the platform's J (without the R²Σm term).
+    groups : the groups, with their spreads resolved, when built from groups; else ().
     """
 
     params: ModelParameters
@@ -44,10 +47,16 @@ class Ensemble:
     theta_dot0: np.ndarray
     phi0: np.ndarray
     phi_dot0: np.ndarray
+    groups: tuple[Group, ...] = ()
 
     @property
     def runs(self) -> int:
         return self.l2.shape[0]
+
+    @property
+    def group_start(self) -> np.ndarray:
+        """(G + 1,) bounds of the groups along the metronomes; one group if none."""
+        return group_bounds(self.groups) if self.groups else np.array([0, self.n], np.int64)
 
     @property
     def n(self) -> int:
@@ -71,6 +80,7 @@ def build_ensemble(
     theta0: Sequence[float] | np.ndarray | None = None,
     theta_dot0: Sequence[float] | np.ndarray | None = None,
     phi_dot0: float = 0.0,
+    groups: Sequence[Group | tuple] | None = None,
 ) -> Ensemble:
     """Build the constants and initial state of an ensemble.
 
@@ -90,6 +100,12 @@ def build_ensemble(
         energy-balance amplitude 2M/(π c_θ) (docs/model.md §6.5).
     theta0, theta_dot0 : explicit initial angles and angular velocities, (N,) or (B, N).
     phi_dot0 : initial angular velocity of the disk.
+    groups : groups of metronomes, each ``(n, bpm)`` or ``(n, bpm, sigma_bpm)``, laid
+        out one after the other (see `metrosync.groups`); replaces ``n`` and ``bpm``,
+        and ``sigma_bpm`` is the spread of the groups that give none. Each run draws
+        group g's frequencies from Normal(bpm_g, sigma_g), from the same stream as an
+        ungrouped draw: groups of equal BPM and σ give exactly the ensemble of their
+        total N.
     """
     runs = _require_count("runs", runs)
     if seed is not None and (not isinstance(seed, int | np.integer) or seed < 0):
@@ -109,7 +125,35 @@ def build_ensemble(
             f"(0 tunes every metronome to the nominal `bpm`)."
         )
     per_metronome = None
-    if metronomes is not None:
+    if groups is not None:
+        if metronomes is not None or frequencies_bpm is not None:
+            given = "`metronomes`" if metronomes is not None else "`frequencies_bpm`"
+            raise ParameterError(
+                f"give `groups` or {given}, not both: each sets the metronomes' frequencies."
+            )
+        if not (math.isfinite(sigma_bpm) and sigma_bpm >= 0):
+            raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {sigma_bpm!r}.")
+        groups = as_groups(groups, sigma_bpm)
+        for k, g in enumerate(groups):
+            design.check_tunable(
+                g.bpm,
+                what=f"`groups` entry {k} ({g.label()}) has BPM {{value!r}}, which",
+                fix="Move that group's BPM into the range.",
+            )
+        n = sum(g.n for g in groups)
+        loc = np.repeat([g.bpm for g in groups], [g.n for g in groups])
+        scale = np.repeat([g.sigma_bpm for g in groups], [g.n for g in groups])
+        # One draw over all N, as for a single group, so equal groups are one group.
+        freq = freq_rng.normal(loc, scale, size=(runs, n))
+        for k, (g, lo) in enumerate(zip(groups, group_bounds(groups), strict=False)):
+            design.check_tunable(
+                freq[:, lo : lo + g.n],
+                what=f"with `groups` entry {k} ({g.label()}), a drawn natural frequency "
+                "({value:.2f} BPM)",
+                fix="Lower that group's sigma or move its BPM inward.",
+            )
+        l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
+    elif metronomes is not None:
         metronomes = list(metronomes)
         if not metronomes:
             raise ParameterError("`metronomes` is empty: give at least one Metronome.")
@@ -185,6 +229,7 @@ def build_ensemble(
         theta_dot0=thd0,
         phi0=np.zeros(runs),
         phi_dot0=np.full(runs, float(phi_dot0)),
+        groups=tuple(groups) if groups is not None else (),
     )
 
 

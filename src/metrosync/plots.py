@@ -40,7 +40,8 @@ def finish_figure(fig, path: Path | str | None, *, dpi: float = 120):
 
 
 def plot_order(ds, path: Path | str | None = None, *, ax=None):
-    """r(t) averaged over runs, both phase definitions, with the equilibrium window.
+    """r(t) averaged over runs, both phase definitions, with the equilibrium window;
+    with groups, also each group's r (analytic phase).
 
     ds : a `metrosync.simulate` dataset, r and r_crossing (time, run).
     path : write the figure there (PNG, PDF, SVG, ...) when given.
@@ -66,9 +67,15 @@ def plot_order(ds, path: Path | str | None = None, *, ax=None):
         crossing = ds.r_crossing.mean("run").where(count == count.max())
     ax.plot(t, crossing, lw=1, label="r, crossing phase")
     a = ds.attrs
-    ax.set_title(
-        f"N = {a['n']}, {a['bpm']} BPM, σ = {a['sigma_bpm']} BPM, mean of {a['runs']} runs"
-    )
+    if "r_group" in ds:
+        labels = str(a["groups"]).split()
+        for g, label in enumerate(labels):
+            ax.plot(t, ds.r_group.isel(group=g).mean("run"), lw=1, ls="--",
+                    label=f"r of group {g} ({label}), analytic")  # fmt: skip
+        ensemble = f"N = {a['n']} in groups {' '.join(labels)} (N@BPM:σ)"
+    else:
+        ensemble = f"N = {a['n']}, {a['bpm']} BPM, σ = {a['sigma_bpm']} BPM"
+    ax.set_title(f"{ensemble}, mean of {a['runs']} runs")
     order_axes(ax, t[-1], a.get("equilibrium_window"), xlabel="t (s)")
     return finish_figure(fig, path)
 

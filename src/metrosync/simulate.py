@@ -18,7 +18,20 @@ was recorded in an `xarray.Dataset`:
     theta, theta_dot (time, run, metronome), phi, phi_dot (time, run)
                                           trajectories, only when asked for
 
-``time`` is in seconds; every parameter is in ``attrs``.
+With ``groups`` (`metrosync.groups`), also each group's order parameters, taken over
+its own metronomes only:
+
+    group        (metronome)              the group of each metronome (coordinate)
+    group_n, group_bpm, group_sigma_bpm (group)
+                                          each group's size, nominal BPM and spread
+    r_group, r_crossing_group (time, run, group)
+                                          r and r_crossing of each group
+    r_eq_group, r_eq_analytic_group (run, group)
+                                          r_eq and r_eq_analytic of each group
+
+``time`` is in seconds; every parameter is in ``attrs`` (the groups as ``groups``,
+e.g. ``"7@184:0.75 7@200:0.75"``, and each group's mean and σ of r_eq as
+``r_eq_group_mean``, ``r_eq_group_std``).
 """
 
 from __future__ import annotations
@@ -36,6 +49,7 @@ from ._version import __version__
 from .budget import simulation_budget
 from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
 from .errors import OverturnWarning, ParameterError
+from .groups import Group, describe_groups
 from .integrators import BACKENDS, get_integrator
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
@@ -59,6 +73,7 @@ def simulate(
     bpm: float | None = 192.0,
     *,
     sigma_bpm: float = 0.0,
+    groups: Sequence[Group | tuple] | None = None,
     runs: int = 1,
     duration: float = 600.0,
     dt: float = 0.01,
@@ -91,6 +106,11 @@ def simulate(
         The nominal BPM tunes the small-swing frequency; at the default swing a
         metronome ticks slower (``tick_rate_bpm`` in the result holds the measured rate).
     sigma_bpm : spread (std, BPM) of the natural frequencies, drawn per run.
+    groups : groups of metronomes at their own frequencies, e.g.
+        ``[(7, 184.0), (7, 200.0)]`` or with a spread of their own ``(7, 200.0, 0.5)``;
+        they replace ``n`` and ``bpm`` (pass None for those), ``sigma_bpm`` is the
+        spread of the groups that give none, and the dataset gains each group's order
+        parameters (module docstring). See `build_ensemble`.
     runs : number of independent runs B.
     duration, dt : simulated time and time step, s.
     seed : seed of every random choice; the result is a pure function of the inputs.
@@ -151,10 +171,11 @@ def simulate(
         )
     record_every, record_reason = record_stride(record_every, n_steps, dt)
     n_records = n_steps // record_every + 1
-    size = _request_size(n, runs, frequencies_bpm, metronomes, theta0)
+    size = _request_size(n, runs, frequencies_bpm, metronomes, theta0, groups)
     if size is not None:
+        # Several groups keep their records per group: count them as that many records.
         simulation_budget(
-            n=size[0], runs=size[1], steps=n_steps, records=n_records,
+            n=size[0], runs=size[1], steps=n_steps, records=n_records * size[2],
             trajectories=trajectories, integrator=integrator, backend=backend, dt=dt,
         ).check()  # fmt: skip
     ensemble = build_ensemble(
@@ -169,6 +190,7 @@ def simulate(
         amplitude=amplitude,
         theta0=theta0,
         theta_dot0=theta_dot0,
+        groups=groups,
     )
     check_time_step(dt, ensemble)
     window = duration / 4 if equilibrium_window is None else float(equilibrium_window)
@@ -193,7 +215,7 @@ def simulate(
                 ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi_dot0,
                 duration=n_steps * dt, grid_dt=record_every * dt, n_records=n_records,
                 trajectories=trajectories, overturn_angle=overturn_angle,
-                on_run_done=lambda: bar.update(1),
+                on_run_done=lambda: bar.update(1), group_start=ensemble.group_start,
             )  # fmt: skip
         since = (n_steps - tail_steps) * dt
         rates = np.stack([tick_rate(run, since) for run in records.crossings])
@@ -201,7 +223,9 @@ def simulate(
     rates[records.status != 0] = np.nan
     settings = {
         "n": ensemble.n,
-        "bpm": "explicit"
+        "bpm": "groups"
+        if groups is not None
+        else "explicit"
         if bpm is None or frequencies_bpm is not None or metronomes is not None
         else bpm,
         "sigma_bpm": sigma_bpm,
@@ -279,11 +303,13 @@ def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
     return int(record_every), reason
 
 
-def _request_size(n, runs, frequencies_bpm, metronomes, theta0) -> tuple[int, int] | None:
-    """(N, runs) of a request, read without building anything; None when the inputs
-    are malformed (`build_ensemble` then says what is wrong)."""
+def _request_size(n, runs, frequencies_bpm, metronomes, theta0, groups) -> tuple[int, int, int] | None:  # fmt: skip  # noqa: E501
+    """(N, runs, groups) of a request, read without building anything; None when the
+    inputs are malformed (`build_ensemble` then says what is wrong)."""
     try:
-        if metronomes is not None:
+        if groups is not None:
+            n = sum(operator.index(g.n if isinstance(g, Group) else g[0]) for g in groups)
+        elif metronomes is not None:
             n = len(metronomes)
         elif frequencies_bpm is not None:
             n = np.shape(frequencies_bpm)[-1]
@@ -292,8 +318,8 @@ def _request_size(n, runs, frequencies_bpm, metronomes, theta0) -> tuple[int, in
         n, runs = operator.index(n), operator.index(runs)
     except (TypeError, IndexError):
         return None
-    return (n, runs) if n >= 1 and runs >= 1 else None
-
+    count = len(groups) if groups is not None else 1
+    return (n, runs, count) if n >= 1 and runs >= 1 else None
 
 
 def _run_fixed_step(ensemble, kernel, backend, dt, n_steps, record_every, n_records, trajectories,
@@ -303,7 +329,7 @@ def _run_fixed_step(ensemble, kernel, backend, dt, n_steps, record_every, n_reco
     (B, N) tick rates."""
     state = StepState.start(
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
-        n_records=n_records, trajectories=trajectories,
+        n_records=n_records, trajectories=trajectories, group_start=ensemble.group_start,
     )  # fmt: skip
     # Chunks sized from the measured throughput end every ~0.25 s, so that Ctrl-C and
     # the progress bar act promptly whatever the problem size (see `metrosync.pacing`).
@@ -404,14 +430,61 @@ def _to_dataset(
         disk_inertia=float(ensemble.disk_inertia[0]),
         metrosync_version=__version__,
     )
-    return xr.Dataset(
-        data,
-        coords={
-            "time": ("time", time, {"units": "s"}),
-            "run": np.arange(ensemble.runs),
-            "metronome": np.arange(ensemble.n),
-        },
-        attrs=attrs,
+    coords = {
+        "time": ("time", time, {"units": "s"}),
+        "run": np.arange(ensemble.runs),
+        "metronome": np.arange(ensemble.n),
+    }
+    if ensemble.groups:
+        _add_groups(data, coords, attrs, ensemble, rec, time, window)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _add_groups(data, coords, attrs, ensemble: Ensemble, rec: Records, time, window) -> None:
+    """Each group's order parameters and description (module docstring)."""
+    groups = ensemble.groups
+    r = rec.r_group.transpose(1, 0, 2)
+    r_cross = rec.r_crossing_group.transpose(1, 0, 2)
+    r_eq = equilibrium_order(r_cross, time, window)
+    dims = ("time", "run", "group")
+    data["r_group"] = (dims, r, {"long_name": "order parameter of each group (analytic phase)"})
+    data["r_crossing_group"] = (
+        dims,
+        r_cross,
+        {"long_name": "order parameter of each group (crossing-interpolated phase)"},
+    )
+    data["r_eq_group"] = (
+        ("run", "group"),
+        r_eq,
+        {"long_name": "equilibrium r of each group (mean of r_crossing_group over final window)"},
+    )
+    data["r_eq_analytic_group"] = (
+        ("run", "group"),
+        equilibrium_order(r, time, window),
+        {"long_name": "equilibrium r of each group from r_group"},
+    )
+    bounds = ensemble.group_start
+    coords["group"] = (
+        "metronome",
+        np.repeat(np.arange(len(groups)), np.diff(bounds)),
+        {"long_name": "group of each metronome (index along the group dimension)"},
+    )
+    coords["group_n"] = ("group", np.array([g.n for g in groups]), {"long_name": "metronomes"})
+    coords["group_bpm"] = (
+        "group",
+        np.array([g.bpm for g in groups]),
+        {"units": "BPM", "long_name": "nominal beat frequency of the group"},
+    )
+    coords["group_sigma_bpm"] = (
+        "group",
+        np.array([g.sigma_bpm for g in groups]),
+        {"units": "BPM", "long_name": "spread (std) of the group's natural frequencies"},
+    )
+    stats = np.array([ensemble_statistics(r_eq[:, g]) for g in range(len(groups))])
+    attrs.update(
+        groups=describe_groups(groups),
+        r_eq_group_mean=stats[:, 0],
+        r_eq_group_std=stats[:, 1],
     )
 
 

@@ -160,3 +160,42 @@ def test_a_warning_raised_twice_is_shown_once(monkeypatch, capsys):
         "metrosync presets: warning: the animation is estimated to take about 15 min",
         "metrosync presets: warning: something else",
     ]
+
+
+def test_simulate_groups_from_the_command_line(tmp_path, capsys):
+    out, plot = tmp_path / "g.nc", tmp_path / "g.png"
+    argv = ["simulate", "--group", "2@184", "--group", "3@200:0.5", "--runs", "2",
+            "--duration", "6", "--out", str(out), "--plot", str(plot)]  # fmt: skip
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "N=5 in groups 2@184:0.75 3@200:0.5" in text
+    assert "group 0 (2@184:0.75):" in text and "group 1 (3@200:0.5):" in text
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.group_bpm.values.tolist() == [184.0, 200.0]
+        assert ds.group_sigma_bpm.values.tolist() == [0.75, 0.5]
+        assert ds.r_group.dims == ("time", "run", "group")
+    assert plot.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--group", "7"], "argument --group: expected N@BPM or N@BPM:SIGMA"),
+        (["--group", "7@184:x"], "argument --group: BPM and SIGMA must be numbers"),
+        (["--group", "7@184", "--n", "7"], "`--group` sets the number and BPM .* drop --n"),
+        (["--group", "7@184", "--bpm", "184"], "drop --bpm"),
+        (["--group", "7@900"], r"`groups` \(--group\) entry 0 \(7@900:0.75\) has BPM 900.0"),
+        (
+            ["--group", "5@184", "--group", "5@200", "--lightgate-dir", "x"],
+            r"at most 8 gates, got 10 metronomes \(--group\)",
+        ),
+    ],
+)
+def test_bad_groups_on_the_command_line_name_the_option(argv, message, capsys, tmp_path):
+    argv = [str(tmp_path / "logs") if item == "x" else item for item in argv]
+    try:
+        code = main(["simulate", *argv, "--duration", "1"])
+    except SystemExit as done:  # argparse's own errors
+        code = done.code
+    assert code == 2
+    assert re.search(message, capsys.readouterr().err)

@@ -17,22 +17,26 @@ from metrosync import build_ensemble, get_preset
 from metrosync.integrators import kernel_cuda, reference
 from metrosync.integrators._state import StepState
 
-# 4 threads for 5 metronomes: each thread strides over two of them.
-ens = build_ensemble(5, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=2, seed=3)
 def run(advance, **kw):
     st = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
-                         n_records=13, trajectories=False)
+                         n_records=13, trajectories=False, group_start=ens.group_start)
     for c in range(2):  # two chunks: the state must survive the round trip to the device
         advance(st, ens.system, dt=0.01, step0=60 * c, n_steps=60, record_every=10,
                 overturn_angle=math.pi / 2, **kw)
     return st
-gpu = run(kernel_cuda.advance_state, threads=4)
-ref = run(reference.advance_state)
-assert np.count_nonzero(ref.cross_count) > 0, "no crossing was booked"
-for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r"):
-    np.testing.assert_allclose(getattr(gpu, name), getattr(ref, name), rtol=0, atol=1e-9)
-np.testing.assert_allclose(gpu.crossing_order(), ref.crossing_order(), atol=1e-9)
-np.testing.assert_array_equal(gpu.status, ref.status)
+
+# 4 threads for 5 metronomes: each thread strides over two of them; then two groups.
+for groups in (None, [(2, 186.0), (3, 198.0)]):
+    ens = build_ensemble(5, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=2, seed=3,
+                         groups=groups)
+    gpu = run(kernel_cuda.advance_state, threads=4)
+    ref = run(reference.advance_state)
+    assert np.count_nonzero(ref.cross_count) > 0, "no crossing was booked"
+    for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r", "r_group", "cross_count"):
+        np.testing.assert_allclose(getattr(gpu, name), getattr(ref, name), rtol=0, atol=1e-9)
+    for name in ("crossing_order", "group_crossing_order", "group_order"):
+        np.testing.assert_allclose(getattr(gpu, name)(), getattr(ref, name)(), atol=1e-9)
+    np.testing.assert_array_equal(gpu.status, ref.status)
 
 # A run that diverges at its start records nothing, as in every CPU backend.
 theta_dot0 = np.zeros((2, 3))

@@ -23,23 +23,41 @@ from metrosync.status import STATUS_DIVERGED
 def run(advance, ens, steps, **kwargs):
     state = StepState.start(
         ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
-        n_records=steps // 10 + 1, trajectories=True,
+        n_records=steps // 10 + 1, trajectories=True, group_start=ens.group_start,
     )  # fmt: skip
     advance(state, ens.system, dt=0.01, step0=0, n_steps=steps, record_every=10,
             overturn_angle=math.pi / 2, **kwargs)  # fmt: skip
     return state
 
 
+#: Model features every layout must reproduce, switched on one at a time: name ->
+#: keyword arguments of `build_ensemble` for n metronomes (``params`` included).
+FEATURES = {
+    "plain": lambda n: {},
+    # Three groups at their own frequencies, the first of a single metronome.
+    "groups": lambda n: {
+        "groups": [(1, 184.0), ((n - 1) // 2, 192.0), (n - 1 - (n - 1) // 2, 200.0, 1.0)]
+    },
+}
+
+
+@pytest.mark.parametrize("feature", sorted(FEATURES))
 @pytest.mark.parametrize("layout", sorted(verlet.LAYOUTS))
 @pytest.mark.parametrize("n, runs", [(3, 11), (20, 3)])  # 11 runs: a partly filled block
-def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs):
-    ens = build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=runs, seed=7)
+def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs, feature):
+    options = {"params": get_preset("default"), "sigma_bpm": 2.0, **FEATURES[feature](n)}
+    ens = build_ensemble(n, 192.0, runs=runs, seed=7, **options)
     ref = run(reference.advance_state, ens, 1000)
     got = run(verlet.advance_state, ens, 1000, layout=layout)
-    for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "traj_theta", "r"):
+    for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "traj_theta", "r", "r_group"):
         np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
-    np.testing.assert_allclose(got.crossing_order(), ref.crossing_order(), atol=1e-10)
+    for name in ("crossing_order", "group_crossing_order", "group_order"):
+        np.testing.assert_allclose(getattr(got, name)(), getattr(ref, name)(), atol=1e-10)
     np.testing.assert_array_equal(got.status, ref.status)
+    np.testing.assert_array_equal(got.cross_count, ref.cross_count)
+    assert np.count_nonzero(ref.cross_count) > 0, "no crossing phase was booked"
+    shape = (runs, 101, len(ens.group_start) - 1)
+    assert ref.group_order().shape == got.group_order().shape == shape
 
 
 @pytest.mark.parametrize("layout", sorted(verlet.LAYOUTS))

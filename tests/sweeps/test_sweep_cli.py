@@ -78,3 +78,16 @@ def test_critical_marks_estimates_at_the_end_of_the_grid(tmp_path, capsys):
     assert "* at an end of the bpm grid (180 .. 190 BPM)" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         main(["critical", str(path), "--no-plot", "--plot", str(tmp_path / "c.png")])
+
+
+def test_sweep_the_offset_between_two_groups(tmp_path, capsys):
+    out = tmp_path / "g.nc"
+    args = ["sweep", "--group", "2@184", "--group", "3@184:0.1", "--group-offset-bpm", "0,16",
+            "--runs", "2", "--duration", "20", "--out", str(out), "--no-progress"]  # fmt: skip
+    assert main(args) == 0
+    with xr.open_dataset(out, engine="h5netcdf") as ds:
+        assert ds.r_eq_group.dims == ("group_offset_bpm", "run", "group")
+        assert ds.r_eq_group_mean.shape == (2, 2) and ds.attrs["groups"] == "2@184 3@184:0.1"
+        assert np.isfinite(ds.r_eq_group).all()
+    assert main([*args[:-3], "--n", "3", "--out", str(out)]) == 2
+    assert "drop `n` (--n)" in capsys.readouterr().err

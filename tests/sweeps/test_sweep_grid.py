@@ -121,3 +121,30 @@ def test_point_seeds_do_not_depend_on_grid_extent():
     assert all(big[b] == small[b] for b in small)
     seeds = [s for s, _ in big.values()]
     assert len(set(seeds)) == len(seeds)
+
+
+def test_groups_replace_n_and_bpm_and_the_offset_moves_every_group_after_the_first():
+    grid = Grid(axes={"group_offset_bpm": "0:20:10"}, fixed={"runs": 2, "sigma": 0.5},
+                groups=["7@184", (3, 190.0, 0.1)])  # fmt: skip
+    points = list(grid.points())
+    assert [p.kwargs["groups"] for p in points] == [
+        [[7, 184.0, None], [3, 190.0 + offset, 0.1]] for offset in (0.0, 10.0, 20.0)
+    ]
+    assert all(p.kwargs["n"] is None and p.kwargs["bpm"] is None for p in points)
+    assert points[0].work == 2 * 10 * 60000 and grid.describe()["groups"] == "7@184 3@190:0.1"
+    assert len({p.kwargs["seed"] for p in points}) == 3
+    # Other groups are other points: another key and another seed.
+    other = next(Grid(axes={"group_offset_bpm": [0]}, fixed={"runs": 2, "sigma": 0.5},
+                      groups=["7@184", (3, 191.0, 0.1)]).points())  # fmt: skip
+    assert other.key != points[0].key and other.kwargs["seed"] != points[0].kwargs["seed"]
+
+
+def test_grouped_grids_refuse_conflicts_clearly():
+    with pytest.raises(ParameterError, match=r"`groups` sets the number and BPM .* drop `n`"):
+        Grid(axes={"n": [3, 5]}, groups=["2@184", "2@200"])
+    with pytest.raises(ParameterError, match="`group_offset_bpm` shifts the groups after the"):
+        Grid(axes={"group_offset_bpm": [0, 10]})
+    with pytest.raises(ParameterError, match=r"tunable range.*Narrow the `group_offset_bpm`"):
+        Grid(axes={"group_offset_bpm": [0, 100]}, groups=["2@184", "2@200"])
+    with pytest.raises(ParameterError, match=r"`groups` entry 1: expected N@BPM"):
+        Grid(axes={"group_offset_bpm": [0]}, groups=["2@184", "2x"])

@@ -13,6 +13,7 @@ import math
 import warnings
 
 from ..errors import ParameterError
+from ..groups import Group, parse_group
 from ..integrators import BACKENDS, REGISTRY, get_integrator, integrator_names
 
 
@@ -52,6 +53,23 @@ def int_list(text: str) -> list[int]:
     return values
 
 
+def group_spec(text: str) -> Group:
+    """Parse ``--group N@BPM[:SIGMA]`` (see `metrosync.groups.parse_group`)."""
+    try:
+        return parse_group(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+class GivenOption(argparse.Action):
+    """Store the value and note that the option was given on the command line, in
+    ``args._given``, for options that another one replaces (``--n`` beside ``--group``)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        namespace._given = {*getattr(namespace, "_given", ()), option_string}
+
+
 def add_aliases(parser: argparse.ArgumentParser, **names: str) -> None:
     """Declare library argument names set by options of another name (for errors)."""
     parser.set_defaults(_aliases={**(parser.get_default("_aliases") or {}), **names})
@@ -69,8 +87,9 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
     one metronome, or explicit initial conditions, imply σ = 0 (and one run) unless given.
     """
     g = parser.add_argument_group("ensemble")
-    g.add_argument("--n", type=int, default=7, help="metronomes on the disk")
-    g.add_argument("--bpm", type=float, default=192.0,
+    g.add_argument("--n", type=int, default=7, action=GivenOption,
+                   help="metronomes on the disk")  # fmt: skip
+    g.add_argument("--bpm", type=float, default=192.0, action=GivenOption,
                    help="nominal beat frequency, BPM; it tunes the small-swing frequency, so "
                    "at the default swing a metronome ticks slower (192 BPM: about 184.6 "
                    "ticks a minute)")  # fmt: skip
@@ -79,6 +98,16 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
         help=f"spread (std) of the natural frequencies, BPM (default: {CLI_SIGMA_BPM}, the "
         f"paper's; 0 with --n 1 or --theta0)",
     )  # fmt: skip
+    g.add_argument(
+        "--group",
+        dest="groups",
+        type=group_spec,
+        action="append",
+        default=None,
+        metavar="N@BPM[:SIGMA]",
+        help="a group of N metronomes at BPM with spread SIGMA (else --sigma); repeat "
+        "for several groups, e.g. --group 7@184 --group 7@200:0.5. Replaces --n and --bpm",
+    )
     more = "; 1 with --n 1 or --theta0" if runs > 1 else ""
     g.add_argument("--runs", type=int, default=None,
                    help=f"independent runs (default: {runs}{more})")  # fmt: skip
@@ -151,6 +180,7 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
         changes="--set",
         l2_bounds="--set l2_bounds=LOW,HIGH",
         l1="--set l1=METRES",
+        groups="--group",
     )
 
 
@@ -205,6 +235,14 @@ def simulate_from_args(args, **extra):
     """Run `metrosync.simulate` with the ensemble options of ``args``."""
     from ..simulate import simulate
 
+    groups = getattr(args, "groups", None)
+    if groups:
+        given = sorted(getattr(args, "_given", ()))
+        if given:
+            raise ParameterError(
+                f"`--group` sets the number and BPM of each group's metronomes; drop "
+                f"{' and '.join(given)} (the total N is the sum of the groups')."
+            )
     if args.backend is not None and not get_integrator(args.integrator).fixed_step:
         warnings.warn(
             f"`--backend {args.backend}` applies to `--integrator verlet` only; "
@@ -214,9 +252,10 @@ def simulate_from_args(args, **extra):
         )
     sigma, runs, _ = ensemble_defaults(args)
     return simulate(
-        args.n,
-        args.bpm,
+        None if groups else args.n,
+        None if groups else args.bpm,
         sigma_bpm=sigma,
+        groups=groups or None,
         runs=runs,
         duration=args.duration,
         dt=args.dt,

@@ -87,9 +87,10 @@ def _simulate_with_gate(args):
 
     gate = LightGate(offset=args.gate_offset, width=args.gate_width, jitter=args.gate_jitter,
                      counter_bits=args.gate_counter_bits, seed=args.seed)  # fmt: skip
-    if args.n > 8:
+    n, option = (sum(g.n for g in args.groups), "--group") if args.groups else (args.n, "--n")
+    if n > 8:
         raise ParameterError(
-            f"`--lightgate-dir`: the logger follows at most 8 gates, got --n {args.n}."
+            f"`--lightgate-dir`: the logger follows at most 8 gates, got {n} metronomes ({option})."
         )
     if args.lightgate_dir.exists() and not args.lightgate_dir.is_dir():
         raise ParameterError(
@@ -111,6 +112,13 @@ def _simulate_with_gate(args):
     ds["r_eq_analytic"] = ("run", equilibrium_order(ds.r.values, t, window), ds.r_eq_analytic.attrs)
     mean, spread = ensemble_statistics(ds.r_eq.values)
     ds.attrs.update(r_eq_mean=mean, r_eq_std=spread, record_every=every)
+    if "r_group" in ds:
+        pairs = (("r_eq_group", "r_crossing_group"), ("r_eq_analytic_group", "r_group"))
+        for name, source in pairs:
+            value = equilibrium_order(ds[source].values, t, window)
+            ds[name] = (("run", "group"), value, ds[name].attrs)
+        stats = np.array([ensemble_statistics(v) for v in ds.r_eq_group.values.T])
+        ds.attrs.update(r_eq_group_mean=stats[:, 0], r_eq_group_std=stats[:, 1])
     return ds
 
 
@@ -140,8 +148,13 @@ def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
     adapted = adapted or {}
     sigma = f"sigma={a['sigma_bpm']} BPM" + (f" ({adapted['sigma']})" if "sigma" in adapted else "")
     runs = plural(a["runs"], "run") + (f" ({adapted['runs']})" if "runs" in adapted else "")
+    ensemble = (
+        f"N={a['n']} in groups {a['groups']} (N@BPM:SIGMA)"
+        if "groups" in a
+        else f"N={a['n']} at {a['bpm']} BPM, {sigma}"
+    )
     lines = [
-        f"metrosync simulate: N={a['n']} at {a['bpm']} BPM, {sigma}, "
+        f"metrosync simulate: {ensemble}, "
         f"{runs} x {a['duration']:g} s, dt={a['dt']} s, "
         f"preset={a['preset']}, integrator={a['integrator']}",
         f"  natural frequencies (small swing): {float(ds.frequency_bpm.min()):.3f} .. "
@@ -166,6 +179,10 @@ def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
         )
     else:
         lines.append(f"{window}: not meaningful, every run is flagged")
+    if "r_eq_group" in ds and ok.any():
+        for g, label in enumerate(str(a["groups"]).split()):
+            mean, spread = ensemble_statistics(ds.r_eq_group.values[ok, g])
+            lines.append(f"    group {g} ({label}): {mean:.4f} +- {spread:.4f}")
     if ok.any():
         final = float(ds.r.isel(time=-1).values[ok].mean())
         lines.append(f"  final r (analytic phase), mean over unflagged runs: {final:.4f}")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import NETCDF, check_output
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, group_spec
 
 #: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
 GRID_OPTIONS = {
@@ -23,6 +23,7 @@ GRID_OPTIONS = {
     "c-theta": "pendulum friction, kg m2/s",
     "c-phi": "disk friction, kg m2/s",
     "inertia": "disk inertia J, kg m2 (inf pins the disk)",
+    "group-offset-bpm": "BPM added to every --group after the first",
 }
 
 
@@ -47,6 +48,10 @@ def register(subparsers) -> None:
     g.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=SPEC",
                    help="any model parameter, e.g. --set l1=0.035 (repeatable)")  # fmt: skip
     g.add_argument("--preset", default=None, help="parameter preset (default: 'default')")
+    g.add_argument("--group", dest="groups", type=group_spec, action="append", default=None,
+                   metavar="N@BPM[:SIGMA]",
+                   help="a group of N metronomes at BPM (repeat for several; replaces --n "
+                   "and --bpm); sweep --group-offset-bpm to move the groups apart")  # fmt: skip
     o = parser.add_argument_group("run")
     o.add_argument("--out", type=Path, required=True, help="merged result, FILE.nc")
     o.add_argument("--store", type=Path, default=None,
@@ -57,7 +62,9 @@ def register(subparsers) -> None:
     o.add_argument("--workers", type=int, default=None, help="workers of --scheduler local")
     o.add_argument("--retry-failed", action="store_true", help="recompute points stored as failed")
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
-    add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers", scheduler="--scheduler")
+    add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers", scheduler="--scheduler",
+                groups="--group", n="--n", bpm="--bpm",
+                group_offset_bpm="--group-offset-bpm")  # fmt: skip
     parser.set_defaults(func=run)
 
 
@@ -89,6 +96,8 @@ def grid_from_args(args):
     options = {"keep_r": True} if args.keep_r else {}
     if args.preset is not None:
         options["preset"] = args.preset
+    if args.groups:
+        options["groups"] = args.groups
     if args.grid is not None:
         return Grid.from_toml(args.grid, axes=axes, fixed=fixed, **options)
     if not axes:

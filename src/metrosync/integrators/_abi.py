@@ -14,7 +14,10 @@ nothing over positional arguments.
 ``Settings``   the scalars of one call: step, first step, step count, record spacing,
                overturn angle.
 ``Recording``  the record buffers, (B, n_rec) and trajectories (B, n_rec, N), or
-               (0, 0, 0) placeholders when trajectories are not kept.
+               (0, 0, 0) placeholders when trajectories are not kept; the
+               crossing-phase sums and ``r_group`` are per group, (B, n_rec, G)
+               (``r_group`` a (0, 0, 0) placeholder for one group, whose r is ``r``),
+               and ``group_start`` (G + 1,) bounds the groups' contiguous metronomes.
 
 numba issues 5872/7135/10338 (open in 0.68): a write through a NamedTuple field inside
 ``prange`` can be silently lost. A kernel therefore unpacks every array it writes
@@ -74,6 +77,8 @@ class Recording(NamedTuple):
     traj_theta_dot: np.ndarray
     traj_phi: np.ndarray
     traj_phi_dot: np.ndarray
+    r_group: np.ndarray
+    group_start: np.ndarray
 
 
 def constants_of(sys: SystemArrays, dt: float):

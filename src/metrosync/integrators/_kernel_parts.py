@@ -1,6 +1,11 @@
 """Compiled pieces shared by every fixed-step CPU kernel: the scheme's updates (see
 `verlet`), crossing-phase bookkeeping and the per-record observables.
 
+Groups of metronomes (`metrosync.ensemble`) are contiguous: group g holds metronomes
+``group_start[g]`` to ``group_start[g + 1] - 1``. The crossing-phase sums are kept per
+group, (B, n_rec, G), so that both the global and each group's order parameter follow
+from them; an ungrouped ensemble is one group.
+
 The forces are not here but in `_physics`. `drift` and `velocity` run in the
 vectorized hot loop (``inline="always"``, arithmetic only); the bookkeeping runs once
 per crossing or per record.
@@ -44,8 +49,18 @@ def upward(theta, theta_next):
 
 
 @nb.njit(cache=True, inline="always")
-def add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_dt, n_rec):
-    """Add e^{iΦ} for grid times in [t_prev, t_next), Φ rising linearly 0 → 2π.
+def group_of(i, group_start):
+    """The group of metronome ``i`` (a short scan: there are few groups)."""
+    g = 0
+    while i >= group_start[g + 1]:
+        g += 1
+    return g
+
+
+@nb.njit(cache=True, inline="always")
+def add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_dt, n_rec, grp):
+    """Add e^{iΦ} for grid times in [t_prev, t_next), Φ rising linearly 0 → 2π, to the
+    sums of group ``grp``.
 
     Φ advances by the same angle from one grid time to the next, so e^{iΦ} is
     rotated by a complex factor instead of calling sin and cos at every grid time
@@ -61,19 +76,20 @@ def add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_
     im, re = sincos(phase0)
     rot_im, rot_re = sincos(step)
     for g in range(g0, g1):
-        cross_re[b, g] += re
-        cross_im[b, g] += im
-        cross_count[b, g] += 1
+        cross_re[b, g, grp] += re
+        cross_im[b, g, grp] += im
+        cross_count[b, g, grp] += 1
         re, im = re * rot_re - im * rot_im, re * rot_im + im * rot_re
 
 
 @nb.njit(cache=True, inline="always")
-def upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec):
+def upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start):  # fmt: skip  # noqa: E501
     """Book an upward zero crossing of metronome ``i`` of run ``b`` at ``t_cross``."""
     if last_up[b, i] >= 0.0:
         add_crossing_phase(
-            cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec
-        )
+            cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec,
+            group_of(i, group_start),
+        )  # fmt: skip
     last_up[b, i] = t_cross
 
 
@@ -101,3 +117,13 @@ def analytic_order(theta_row, theta_dot_row, omega_row):
         re += x * inv
         im += y * inv
     return math.sqrt(re * re + im * im) / n
+
+
+@nb.njit(cache=True, inline="always")
+def group_orders(r_group, b, k, theta_row, theta_dot_row, omega_row, group_start):
+    """r of each group's analytic phases into ``r_group[b, k, :]`` (`analytic_order` on
+    each group's contiguous slice of the run's metronomes)."""
+    for g in range(group_start.shape[0] - 1):
+        lo = group_start[g]
+        hi = group_start[g + 1]
+        r_group[b, k, g] = analytic_order(theta_row[lo:hi], theta_dot_row[lo:hi], omega_row[lo:hi])

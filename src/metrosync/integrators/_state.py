@@ -33,9 +33,12 @@ class StepState:
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
     r : (B, n_rec) analytic-phase order parameter at each record.
-    cross_re, cross_im, cross_count : (B, n_rec) running sums of e^{iΦ} over the
-        metronomes whose crossing-interpolated phase Φ is known at each record.
+    cross_re, cross_im, cross_count : (B, n_rec, G) running sums of e^{iΦ} over each
+        group's metronomes whose crossing-interpolated phase Φ is known at each record.
     traj_* : trajectories (B, n_rec, N) and (B, n_rec), or (0, 0, 0) placeholders.
+    r_group : (B, n_rec, G) each group's analytic-phase r, or a (0, 0, 0) placeholder
+        for a single group (its r is ``r``).
+    group_start : (G + 1,) group g is metronomes group_start[g] .. group_start[g+1]-1.
     """
 
     state: State
@@ -60,8 +63,15 @@ class StepState:
         *,
         n_records: int,
         trajectories: bool,
+        group_start: np.ndarray | None = None,
     ) -> StepState:
+        """The state at t = 0 and empty records; ``group_start`` bounds the groups
+        (default: all N metronomes one group)."""
         b, n = theta0.shape
+        bounds = np.array([0, n] if group_start is None else group_start, dtype=np.int64)
+        if bounds[0] != 0 or bounds[-1] != n or np.any(np.diff(bounds) < 1):
+            raise ValueError(f"group_start {bounds} does not split {n} metronomes into groups")
+        n_groups = bounds.size - 1
         theta = np.array(theta0, dtype=float, order="C")
         theta_dot = np.array(theta_dot0, dtype=float, order="C")
         phi_dot = np.array(phi_dot0, dtype=float)
@@ -88,13 +98,15 @@ class StepState:
         )
         recording = Recording(
             r=np.full((b, n_records), np.nan),
-            cross_re=np.zeros((b, n_records)),
-            cross_im=np.zeros((b, n_records)),
-            cross_count=np.zeros((b, n_records), dtype=np.int32),
+            cross_re=np.zeros((b, n_records, n_groups)),
+            cross_im=np.zeros((b, n_records, n_groups)),
+            cross_count=np.zeros((b, n_records, n_groups), dtype=np.int32),
             traj_theta=np.full(traj_shape, np.nan),
             traj_theta_dot=np.full(traj_shape, np.nan),
             traj_phi=np.full(traj_shape[:2], np.nan),
             traj_phi_dot=np.full(traj_shape[:2], np.nan),
+            r_group=np.full((b, n_records, n_groups) if n_groups > 1 else (0, 0, 0), np.nan),
+            group_start=bounds,
         )
         return cls(state, recording)
 
@@ -111,13 +123,25 @@ class StepState:
         has no phase (before its first or after its last upward crossing)."""
         n = self.theta.shape[1]
         with np.errstate(invalid="ignore"):
-            r = np.hypot(self.cross_re, self.cross_im) / n
-        return np.where(self.cross_count == n, r, np.nan)
+            r = np.hypot(self.cross_re.sum(axis=2), self.cross_im.sum(axis=2)) / n
+        return np.where(self.cross_count.sum(axis=2) == n, r, np.nan)
+
+    def group_crossing_order(self) -> np.ndarray:
+        """Each group's `crossing_order`, (B, n_rec, G)."""
+        size = np.diff(self.group_start)
+        with np.errstate(invalid="ignore"):
+            r = np.hypot(self.cross_re, self.cross_im) / size
+        return np.where(self.cross_count == size, r, np.nan)
+
+    def group_order(self) -> np.ndarray:
+        """Each group's analytic-phase r, (B, n_rec, G)."""
+        return self.r_group if self.group_start.size > 2 else self.r[:, :, None]
 
 
 @dataclass
 class Records:
-    """What an integrator hands back, per run: arrays (B, n_rec[, N]) and (B,)."""
+    """What an integrator hands back, per run: arrays (B, n_rec[, N]) and (B,); the
+    groups' r and r_crossing are (B, n_rec, G)."""
 
     r: np.ndarray
     r_crossing: np.ndarray
@@ -128,16 +152,23 @@ class Records:
     phi_dot: np.ndarray | None = None
     #: per run, N lists of upward-crossing times (integrators that keep them all).
     crossings: list | None = None
+    r_group: np.ndarray | None = None
+    r_crossing_group: np.ndarray | None = None
 
 
 def records_of(state: StepState) -> Records:
     traj = state.traj_theta.shape[0] > 0
+    r_crossing = state.crossing_order()
+    grouped = state.group_start.size > 2
     return Records(
         r=state.r,
-        r_crossing=state.crossing_order(),
+        r_crossing=r_crossing,
         status=state.status,
         theta=state.traj_theta if traj else None,
         theta_dot=state.traj_theta_dot if traj else None,
         phi=state.traj_phi if traj else None,
         phi_dot=state.traj_phi_dot if traj else None,
+        # One group: views of the global records, no copies.
+        r_group=state.group_order(),
+        r_crossing_group=state.group_crossing_order() if grouped else r_crossing[:, :, None],
     )

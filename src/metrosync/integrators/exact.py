@@ -41,11 +41,15 @@ def integrate(
     trajectories: bool,
     overturn_angle: float,
     on_run_done: Callable[[], None] | None = None,
+    group_start: np.ndarray | None = None,
 ) -> Records:
-    """Integrate every run to ``duration``, sampling on a grid of step ``grid_dt``."""
+    """Integrate every run to ``duration``, sampling on a grid of step ``grid_dt``;
+    ``group_start`` bounds the groups of metronomes (default: one group)."""
     runs, n = theta0.shape
     grid = np.arange(n_records) * grid_dt
     shape = (runs, n_records)
+    bounds = [0, n] if group_start is None else [int(k) for k in group_start]
+    groups = list(zip(bounds[:-1], bounds[1:], strict=True))
     out = Records(
         r=np.full(shape, np.nan),
         r_crossing=np.full(shape, np.nan),
@@ -55,6 +59,8 @@ def integrate(
         phi=np.full(shape, np.nan) if trajectories else None,
         phi_dot=np.full(shape, np.nan) if trajectories else None,
         crossings=[],
+        r_group=np.full(shape + (len(groups),), np.nan),
+        r_crossing_group=np.full(shape + (len(groups),), np.nan),
     )
     for b in range(runs):
         samples, upcrossings, status = _integrate_run(
@@ -63,8 +69,12 @@ def integrate(
         out.status[b] = status
         out.crossings.append(upcrossings)
         th, thd = samples[:, 1 : n + 1], samples[:, n + 2 :]
-        out.r[b] = order_parameter(analytic_phase(th, thd, sys.omega[b]))
+        phase = analytic_phase(th, thd, sys.omega[b])
+        out.r[b] = order_parameter(phase)
         out.r_crossing[b] = crossing_order(upcrossings, grid)
+        for g, (lo, hi) in enumerate(groups):
+            out.r_group[b, :, g] = order_parameter(phase[:, lo:hi])
+            out.r_crossing_group[b, :, g] = crossing_order(upcrossings[lo:hi], grid)
         if trajectories:
             out.theta[b], out.theta_dot[b] = th, thd
             out.phi[b], out.phi_dot[b] = samples[:, 0], samples[:, n + 1]

@@ -50,6 +50,7 @@ drift = device_function(_kernel_parts.drift)
 velocity = device_function(_kernel_parts.velocity)
 momentum = device_function(_kernel_parts.momentum)
 upward = device_function(_kernel_parts.upward)
+group_of = device_function(_kernel_parts.group_of)
 
 
 def gpu_available() -> bool:
@@ -68,15 +69,15 @@ def threads_for(n: int) -> int:
 
 
 @cuda.jit(device=True)
-def _add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_dt, n_rec):
+def _add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_dt, n_rec, grp):
     period = t_next - t_prev
     g0 = int(math.ceil(t_prev / grid_dt))
     g1 = min(int(math.ceil(t_next / grid_dt)), n_rec)
     for g in range(g0, g1):
         ph = TWO_PI * (g * grid_dt - t_prev) / period
-        cuda.atomic.add(cross_re, (b, g), math.cos(ph))
-        cuda.atomic.add(cross_im, (b, g), math.sin(ph))
-        cuda.atomic.add(cross_count, (b, g), 1)
+        cuda.atomic.add(cross_re, (b, g, grp), math.cos(ph))
+        cuda.atomic.add(cross_im, (b, g, grp), math.sin(ph))
+        cuda.atomic.add(cross_count, (b, g, grp), 1)
 
 
 @cuda.jit(device=True)
@@ -94,6 +95,7 @@ def _block_sum(red, k, tid, nt):
 def advance(st, c, settings, rec, scratch):
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count = rec[:4]  # no trajectories on the GPU yet
+    r_group, group_start = rec[8:10]
     dt, step0, n_steps, record_every, overturn_angle = settings
     th_new, rest, q = scratch
     b = cuda.blockIdx.x
@@ -106,7 +108,7 @@ def advance(st, c, settings, rec, scratch):
     dt2 = dt * dt
     grid_dt = record_every * dt
     if step0 == 0:
-        _record(b, 0, theta, theta_dot, c.omega, r, red, tid, nt, status)
+        _record(b, 0, theta, theta_dot, c.omega, r, red, tid, nt, status, r_group, group_start)
     for s in range(step0, step0 + n_steps):
         cuda.syncthreads()
         if status[b] & STATUS_DIVERGED:
@@ -123,7 +125,7 @@ def advance(st, c, settings, rec, scratch):
             if upward(th, tn):
                 t_cross = t_old + dt * th / (th - tn)
                 if last_up[b, i] >= 0.0:
-                    _add_crossing_phase(cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                    _add_crossing_phase(cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec, group_of(i, group_start))  # fmt: skip  # noqa: E501
                 last_up[b, i] = t_cross
             if abs(tn) > overturn_angle:
                 over = 1.0
@@ -176,20 +178,35 @@ def advance(st, c, settings, rec, scratch):
             acc_phi[b] = phdd
         cuda.syncthreads()
         if (s + 1) % record_every == 0:
-            _record(b, (s + 1) // record_every, theta, theta_dot, c.omega, r, red, tid, nt, status)
+            _record(b, (s + 1) // record_every, theta, theta_dot, c.omega, r, red, tid, nt, status, r_group, group_start)  # fmt: skip  # noqa: E501
 
 
 @cuda.jit(device=True)
-def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status):
-    """r from the analytic phases, reduced over the block; thread 0 stores it. A run
-    that has diverged records nothing, as in every other backend (the test is the
-    same for all threads of the block, so none waits alone at a barrier)."""
+def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status, r_group, group_start):
+    """r from the analytic phases, reduced over the block; thread 0 stores it, and
+    each group's r when there are several. A run that has diverged records nothing,
+    as in every other backend (the test is the same for all threads of the block, so
+    none waits alone at a barrier)."""
     if status[b] & STATUS_DIVERGED:
         return
-    n = theta.shape[1]
+    value = _order(b, 0, theta.shape[1], theta, theta_dot, omega, red, tid, nt)
+    if tid == 0:
+        r[b, k] = value
+    if group_start.shape[0] > 2:  # several groups
+        for g in range(group_start.shape[0] - 1):
+            lo = group_start[g]
+            hi = group_start[g + 1]
+            value = _order(b, lo, hi, theta, theta_dot, omega, red, tid, nt)
+            if tid == 0:
+                r_group[b, k, g] = value
+
+
+@cuda.jit(device=True)
+def _order(b, lo, hi, theta, theta_dot, omega, red, tid, nt):
+    """r of metronomes lo..hi-1 of run ``b``, reduced over the block (valid in thread 0)."""
     re = 0.0
     im = 0.0
-    for i in range(tid, n, nt):
+    for i in range(lo + tid, hi, nt):
         x = theta[b, i]
         y = -theta_dot[b, i] / omega[b, i]
         rho = math.sqrt(x * x + y * y)
@@ -201,9 +218,9 @@ def _record(b, k, theta, theta_dot, omega, r, red, tid, nt, status):
     cuda.syncthreads()
     _block_sum(red, 0, tid, nt)
     _block_sum(red, 1, tid, nt)
-    if tid == 0:
-        r[b, k] = math.sqrt(red[0, 0] ** 2 + red[1, 0] ** 2) / n
-    cuda.syncthreads()
+    out = math.sqrt(red[0, 0] ** 2 + red[1, 0] ** 2) / (hi - lo)
+    cuda.syncthreads()  # every thread has read red before the next reduction reuses it
+    return out
 
 
 def advance_state(
@@ -219,10 +236,13 @@ def advance_state(
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
     constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))
     kept = state.kernel_recording()
-    # Trajectory fields: placeholders that the kernel never reads.
+    grouped = state.group_start.size > 2
+    # Trajectory fields, and r_group of one group: placeholders the kernel never reads.
     rec = Recording(
         *(cuda.to_device(a) for a in kept[:4]),
-        *(cuda.device_array((1,) * np.ndim(a)) for a in kept[4:]),
+        *(cuda.device_array((1,) * np.ndim(a)) for a in kept[4:8]),
+        cuda.to_device(kept.r_group) if grouped else cuda.device_array((1, 1, 1)),
+        cuda.to_device(kept.group_start),
     )
     scratch = tuple(cuda.device_array((b, n)) for _ in range(3))
     settings = settings_of(
@@ -230,5 +250,7 @@ def advance_state(
         overturn_angle=overturn_angle,
     )  # fmt: skip
     advance[b, threads or threads_for(n)](st, constants, settings, rec, scratch)
-    for device, host in zip(st + rec[:4], state.kernel_state() + kept[:4], strict=True):
+    back = st + rec[:4] + ((rec.r_group,) if grouped else ())
+    hosts = state.kernel_state() + kept[:4] + ((kept.r_group,) if grouped else ())
+    for device, host in zip(back, hosts, strict=True):
         device.copy_to_host(host)

@@ -24,6 +24,7 @@ from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import (
     analytic_order,
     drift,
+    group_orders,
     momentum,
     save_state,
     upward,
@@ -54,11 +55,12 @@ def advance(st, c, settings, rec):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
     save = traj_theta.shape[0] > 0
+    grouped = group_start.shape[0] > 2  # several groups
     dt2 = dt * dt
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
@@ -70,6 +72,8 @@ def advance(st, c, settings, rec):
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
             r[b, 0] = analytic_order(theta[b], theta_dot[b], c.omega[b])
+            if grouped:
+                group_orders(r_group, b, 0, theta[b], theta_dot[b], c.omega[b], group_start)
             if save:
                 save_state(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
@@ -87,7 +91,7 @@ def advance(st, c, settings, rec):
                     if crossed[i]:
                         th = theta[b, i]
                         t_cross = t_old + dt * th / (th - th_new[i])
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                         n_up -= 1
                         if n_up == 0:
                             break
@@ -115,6 +119,8 @@ def advance(st, c, settings, rec):
                 until_record = record_every
                 k = (s + 1) // record_every
                 r[b, k] = analytic_order(theta[b], theta_dot[b], c.omega[b])
+                if grouped:
+                    group_orders(r_group, b, k, theta[b], theta_dot[b], c.omega[b], group_start)
                 if save:
                     save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
 

@@ -22,7 +22,15 @@ import numba as nb
 import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._kernel_parts import analytic_order, drift, momentum, upward, upward_crossing, velocity
+from ._kernel_parts import (
+    analytic_order,
+    drift,
+    group_orders,
+    momentum,
+    upward,
+    upward_crossing,
+    velocity,
+)
 from ._physics import (
     applied_torque,
     disk_acceleration,
@@ -62,7 +70,7 @@ def advance(st, c, settings, rec):
     transposed into blocks here, once per call; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
@@ -114,7 +122,7 @@ def advance(st, c, settings, rec):
         if step0 == 0:
             for w in range(lanes):
                 if alive[w] > 0.0:
-                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
             n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, sincos)  # fmt: skip  # noqa: E501
             if n_far > 0:  # rare: redo the pass with libm trig
@@ -133,7 +141,7 @@ def advance(st, c, settings, rec):
                         tn = tn_s[i, w]
                         if upward(t0, tn):
                             t_cross = t_old + dt * t0 / (t0 - tn)
-                            upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                            upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                             ups[w] -= 1
             t_new = (s + 1) * dt
             for w in range(LANES):
@@ -167,7 +175,7 @@ def advance(st, c, settings, rec):
                 k = (s + 1) // record_every
                 for w in range(lanes):
                     if alive[w] > 0.0:
-                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for w in range(lanes):
             b = b0 + w
             for i in range(n):
@@ -214,8 +222,10 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
 
 
 @nb.njit(cache=True, inline="always")
-def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start):  # fmt: skip  # noqa: E501
     r[b, k] = analytic_order(th[:, w], thd[:, w], c.omega[blk, :, w])
+    if group_start.shape[0] > 2:  # several groups
+        group_orders(r_group, b, k, th[:, w], thd[:, w], c.omega[blk, :, w], group_start)
     if save:
         for i in range(th.shape[0]):
             traj_theta[b, k, i] = th[i, w]

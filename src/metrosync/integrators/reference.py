@@ -51,7 +51,8 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
         for b, i in zip(*np.nonzero(up), strict=True):
             t_cross = t_old + dt * th[b, i] / (th[b, i] - th_new[b, i])
             if state.last_up[b, i] >= 0:
-                _add_crossing_phase(state, b, state.last_up[b, i], t_cross, grid_dt, n_rec)
+                grp = np.searchsorted(state.group_start, i, side="right") - 1
+                _add_crossing_phase(state, b, grp, state.last_up[b, i], t_cross, grid_dt, n_rec)
             state.last_up[b, i] = t_cross
         overturned = np.any(np.abs(th_new) > overturn_angle, axis=1) & alive
         state.status[overturned] |= STATUS_OVERTURNED
@@ -80,12 +81,12 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
             _record(state, (s + 1) // record_every, sys.omega, ok)
 
 
-def _add_crossing_phase(state, b, t_prev, t_next, grid_dt, n_rec):
+def _add_crossing_phase(state, b, grp, t_prev, t_next, grid_dt, n_rec):
     g = np.arange(int(np.ceil(t_prev / grid_dt)), min(int(np.ceil(t_next / grid_dt)), n_rec))
     phase = 2 * np.pi * (g * grid_dt - t_prev) / (t_next - t_prev)
-    state.cross_re[b, g] += np.cos(phase)
-    state.cross_im[b, g] += np.sin(phase)
-    state.cross_count[b, g] += 1
+    state.cross_re[b, g, grp] += np.cos(phase)
+    state.cross_im[b, g, grp] += np.sin(phase)
+    state.cross_count[b, g, grp] += 1
 
 
 def _record(state: StepState, k: int, omega: np.ndarray, which: np.ndarray) -> None:
@@ -96,6 +97,10 @@ def _record(state: StepState, k: int, omega: np.ndarray, which: np.ndarray) -> N
     unit = np.where(rho > 0, (x + 1j * y) / safe, 0.0)
     r = np.abs(unit.sum(axis=1)) / x.shape[1]
     state.r[which, k] = r[which]
+    if state.group_start.size > 2:  # several groups
+        bounds = state.group_start
+        for g, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+            state.r_group[which, k, g] = (np.abs(unit[:, lo:hi].sum(axis=1)) / (hi - lo))[which]
     if state.traj_theta.shape[0]:
         state.traj_theta[which, k] = x[which]
         state.traj_theta_dot[which, k] = state.theta_dot[which]

@@ -30,6 +30,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import ParameterError, describe
+from ..groups import as_groups, describe_groups, shifted
 from ..model import MetronomeDesign, Platform, get_preset
 from .points import PointSpec, canonical_json, make_point
 
@@ -45,6 +46,8 @@ ENSEMBLE_SETTINGS: dict[str, tuple[type, Any]] = {
     # None: the steady swing 2M/(π c_θ); needed where that is 0 or infinite.
     "amplitude": (float, None),
 }
+#: Settings that exist only with ``groups``: the BPM added to every group after the first.
+GROUP_SETTINGS = ("group_offset_bpm",)
 #: Model parameters that can be swept or fixed (routed through ``simulate(changes=)``).
 MODEL_PARAMETERS = tuple(
     sorted(
@@ -65,6 +68,7 @@ ALIASES = {
 UNITS = {
     "amplitude": "rad",
     "bpm": "BPM",
+    "group_offset_bpm": "BPM",
     "sigma_bpm": "BPM",
     "duration": "s",
     "dt": "s",
@@ -90,14 +94,15 @@ OPTIONS: dict[str, Any] = {
     "record_every": None,
     "integrator": "verlet",
     "backend": "numba",
+    "groups": None,
 }
 
 
 def canonical_name(name: str) -> str:
     """The parameter's canonical name, or a `ParameterError` listing the valid ones."""
     name = ALIASES.get(name, name).replace("-", "_")
-    if name not in ENSEMBLE_SETTINGS and name not in MODEL_PARAMETERS:
-        valid = sorted({*ENSEMBLE_SETTINGS, *MODEL_PARAMETERS, *ALIASES})
+    if name not in ENSEMBLE_SETTINGS and name not in MODEL_PARAMETERS + GROUP_SETTINGS:
+        valid = sorted({*ENSEMBLE_SETTINGS, *MODEL_PARAMETERS, *GROUP_SETTINGS, *ALIASES})
         raise ParameterError(f"unknown sweep parameter {name!r}; valid names: {valid}.")
     return name
 
@@ -199,6 +204,10 @@ class Grid:
     preset : the model preset the changes apply to.
     keep_r : keep r(t) of every run (large: points × runs × records).
     equilibrium_window, record_every, integrator, backend : passed to `simulate`.
+    groups : groups of metronomes (`metrosync.groups`; tuples or ``"N@BPM[:SIGMA]"``)
+        in place of ``n`` and ``bpm``; then ``group_offset_bpm`` (swept or fixed) adds
+        to the BPM of every group after the first, and ``sigma_bpm`` is the spread of
+        the groups that give none.
     """
 
     axes: Mapping[str, Any]
@@ -210,6 +219,7 @@ class Grid:
     record_every: int | None = None
     integrator: str = "verlet"
     backend: str = "numba"
+    groups: Any = None
 
     def __post_init__(self) -> None:
         axes: dict[str, tuple] = {}
@@ -226,18 +236,40 @@ class Grid:
             if name in axes:
                 raise ParameterError(f"`{name}` is both swept and fixed; keep one.")
             (fixed[name],) = parse_values(name, value)
+        self._check_groups(axes, fixed)
+        replaced = ("n", "bpm") if self.groups else ()
         for name, (_, default) in ENSEMBLE_SETTINGS.items():
-            if name not in axes and name not in fixed and (default is not None or name == "seed"):
+            if name in axes or name in fixed or name in replaced:
+                continue
+            if default is not None or name == "seed":
                 fixed[name] = self.seed if name == "seed" else default
         object.__setattr__(self, "axes", axes)
         object.__setattr__(self, "fixed", fixed)
         get_preset(self.preset, warn=False)  # an unknown preset fails here, not per point
         self._check_model()
 
+    def _check_groups(self, axes, fixed) -> None:
+        if self.groups is None:
+            if "group_offset_bpm" in {*axes, *fixed}:
+                raise ParameterError(
+                    "`group_offset_bpm` shifts the groups after the first: give `groups` too."
+                )
+            return
+        object.__setattr__(self, "groups", as_groups(self.groups, None))
+        given = [name for name in ("n", "bpm") if name in axes or name in fixed]
+        if given:
+            raise ParameterError(
+                f"`groups` sets the number and BPM of each group's metronomes; drop `{given[0]}`."
+            )
+
     def _check_model(self) -> None:
         """Build every distinct parameter set once, so bad values fail before any work."""
         swept_model = [name for name in self.axes if name in MODEL_PARAMETERS]
-        bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed["bpm"],)
+        bpms = self.axes["bpm"] if "bpm" in self.axes else (self.fixed.get("bpm"),)
+        if self.groups:
+            offsets = self.axes.get("group_offset_bpm", (self.fixed.get("group_offset_bpm", 0),))
+            bpms = [g.bpm for o in offsets for g in shifted(self.groups, o)]
+        axis = "group_offset_bpm" if self.groups else "bpm"
         started = "amplitude" in self.axes or "amplitude" in self.fixed
         for values in itertools.product(*(self.axes[name] for name in swept_model)):
             where = dict(zip(swept_model, values, strict=True))
@@ -252,14 +284,15 @@ class Grid:
                     f"amplitude: `amplitude` (--amplitude 0.5, or amplitude = 0.5 under [fixed] "
                     f"in the grid file)."
                 )
-            params.metronome.check_tunable(bpms, fix="Narrow the `bpm` axis.")
+            params.metronome.check_tunable(bpms, fix=f"Narrow the `{axis}` axis.")
 
     @classmethod
     def from_toml(cls, path: str | Path, **overrides) -> Grid:
         """Read a grid from TOML: ``[grid]`` swept values, ``[fixed]`` fixed ones, and
         top-level ``seed``, ``preset``, ``keep_r``, ``equilibrium_window``,
-        ``record_every``, ``integrator``, ``backend``. ``overrides`` replace or extend
-        (``axes``/``fixed`` are merged by name)."""
+        ``record_every``, ``integrator``, ``backend``, ``groups`` (e.g.
+        ``["7@184", "7@184:0.5"]``). ``overrides`` replace or extend (``axes``/``fixed``
+        are merged by name)."""
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text())
@@ -315,14 +348,18 @@ class Grid:
     def _point(self, index: tuple[int, ...], coords: dict[str, Any]) -> PointSpec:
         values = {**self.fixed, **coords}
         changes = {k: v for k, v in values.items() if k in MODEL_PARAMETERS}
+        if self.groups:
+            groups = shifted(self.groups, values.get("group_offset_bpm", 0.0))
+            values["groups"] = describe_groups(groups)  # for the seed
         kwargs = {
-            "n": values["n"],
-            "bpm": values["bpm"],
+            "n": values.get("n"),
+            "bpm": values.get("bpm"),
             "sigma_bpm": values["sigma_bpm"],
             "runs": values["runs"],
             "duration": values["duration"],
             "dt": values["dt"],
             "seed": point_seed(values["seed"], {k: v for k, v in values.items() if k != "seed"}),
+            **({"groups": [[g.n, g.bpm, g.sigma_bpm] for g in groups]} if self.groups else {}),
             "preset": self.preset,
             "changes": changes or None,
             "integrator": self.integrator,
@@ -349,6 +386,8 @@ class Grid:
             record_every=_attr(self.record_every),
             metrosync_version=__version__,
         )
+        if self.groups:
+            attrs["groups"] = describe_groups(self.groups)
         unswept = {k: v for k, v in self.model_parameters().as_dict().items() if k not in self.axes}
         attrs.update({f"model_{k}": _attr(v) for k, v in unswept.items()})
         return attrs

@@ -62,6 +62,8 @@ def _sweep_point(spec: PointSpec, result: xr.Dataset) -> xr.Dataset:
         "status": ("run", result.status.values.astype(np.int8)),
     }
     coords = {}
+    if "r_eq_group" in result:  # groups (`metrosync.groups`): each group's r_eq
+        data["r_eq_group"] = (("run", "group"), result.r_eq_group.values)
     if spec.keep_r:
         data["r"] = (("time", "run"), result.r.values)
         data["r_crossing"] = (("time", "run"), result.r_crossing.values)

@@ -79,7 +79,9 @@ def make_point(
         raise ParameterError(f"unknown `keep` {keep!r}; choose one of {list(KEEPS)}.")
     kwargs = dict(kwargs)
     steps = round(kwargs["duration"] / kwargs.get("dt", 0.01))
-    work = int(kwargs.get("runs", 1)) * int(kwargs["n"]) * int(steps)
+    groups = kwargs.get("groups")  # (n, bpm[, sigma]) each, in place of n
+    n = sum(int(g[0]) for g in groups) if groups else int(kwargs["n"])
+    work = int(kwargs.get("runs", 1)) * n * int(steps)
     return PointSpec(tuple(index), dict(coords or {}), kwargs, keep, point_key(kwargs, keep), work)
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import socket
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +54,7 @@ LONG_NAMES = {
     "l1": "distance of the fixed weight below the pivot",
     "radius": "disk radius",
     "g": "gravitational acceleration",
+    "group_offset_bpm": "BPM added to every group after the first",
 }
 
 
@@ -130,8 +132,9 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
 
     Variables (``*axes`` = one dimension per swept parameter, in grid order):
     r_eq, r_eq_analytic (*axes, run); status (*axes, run) int8 bit flags, -1 for no
-    such run; r_eq_mean, r_eq_std, n_flagged, seed, error (*axes); and with
-    ``keep_r`` r, r_crossing (*axes, time, run).
+    such run; r_eq_mean, r_eq_std, n_flagged, seed, error (*axes); with groups
+    r_eq_group (*axes, run, group) and its mean over runs r_eq_group_mean (*axes,
+    group); and with ``keep_r`` r, r_crossing (*axes, time, run).
     """
     specs = list(grid.points())
     loaded: dict[tuple[int, ...], xr.Dataset | None] = {
@@ -151,6 +154,8 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
     if time is not None:
         r_t = np.full((*shape, len(time), n_run), np.nan)
         r_cross = np.full((*shape, len(time), n_run), np.nan)
+    n_groups = len(grid.groups) if grid.groups else 0
+    r_eq_group = np.full((*shape, n_run, n_groups), np.nan)
     for spec in specs:
         i = spec.index
         seed[i] = spec.kwargs["seed"]
@@ -164,6 +169,8 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         status[i][:runs] = ds.status.values
         mean[i], std[i] = ds.attrs["r_eq_mean"], ds.attrs["r_eq_std"]
         error[i] = ds.attrs.get("error", "")
+        if "r_eq_group" in ds:
+            r_eq_group[i][:runs] = ds.r_eq_group.values
         if time is not None and "r" in ds:
             steps = ds.sizes["time"]
             r_t[i][:steps, :runs] = ds.r.values
@@ -206,6 +213,20 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
             {"long_name": "Kuramoto r (crossing phases)"},
         )
         coords["time"] = ("time", time, {"units": "s", "long_name": "simulated time"})
+    if n_groups:
+        data["r_eq_group"] = (
+            (*dims, "run", "group"),
+            r_eq_group,
+            {"long_name": "equilibrium r of each group per run (crossing phases)"},
+        )
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # a point without finite runs
+            group_mean = np.nanmean(r_eq_group, axis=-2)
+        data["r_eq_group_mean"] = (
+            (*dims, "group"),
+            group_mean,
+            {"long_name": "equilibrium r of each group, mean over runs"},
+        )
     return xr.Dataset(data, coords=coords, attrs=grid.describe())
 
 

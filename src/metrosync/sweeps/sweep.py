@@ -183,10 +183,13 @@ def sweep_budget(specs, todo, *, scheduler=None, n_workers=None) -> Budget:
         records = steps // every + 1
         merge += 2 * (17.0 * k["runs"] + (16.0 * records * k["runs"] if spec.keep_r else 0.0))
         merge += POINT_OVERHEAD
+        groups = k.get("groups") or ()  # records are kept per group, N is their total
+        n = sum(g[0] for g in groups) if groups else k["n"]
         if spec.key in to_compute:
             sims.append(
                 simulation_budget(
-                    n=k["n"], runs=k["runs"], steps=steps, records=records, trajectories=False,
+                    n=n, runs=k["runs"], steps=steps, records=records * max(1, len(groups)),
+                    trajectories=False,
                     integrator=k["integrator"], backend=k["backend"], dt=k["dt"],
                 )  # fmt: skip
             )
