@@ -1,8 +1,18 @@
-"""The solved form (eqm1)–(eqm2) must satisfy the unsolved equations (metron2a)–(metron2)."""
+"""The solved form (eqm1)–(eqm2) must satisfy the unsolved equations (metron2a)–(metron2),
+with the model's switches beyond the paper on or off."""
+
+from dataclasses import replace
 
 import numpy as np
 
-from metrosync.equations import SystemArrays, accelerations, residuals
+from metrosync.equations import (
+    SystemArrays,
+    accelerations,
+    applied_torque,
+    escapement,
+    residuals,
+)
+from metrosync.model import get_preset, system_arrays
 
 
 def test_solved_form_solves_the_equations_of_motion(rng, random_system):
@@ -37,3 +47,97 @@ def test_rigid_support_leaves_the_disk_still(rng, random_system):
     phi_ddot, theta_ddot = accelerations(sys, theta, zeros, np.zeros(4), zeros)
     assert np.all(phi_ddot == 0)
     np.testing.assert_allclose(theta_ddot, -sys.mgh * np.sin(theta) / sys.inertia)
+
+
+def with_features(sys, rng):
+    """``sys`` with the features beyond the paper on, at random strengths: an applied
+    torque, escapement offsets, and the escapement's reaction on or off per run."""
+    b, n = sys.shape
+    return replace(
+        sys,
+        forcing_amplitude=rng.uniform(0, 0.05, b),
+        forcing_omega=rng.uniform(5, 30, b),
+        escapement_offset=rng.uniform(-0.2, 0.2, (b, n)),
+        escapement_reaction=rng.choice([0.0, 1.0], b),
+    )
+
+
+def test_solved_form_solves_the_equations_with_every_feature_on(rng, random_system):
+    for _ in range(20):
+        sys = with_features(random_system(), rng)
+        theta = rng.uniform(-np.pi, np.pi, sys.shape)
+        theta_dot = rng.normal(0, 5, sys.shape)
+        phi_dot = rng.normal(0, 1, sys.shape[0])
+        kick = rng.choice([-1.0, 0.0, 1.0], sys.shape) * sys.drive / 0.01
+        t = rng.uniform(0, 100)
+        phi_ddot, theta_ddot = accelerations(sys, theta, theta_dot, phi_dot, kick, t)
+        disk, pendulum = residuals(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t)
+        scale = np.abs(kick).max() + 1.0
+        np.testing.assert_allclose(disk, 0, atol=1e-12 * scale)
+        np.testing.assert_allclose(pendulum, 0, atol=1e-12 * scale)
+
+
+def paper_disk_equation(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, reaction):
+    """Left minus right of eq. (metron2a) as the paper writes it, with the −Σ𝕄_i term
+    kept (``reaction``) or dropped; no applied torque."""
+    lhs = sys.total_inertia * phi_ddot + sys.radius * np.sum(
+        sys.mh * (theta_ddot * np.cos(theta) - theta_dot**2 * np.sin(theta)), axis=-1
+    )
+    rhs = -sys.c_phi * phi_dot - (np.sum(kick, axis=-1) if reaction else 0.0)
+    return lhs - rhs
+
+
+def test_without_escapement_reaction_the_disk_equation_loses_exactly_that_term(rng, random_system):
+    on = random_system()
+    off = replace(on, escapement_reaction=np.zeros(on.shape[0]))
+    theta = rng.uniform(-1.5, 1.5, on.shape)
+    theta_dot = rng.normal(0, 5, on.shape)
+    phi_dot = rng.normal(0, 1, on.shape[0])
+    kick = rng.choice([-1.0, 1.0], on.shape) * on.drive / 0.01
+    state = (theta, theta_dot, phi_dot, kick)
+    acc_on, acc_off = accelerations(on, *state), accelerations(off, *state)
+    scale = np.abs(kick).max()
+    for acc, reaction in ((acc_on, True), (acc_off, False)):
+        np.testing.assert_allclose(
+            paper_disk_equation(on, *state, *acc, reaction), 0, atol=1e-12 * scale
+        )
+    # The pendulum equation (metron2) keeps its kick either way.
+    np.testing.assert_allclose(residuals(off, *state, *acc_off)[1], 0, atol=1e-12 * scale)
+    # The solved form: φ̈ gains Σ𝕄_i / D and nothing else (the C term stays), with D
+    # the paper's denominator.
+    d = on.total_inertia - np.sum(
+        (on.radius[:, None] * on.mh * np.cos(theta)) ** 2 / on.inertia, axis=-1
+    )
+    np.testing.assert_allclose(
+        acc_off[0] - acc_on[0], np.sum(kick, axis=-1) / d, rtol=1e-9, atol=1e-12 * scale
+    )
+    assert np.all(np.abs(acc_off[0] - acc_on[0]) > 1e-6)  # the term is not negligible here
+    # Unkicked, the switch changes nothing.
+    zero = np.zeros(on.shape)
+    np.testing.assert_array_equal(
+        accelerations(on, theta, theta_dot, phi_dot, zero)[0],
+        accelerations(off, theta, theta_dot, phi_dot, zero)[0],
+    )
+
+
+def test_applied_torque_is_a_sine_at_the_forcing_bpm():
+    params = get_preset("default").with_changes(forcing_amplitude=0.003, forcing_bpm=120.0)
+    sys, _ = system_arrays(params, np.full((2, 3), 0.03))
+    # 120 BPM is one period per second (two beats a period): Ω = 2π rad/s.
+    np.testing.assert_allclose(sys.forcing_omega, 2 * np.pi)
+    np.testing.assert_allclose(applied_torque(sys, 0.25), 0.003, rtol=1e-15)
+    np.testing.assert_allclose(applied_torque(sys, 0.75), -0.003, rtol=1e-15)
+    unforced, _ = system_arrays(get_preset("default"), np.full((2, 3), 0.03))
+    assert np.all(applied_torque(unforced, 12.3) == 0)
+
+
+def test_escapement_kicks_where_theta_crosses_its_offset(random_system):
+    sys = replace(random_system(b=1, n=1), escapement_offset=np.full((1, 1), 0.05))
+    rate = sys.drive[0, 0] / 0.01
+    for before, after, want in [
+        (0.04, 0.06, rate), (0.06, 0.04, -rate),
+        (-0.01, 0.01, 0.0), (0.01, -0.01, 0.0),  # crossing 0 is no longer a kick
+        (0.05, 0.06, 0.0), (0.04, 0.05, 0.0),  # touching δ is not crossing it
+    ]:  # fmt: skip
+        kick = escapement(sys, np.array([[before]]), np.array([[after]]), 0.01)
+        assert kick[0, 0] == want, (before, after)

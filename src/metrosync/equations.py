@@ -7,7 +7,8 @@ The contract: `accelerations` evaluates the solved form, eqs. (eqm1) and (eqm2),
 
 with A, B, C, D as in the paper (generalised to a mass m_i per metronome), and
 −c_φ φ̇ − Σ𝕄_i + τ(t) the torque on the disk from outside the pendulums (`disk_torque`;
-τ(t), `applied_torque`, is none in the current model). It is the one vectorised
+τ(t) = A sin(Ω t), `applied_torque`, is 0 unless the platform is forced; the −Σ𝕄_i
+term is dropped when ``escapement_reaction`` is off). It is the one vectorised
 definition shared by the NumPy reference integrator and the accurate ``exact``
 integrator; the compiled kernels call the scalar form of the same forces in
 `integrators._physics`, and tests hold the two equal. `residuals` evaluates the
@@ -16,8 +17,8 @@ form satisfies them.
 
 All arrays broadcast over leading "batch" axes: per-metronome arrays have shape
 (..., N), per-run arrays shape (...). ``kick`` is the escapement torque 𝕄_i (N m) in
-force form; the integrators supply ±M/dt or 0. The constants come as `SystemArrays`
-(defined with their builder in `model.system`, re-exported here).
+force form; the fixed-step integrators supply ±M/dt or 0 (`escapement`). The constants
+come as `SystemArrays` (defined with their builder in `model.system`, re-exported here).
 """
 
 from __future__ import annotations
@@ -26,18 +27,38 @@ import numpy as np
 
 from .model.system import SystemArrays
 
-__all__ = ["SystemArrays", "accelerations", "applied_torque", "disk_torque", "residuals"]
+__all__ = [
+    "SystemArrays",
+    "accelerations",
+    "applied_torque",
+    "disk_torque",
+    "escapement",
+    "residuals",
+]
 
 
 def applied_torque(sys: SystemArrays, t) -> np.ndarray:
-    """External torque τ(t) on the disk (N m), (B,): none in the current model."""
-    return np.zeros(np.shape(sys.radius))
+    """External torque τ(t) = A sin(Ω t) on the disk (N m), (B,); 0 where A = 0."""
+    return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)
 
 
 def disk_torque(sys: SystemArrays, phi_dot, kick, t=0.0):
     """Torque on the disk from outside the pendulums' swing, (B,): bearing friction,
-    the escapement's reaction and the applied torque, −c_φ φ̇ − Σ𝕄_i + τ(t)."""
-    return -sys.c_phi * phi_dot - np.sum(kick, axis=-1) + applied_torque(sys, t)
+    the escapement's reaction (times ``escapement_reaction``, 1 or 0) and the applied
+    torque, −c_φ φ̇ − Σ𝕄_i + τ(t)."""
+    reaction = sys.escapement_reaction * np.sum(kick, axis=-1)
+    return -sys.c_phi * phi_dot - reaction + applied_torque(sys, t)
+
+
+def escapement(sys: SystemArrays, theta, theta_next, dt: float) -> np.ndarray:
+    """The paper's discrete escapement over a step ``dt`` from ``theta`` to
+    ``theta_next``, (B, N): 𝕄_i = +M/dt when θ_i rises through its escapement angle
+    δ_i (``escapement_offset``, 0 in the paper), −M/dt when it falls through it, else 0."""
+    at = sys.escapement_offset
+    rate = sys.drive / dt
+    up = (theta < at) & (theta_next > at)
+    down = (theta > at) & (theta_next < at)
+    return np.where(up, rate, np.where(down, -rate, 0.0))
 
 
 def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):

@@ -15,6 +15,8 @@ was recorded in an `xarray.Dataset`:
     frequency_bpm, l2 (run, metronome)    natural frequency and slider position
     tick_rate_bpm (run, metronome)        ticks per minute measured at the end of the
                                           run (see `metrosync.observables.ticks`)
+    escapement_offset (run, metronome)    where each escapement acts, rad, only when
+                                          some metronome is out of beat
     theta, theta_dot (time, run, metronome), phi, phi_dot (time, run)
                                           trajectories, only when asked for
 
@@ -410,6 +412,13 @@ def _to_dataset(
             },
         ),
     }
+    offset = ensemble.system.escapement_offset
+    if np.any(offset != 0):  # some metronome is out of beat: say which, and by how much
+        data["escapement_offset"] = (
+            ("run", "metronome"),
+            np.array(offset, dtype=float),
+            {"units": "rad", "long_name": "angle at which the escapement acts"},
+        )
     if rec.theta is not None:
         data["theta"] = (
             ("time", "run", "metronome"),

@@ -77,15 +77,13 @@ def test_asymmetry_of_a_tick_off_the_vertical():
 
 
 def test_simulated_escapement_offset_is_heard_as_its_asymmetry(tmp_path):
-    """The model's escapement offset, rendered by `write_wav` and analysed (issue item:
-    ticks out of beat in the simulator). Skips until the model has the parameter."""
+    """The model's escapement offset, rendered by `write_wav` (a click where each kick
+    is) and analysed: the limp heard is the one the offset makes (measured 4.94 % for
+    4.98 % expected)."""
     import metrosync
     from metrosync.audio.metronome import asymmetry_from_offset
-    from metrosync.model import MetronomeDesign
     from metrosync.show.sound import write_wav
 
-    if "escapement_offset" not in MetronomeDesign.__dataclass_fields__:
-        pytest.skip("the model has no `escapement_offset` yet")
     offset = 0.03
     ds = metrosync.simulate(1, 150.0, duration=60.0, record_every=1, trajectories=True,
                             changes={"escapement_offset": offset})  # fmt: skip

@@ -25,9 +25,14 @@ def run(advance, **kw):
                 overturn_angle=math.pi / 2, **kw)
     return st
 
-# 4 threads for 5 metronomes: each thread strides over two of them; then two groups.
-for groups in (None, [(2, 186.0), (3, 198.0)]):
-    ens = build_ensemble(5, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=2, seed=3,
+# 4 threads for 5 metronomes: each thread strides over two of them; then two groups,
+# then the features beyond the paper (the GPU kernel compiles the same _physics
+# functions, so it has them too).
+FEATURES = {"forcing_amplitude": 0.02, "forcing_bpm": 189.0, "escapement_offset": 0.07,
+            "escapement_reaction": False}
+for groups, changes in ((None, {}), ([(2, 186.0), (3, 198.0)], {}), (None, FEATURES)):
+    params = get_preset("default").with_changes(**changes)
+    ens = build_ensemble(5, 192.0, params=params, sigma_bpm=2.0, runs=2, seed=3,
                          groups=groups)
     gpu = run(kernel_cuda.advance_state, threads=4)
     ref = run(reference.advance_state)

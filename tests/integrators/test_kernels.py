@@ -30,14 +30,22 @@ def run(advance, ens, steps, **kwargs):
     return state
 
 
-#: Model features every layout must reproduce, switched on one at a time: name ->
-#: keyword arguments of `build_ensemble` for n metronomes (``params`` included).
+#: Model features every layout must reproduce, switched on one at a time and all at once:
+#: name -> keyword arguments of `build_ensemble` for n metronomes (``params`` included).
+FORCING = {"forcing_amplitude": 0.02, "forcing_bpm": 189.0}
+ESCAPEMENT = {"escapement_offset": 0.07, "escapement_reaction": False}
 FEATURES = {
     "plain": lambda n: {},
     # Three groups at their own frequencies, the first of a single metronome.
     "groups": lambda n: {
         "groups": [(1, 184.0), ((n - 1) // 2, 192.0), (n - 1 - (n - 1) // 2, 200.0, 1.0)]
     },
+    "forcing": lambda n: {"params": get_preset("default").with_changes(**FORCING)},
+    "escapement": lambda n: {"params": get_preset("default").with_changes(**ESCAPEMENT)},
+}
+FEATURES["all"] = lambda n: {
+    **FEATURES["groups"](n),
+    "params": get_preset("default").with_changes(**FORCING, **ESCAPEMENT),
 }
 
 

@@ -3,6 +3,7 @@
 the GPU kernel compile the same source."""
 
 import math
+from dataclasses import replace
 
 import numba as nb
 import numpy as np
@@ -66,10 +67,25 @@ def scalar_accelerations(c, theta, theta_dot, phi_dot, kick, t, blocked):
     return phdd, thdd, force
 
 
+def with_features(sys, rng):
+    """``sys`` with the features beyond the paper on, at random strengths."""
+    b, n = sys.shape
+    return replace(
+        sys,
+        forcing_amplitude=rng.uniform(0, 0.05, b) * rng.choice([0.0, 1.0], b),
+        forcing_omega=rng.uniform(5, 30, b),
+        escapement_offset=rng.uniform(-0.2, 0.2, (b, n)),
+        escapement_reaction=rng.choice([0.0, 1.0], b),
+    )
+
+
+@pytest.mark.parametrize("features", [False, True], ids=["paper", "features"])
 @pytest.mark.parametrize("blocked", [False, True])
-def test_scalar_physics_equals_the_vectorised_equations(rng, random_system, blocked):
+def test_scalar_physics_equals_the_vectorised_equations(rng, random_system, blocked, features):
     for _ in range(5):
         sys = random_system(b=5, n=4)
+        if features:
+            sys = with_features(sys, rng)
         theta = rng.uniform(-np.pi, np.pi, sys.shape)
         theta_dot = rng.normal(0, 5, sys.shape)
         phi_dot = rng.normal(0, 1, sys.shape[0])
@@ -96,6 +112,26 @@ def test_escapement_is_the_papers_discrete_kick(random_system):
     ]:  # fmt: skip
         assert escapement.py_func(c, (0, 0), before, after) == want
         assert escapement(c, (0, 0), before, after) == want
+
+
+def test_scalar_escapement_kicks_at_its_offset_like_the_vectorised_one(rng, random_system):
+    sys = with_features(random_system(b=3, n=50), rng)
+    c = constants_of(sys, DT)
+    theta = sys.escapement_offset + rng.uniform(-0.05, 0.05, sys.shape)
+    theta_next = sys.escapement_offset + rng.uniform(-0.05, 0.05, sys.shape)
+    want = equations.escapement(sys, theta, theta_next, DT)
+    got = [[escapement(c, (b, i), theta[b, i], theta_next[b, i]) for i in range(50)]
+           for b in range(3)]  # fmt: skip
+    np.testing.assert_array_equal(got, want)
+    assert np.count_nonzero(want) > 20
+
+
+def test_applied_torque_is_off_unless_forced(random_system):
+    sys = random_system(b=2, n=1)
+    forced = replace(sys, forcing_amplitude=np.array([0.0, 0.01]), forcing_omega=np.full(2, 20.0))
+    c = constants_of(forced, DT)
+    assert applied_torque(c, 0, 0.3) == 0.0
+    assert applied_torque(c, 1, 0.3) == pytest.approx(0.01 * math.sin(6.0), rel=1e-15)
 
 
 def test_disk_velocity_inverts_the_disk_momentum(rng, random_system):

@@ -164,3 +164,35 @@ def test_writing_does_not_hold_the_audio_in_memory(recorded_ds, tmp_path):
 def test_useless_lengths_are_refused(recorded_ds, options, match):
     with pytest.raises(ParameterError, match=match):
         click_track(RecordedRun.from_dataset(recorded_ds), **options)
+
+
+def test_a_metronome_out_of_beat_clicks_where_its_escapement_acts():
+    """With `escapement_offset`, the clicks sit where θ crosses the offset (where the
+    kicks are), each metronome its own, not at the vertical."""
+    design = metrosync.MetronomeDesign()
+    offsets = (0.05, -0.02)
+    metronomes = [
+        metrosync.Metronome(metrosync.MetronomeDesign(escapement_offset=d), design.l2_for_bpm(b))
+        for d, b in zip(offsets, (188.0, 196.0), strict=True)
+    ]
+    ds = metrosync.simulate(None, None, metronomes=metronomes, theta0=[0.5, -0.4],
+                            duration=8.0, record_every=1, trajectories=True)  # fmt: skip
+    np.testing.assert_array_equal(ds.escapement_offset.values, [offsets])
+    run = RecordedRun.from_dataset(ds)
+    np.testing.assert_array_equal(run.tick_angles, offsets)
+    found = crossing_times(run)
+    for i, offset in enumerate(offsets):
+        want = simulated_crossings(run.theta[:, i] - offset, run.time)
+        np.testing.assert_allclose(found[i], want, rtol=0, atol=1e-12)
+        # Each click is where the escapement kicks: θ̇ jumps there.
+        jumps = np.abs(np.diff(run.theta_dot[:, i], 2))
+        kicked = run.time[1:-1][jumps > 10 * np.median(jumps)]
+        assert kicked.size >= found[i].size > 10
+        assert np.all(np.min(np.abs(kicked[:, None] - found[i][None, :]), axis=1) < 0.02)
+    # The model's one value is used when the dataset has no per-metronome variable.
+    same = metrosync.simulate(1, 192, duration=2.0, record_every=1, trajectories=True,
+                              changes={"escapement_offset": 0.04}).drop_vars("escapement_offset")  # fmt: skip  # noqa: E501
+    np.testing.assert_array_equal(RecordedRun.from_dataset(same).tick_angles, [0.04])
+    plain = metrosync.simulate(1, 192, duration=2.0, record_every=1, trajectories=True)
+    assert "escapement_offset" not in plain
+    np.testing.assert_array_equal(RecordedRun.from_dataset(plain).tick_angles, [0.0])

@@ -14,7 +14,9 @@ def register(subparsers) -> None:
         "listen",
         help="write the ticks of a run as a WAV file",
         description="Write a stereo WAV with a click for every zero crossing of every "
-        "pendulum (the instant a metronome ticks), panned by its place on the disk. "
+        "pendulum (the instant a metronome ticks; for a metronome out of beat, "
+        "--set escapement_offset=RAD, where θ crosses that angle), panned by its place "
+        "on the disk. "
         "Simulating here records every step, so clicks fall on the simulated crossings.",
         formatter_class=HelpFormatter,
     )

@@ -27,9 +27,9 @@ def run(args) -> int:
         print(f"{name}: {params.description}")
         for key, value in params.as_dict().items():
             if key != "preset":
-                print(f"    {key:16s} {value} {units.get(key, '')}".rstrip())
+                print(f"    {key:20s} {value} {units.get(key, '')}".rstrip())
         low, high = params.metronome.bpm_range()
-        print(f"    {'steady amp.':16s} {params.steady_amplitude:.3f} rad"
+        print(f"    {'steady amp.':20s} {params.steady_amplitude:.3f} rad"
               + ("  (OVERTURNS: > pi/2)" if params.overturns else ""))  # fmt: skip
-        print(f"    {'tunable BPM':16s} {low:.1f} .. {high:.1f}")
+        print(f"    {'tunable BPM':20s} {low:.1f} .. {high:.1f}")
     return 0

@@ -31,7 +31,8 @@ eq. (eqm2) reads θ̈_i = ρ_i − R q_i φ̈ / I_i; put into eq. (metron2a) it 
     φ̈ = (R Σ_i (m_i h_i θ̇_i² sin θ_i − q_i ρ_i) + F) / (J + R² Σm − R² Σ_i q_i² / I_i),
 
 with F the torque on the disk from outside the pendulums' swing: bearing friction, the
-escapement's reaction −Σ𝕄_i, and any applied torque. A kernel sums the per-metronome
+escapement's reaction −Σ𝕄_i (unless ``escapement_reaction`` is off), and the applied
+torque A sin(Ω t) (when ``forcing_amplitude`` is not 0). A kernel sums the per-metronome
 parts (`pendulum_terms`), then calls `disk_acceleration` once per run and
 `theta_ddot` once per metronome.
 """
@@ -46,10 +47,12 @@ import numba as nb
 @nb.njit(cache=True, inline="always")
 def escapement(c, m, theta, theta_next):
     """The paper's discrete escapement over one step from ``theta`` to ``theta_next``:
-    the torque 𝕄 = +M/dt when θ rises through 0, −M/dt when it falls through 0, else 0
-    (selects, not branches, so that it vectorizes)."""
-    up = (theta < 0.0) & (theta_next > 0.0)
-    down = (theta > 0.0) & (theta_next < 0.0)
+    the torque 𝕄 = +M/dt when θ rises through the escapement's angle δ, −M/dt when it
+    falls through it, else 0 (selects, not branches, so that it vectorizes). δ is
+    ``escapement_offset``, 0 in the paper."""
+    at = c.escapement_offset[m]
+    up = (theta < at) & (theta_next > at)
+    down = (theta > at) & (theta_next < at)
     rate = c.kick_rate[m]
     return rate if up else (-rate if down else 0.0)
 
@@ -70,15 +73,29 @@ def pendulum_terms(c, m, kick, sin_t, cos_t, theta_dot):
 @nb.njit(cache=True, inline="always")
 def disk_torque(c, r, phi_dot, sum_kick):
     """F without the applied torque: bearing friction −c_φ φ̇ and the escapement's
-    reaction −Σ𝕄_i on the disk (eq. (metron2a))."""
-    return -c.c_phi[r] * phi_dot - sum_kick
+    reaction −Σ𝕄_i on the disk (eq. (metron2a)), the latter times
+    ``escapement_reaction`` (1 as the paper has it, 0 to take it off the disk)."""
+    return -c.c_phi[r] * phi_dot - c.escapement_reaction[r] * sum_kick
 
 
 @nb.njit(cache=True, inline="always")
 def applied_torque(c, r, t):
-    """External torque on the disk at time ``t``, N m: the hook for a driven platform.
-    None in the current model; `equations.applied_torque` is its vectorised twin."""
-    return 0.0
+    """External torque on the disk at time ``t``, τ = A sin(Ω t), N m
+    (``forcing_amplitude``, ``forcing_omega``); `equations.applied_torque` is its
+    vectorised twin. An unforced run (A = 0, the default) skips the sine: the branch is
+    the same for every step, so it costs nothing measurable."""
+    amplitude = c.forcing_amplitude[r]
+    if amplitude == 0.0:
+        return 0.0
+    return amplitude * math.sin(c.forcing_omega[r] * t)
+
+
+@nb.njit(cache=True, inline="always")
+def forced(c, r):
+    """Whether run ``r``'s disk feels an applied torque. A layout that vectorizes over
+    runs asks once per block, and calls `applied_torque` (a sine: not vectorizable)
+    only for a forced block, so an unforced run pays nothing for the feature."""
+    return c.forcing_amplitude[r] != 0.0
 
 
 @nb.njit(cache=True, inline="always")
@@ -111,6 +128,7 @@ FUNCTIONS = (
     pendulum_terms,
     disk_torque,
     applied_torque,
+    forced,
     disk_acceleration,
     theta_ddot,
     disk_velocity,

@@ -1,12 +1,16 @@
 """Accurate reference integrator: an 8th-order Dormand–Prince solver between impulses.
 
-Between zero crossings the equations are smooth, so scipy's DOP853 integrates them
+Between escapement events the equations are smooth, so scipy's DOP853 integrates them
 to a tight tolerance. After every accepted step each pendulum's angle is checked for
-a strict sign change; the earliest crossing is located on the step's dense output
-(Brent's method), the state is taken there, the crossing pendulum's angle is set to
-exactly 0, and the escapement impulse is applied: angular momentum M·sign(θ̇) to the
-pendulum and the matching reaction on the disk, i.e. the kick-linear part of eqs.
-(eqm1)–(eqm2) integrated over the delta function. Integration then restarts.
+a strict crossing of its escapement angle δ_i (0 in the paper, ``escapement_offset``
+otherwise); the earliest crossing is located on the step's dense output (Brent's
+method), the state is taken there, the crossing pendulum's angle is set to exactly
+δ_i, and the escapement impulse is applied: angular momentum M·sign(θ̇) to the
+pendulum and the matching reaction on the disk (unless ``escapement_reaction`` is
+off), i.e. the kick-linear part of eqs. (eqm1)–(eqm2) integrated over the delta
+function. Integration then restarts. The upward zero crossings that define the
+crossing phase are the events themselves when δ_i = 0, and are located on the dense
+output (without a restart) otherwise.
 
 It is slow (Python-level stepping) and meant for checking the fixed-step scheme on
 small ensembles and short horizons.
@@ -87,6 +91,8 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     """One run. Returns grid samples (T, 2N+2) of [φ, θ, φ̇, θ̇], upward-crossing times
     per metronome, and the status bits."""
     n = theta0.size
+    offset = sys.escapement_offset[0]
+    off_zero = np.nonzero(offset != 0.0)[0]  # their zero crossings are not events
     zero_kick = np.zeros((1, n))
     rigid = bool(np.isinf(sys.total_inertia[0]))
     period = 2 * np.pi / sys.omega.max()
@@ -113,16 +119,17 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
                 return samples, upcrossings, status | STATUS_DIVERGED
             dense = solver.dense_output()
             th_old, th_new = y_old[1 : n + 1], solver.y[1 : n + 1]
-            crossing = np.nonzero(th_old * th_new < 0)[0]
+            crossing = np.nonzero((th_old - offset) * (th_new - offset) < 0)[0]
             t_end = solver.t
             event = None
             if crossing.size:
-                roots = [
-                    brentq(lambda s, i=i, f=dense: f(s)[1 + i], dense.t_old, dense.t, xtol=1e-14)
-                    for i in crossing
-                ]
+                roots = [_crossing(dense, 1 + i, offset[i], dense.t) for i in crossing]
                 k = int(np.argmin(roots))
                 event, t_end = int(crossing[k]), roots[k]
+            if off_zero.size:
+                th_end = th_new if event is None else dense(t_end)[1 : n + 1]
+                for i in off_zero[(th_old[off_zero] < 0) & (th_end[off_zero] > 0)]:
+                    upcrossings[i].append(_crossing(dense, 1 + i, 0.0, t_end))
             while next_sample < grid.size and grid[next_sample] <= t_end:
                 samples[next_sample] = dense(grid[next_sample])
                 next_sample += 1
@@ -130,9 +137,9 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
                 status |= STATUS_OVERTURNED
             if event is not None:
                 y = dense(t_end)
-                y[1 + event] = 0.0
+                y[1 + event] = offset[event]
                 direction = np.sign(y[n + 2 + event])
-                if direction > 0:
+                if direction > 0 and offset[event] == 0.0:
                     upcrossings[event].append(t_end)
                 y = _apply_impulse(sys, y, n, event, direction, rigid)
                 t = t_end
@@ -141,6 +148,11 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
         if not restarted:
             t = duration
     return samples, [np.asarray(c) for c in upcrossings], status
+
+
+def _crossing(dense, k, level, t_end):
+    """When component ``k`` of the dense output crosses ``level`` in (t_old, t_end)."""
+    return brentq(lambda s: dense(s)[k] - level, dense.t_old, t_end, xtol=1e-14)
 
 
 def _apply_impulse(sys, y, n, event, direction, rigid):

@@ -37,6 +37,7 @@ from ._physics import (
     disk_torque,
     disk_velocity,
     escapement,
+    forced,
     pendulum_terms,
     theta_ddot,
 )
@@ -116,6 +117,10 @@ def advance(st, c, settings, rec):
         s_p = np.empty(LANES)
         phdd = np.empty(LANES)
         force = np.empty(LANES)
+        tau = np.zeros(LANES)  # applied torque, computed only for a forced block
+        block_forced = False
+        for w in range(LANES):
+            block_forced |= forced(c, (blk, w))
         ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
         overs = np.empty(LANES, dtype=np.int64)
         until_record = record_every - step0 % record_every
@@ -144,9 +149,12 @@ def advance(st, c, settings, rec):
                             upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                             ups[w] -= 1
             t_new = (s + 1) * dt
+            if block_forced:  # a sine per lane: kept out of the vectorized loop below
+                for w in range(LANES):
+                    tau[w] = applied_torque(c, (blk, w), t_new)
             for w in range(LANES):
                 ph_new[w], phd_pred[w] = drift(ph[w], phd[w], aph[w], dt, dt2)
-                force[w] = disk_torque(c, (blk, w), phd_pred[w], s_kick[w]) + applied_torque(c, (blk, w), t_new)  # fmt: skip  # noqa: E501
+                force[w] = disk_torque(c, (blk, w), phd_pred[w], s_kick[w]) + tau[w]
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
             for w in range(lanes):

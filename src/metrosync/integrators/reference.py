@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations, disk_torque
+from ..equations import SystemArrays, accelerations, disk_torque, escapement
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._state import StepState
 
@@ -45,9 +45,8 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
         th_new = th + state.theta_dot * dt + 0.5 * acc * dt * dt
         vel_pred = state.theta_dot + acc * dt
         phd_pred = state.phi_dot + state.acc_phi * dt
-        up = (th < 0) & (th_new > 0) & alive[:, None]
-        down = (th > 0) & (th_new < 0) & alive[:, None]
-        kick = np.where(up, sys.drive / dt, np.where(down, -sys.drive / dt, 0.0))
+        kick = np.where(alive[:, None], escapement(sys, th, th_new, dt), 0.0)
+        up = (th < 0) & (th_new > 0) & alive[:, None]  # the phase's crossings, at 0
         for b, i in zip(*np.nonzero(up), strict=True):
             t_cross = t_old + dt * th[b, i] / (th[b, i] - th_new[b, i])
             if state.last_up[b, i] >= 0:

@@ -8,12 +8,19 @@ linear law that matches both ends (docs/model.md §6.6),
 
 which makes the coupling mean-field as N grows. A fixed ``J`` (or ``inf`` for a rigid
 support) overrides the law.
+
+Beyond the paper, two switches of the disk's equation (metron2a), both off by default:
+an external periodic torque τ(t) = A sin(Ω t) with Ω = π·BPM/60 (the metronomes'
+convention, so forcing at a metronome's BPM is resonant), and ``escapement_reaction``,
+which the paper has on: the escapement's torque −Σ𝕄_i reacts on the disk.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from ..errors import ParameterError, require_positive
 
@@ -30,6 +37,14 @@ class Platform:
     c_phi : viscous friction of the disk's bearing, kg m²/s.
     j0, j_per_metronome : the law J(N) = j0 + N·j_per_metronome, kg m².
     inertia : if set, a fixed J that ignores the law; ``math.inf`` pins the disk.
+    forcing_amplitude : A of the external torque τ(t) = A sin(Ω t) on the disk, N m;
+        0 (the default) switches it off.
+    forcing_bpm : the forcing's frequency in the metronomes' BPM, Ω = π·BPM/60 rad/s;
+        needed (> 0) when ``forcing_amplitude`` is not 0.
+    escapement_reaction : whether the escapement's torque reacts on the disk, the
+        −Σ𝕄_i term of eq. (metron2a) (True, as the paper writes it). False keeps the
+        kicks on the pendulums but takes their reaction off the disk, as if the
+        escapement were driven from outside the platform. Accepts 0 or 1.
     """
 
     radius: float = 0.27
@@ -37,6 +52,9 @@ class Platform:
     j0: float = PAPER_J_MIN
     j_per_metronome: float = (PAPER_J_MAX - PAPER_J_MIN) / PAPER_N_MAX
     inertia: float | None = None
+    forcing_amplitude: float = 0.0
+    forcing_bpm: float = 0.0
+    escapement_reaction: bool = True
 
     def __post_init__(self) -> None:
         require_positive("radius", self.radius, unit="m")
@@ -48,6 +66,19 @@ class Platform:
                 f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), "
                 f"got {self.inertia!r}."
             )
+        require_positive("forcing_amplitude", self.forcing_amplitude, allow_zero=True, unit="N m")
+        require_positive("forcing_bpm", self.forcing_bpm, allow_zero=True, unit="BPM")
+        if self.forcing_amplitude > 0 and self.forcing_bpm == 0:
+            raise ParameterError(
+                f"`forcing_amplitude` = {self.forcing_amplitude!r} N m needs a frequency: set "
+                f"`forcing_bpm` > 0 (Ω = π·BPM/60, e.g. the metronomes' BPM for resonance)."
+            )
+        reaction = self.escapement_reaction
+        if not (isinstance(reaction, bool | np.bool_) or reaction in (0, 1)):
+            raise ParameterError(
+                f"`escapement_reaction` must be true or false (1 or 0), got {reaction!r}."
+            )
+        object.__setattr__(self, "escapement_reaction", bool(reaction))
 
     def disk_inertia(self, n: int) -> float:
         """J for ``n`` metronomes on the disk, kg m²."""

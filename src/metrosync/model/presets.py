@@ -64,7 +64,8 @@ class ModelParameters:
             out[key] = list(value) if isinstance(value, tuple) else value
         for key, value in vars(self.platform).items():
             out[key] = "law J0+N*j" if value is None else value
-        return out
+        # NetCDF has no booleans: a switch is stored as 0 or 1.
+        return {k: int(v) if isinstance(v, bool) else v for k, v in out.items()}
 
 
 PRESETS: dict[str, ModelParameters] = {

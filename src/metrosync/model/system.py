@@ -16,11 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from .metronome import centre_of_mass, natural_omega, pendulum_inertia
+from .metronome import bpm_to_omega, centre_of_mass, natural_omega, pendulum_inertia
 from .presets import ModelParameters
 
 #: The design values that may differ per metronome (`MetronomeDesign` fields).
-PER_METRONOME = ("w1", "w2", "l1", "c_theta", "drive", "g")
+PER_METRONOME = ("w1", "w2", "l1", "c_theta", "drive", "g", "escapement_offset")
 
 
 @dataclass(frozen=True)
@@ -34,6 +34,14 @@ class SystemArrays:
     omega : small-amplitude natural frequency on a rigid support, rad/s.
     radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
     in eq. (metron2a)); ``inf`` pins the disk.
+
+    Beyond the paper (each defaults to "off" when not given, so that a caller that
+    builds the arrays by hand need not know them):
+    forcing_amplitude, forcing_omega : (B,) A (N m) and Ω (rad/s) of the external
+        torque A sin(Ω t) on the disk; A = 0 switches it off.
+    escapement_offset : (B, N) angle δ_i at which metronome i's escapement acts, rad.
+    escapement_reaction : (B,) 1.0 when the escapement's reaction −Σ𝕄_i acts on the
+        disk (the paper), 0.0 when it does not.
     """
 
     mh: np.ndarray
@@ -45,6 +53,22 @@ class SystemArrays:
     radius: np.ndarray
     c_phi: np.ndarray
     total_inertia: np.ndarray
+    forcing_amplitude: np.ndarray | None = None
+    forcing_omega: np.ndarray | None = None
+    escapement_offset: np.ndarray | None = None
+    escapement_reaction: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        runs = np.shape(self.radius)
+        off = {
+            "forcing_amplitude": np.zeros(runs),
+            "forcing_omega": np.zeros(runs),
+            "escapement_offset": np.zeros(np.shape(self.mh)),
+            "escapement_reaction": np.ones(runs),
+        }
+        for name, value in off.items():
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, value)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -103,5 +127,9 @@ def system_arrays(
         radius=radius,
         c_phi=np.full(runs, platform.c_phi),
         total_inertia=disk + radius**2 * mass.sum(axis=1),
+        forcing_amplitude=np.full(runs, platform.forcing_amplitude),
+        forcing_omega=np.full(runs, float(bpm_to_omega(platform.forcing_bpm))),
+        escapement_offset=np.array(values["escapement_offset"], dtype=float),
+        escapement_reaction=np.full(runs, 1.0 if platform.escapement_reaction else 0.0),
     )
     return system, disk

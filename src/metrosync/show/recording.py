@@ -41,6 +41,8 @@ class RecordedRun:
     r_eq : equilibrium r of this run (crossing phases), NaN if undefined.
     run : index of the run in the dataset.
     attrs : the dataset's attributes.
+    escapement_offset : (N,) angle δ_i at which each metronome's escapement acts, rad;
+        None for 0, the vertical (see `tick_angles`).
     """
 
     time: np.ndarray
@@ -57,6 +59,7 @@ class RecordedRun:
     r_eq: float
     run: int
     attrs: dict
+    escapement_offset: np.ndarray | None = None
 
     @classmethod
     def from_dataset(cls, ds, run: int = 0) -> RecordedRun:
@@ -108,7 +111,15 @@ class RecordedRun:
             r_eq=r_eq,
             run=run,
             attrs=dict(ds.attrs),
+            escapement_offset=_escapement_offset(ds, sel),
         )
+
+    @property
+    def tick_angles(self) -> np.ndarray:
+        """(N,) the angle where each metronome ticks, rad: where its escapement acts."""
+        if self.escapement_offset is None:
+            return np.zeros(self.n)
+        return np.broadcast_to(np.asarray(self.escapement_offset, dtype=float), (self.n,))
 
     @property
     def n(self) -> int:
@@ -194,3 +205,12 @@ def hermite(time, y, y_dot, times) -> np.ndarray:
         + (-2 * s3 + 3 * s2) * y[k + 1]
         + (s3 - s2) * h * y_dot[k + 1]
     )
+
+
+def _escapement_offset(ds, sel) -> np.ndarray | None:
+    """Each metronome's escapement angle: the per-metronome variable `simulate` writes
+    when some metronome is out of beat, else the model's one value, else None."""
+    if "escapement_offset" in sel:
+        return np.asarray(sel.escapement_offset.values, dtype=float)
+    value = float(ds.attrs.get("escapement_offset", 0.0))
+    return None if value == 0.0 else np.full(ds.sizes["metronome"], value)

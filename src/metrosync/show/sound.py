@@ -1,9 +1,11 @@
-"""Hear a run: a stereo WAV with one click per metronome at each zero crossing of θ.
+"""Hear a run: a stereo WAV with one click per metronome each time θ passes the angle
+where its escapement acts.
 
 A real metronome ticks when its escapement releases, i.e. when the pendulum passes
-through the vertical, in both directions. So every zero crossing of θ_i, up or down,
-becomes one short click of metronome i, and the ticks audibly come together as r
-rises.
+through the vertical, in both directions, or through the angle δ_i of a metronome out
+of beat (the model's ``escapement_offset``; tick and tock then come unevenly). So every
+crossing of θ_i through δ_i, up or down, becomes one short click of metronome i, and
+the ticks audibly come together as r rises.
 
 Crossing times come from the recorded trajectory. When every integration step was
 recorded they are found exactly as the integrator finds them: the sign of θ changes
@@ -118,15 +120,17 @@ class ClickTrack:
 
 
 def crossing_times(run: RecordedRun) -> list[np.ndarray]:
-    """Times (s) of every zero crossing of each θ_i, both directions.
+    """Times (s) at which each θ_i crosses its tick angle δ_i (`RecordedRun.tick_angles`,
+    0 unless the metronome is out of beat), both directions.
 
-    Returns N increasing arrays. A crossing is a sign change from strictly negative
-    to strictly positive or back between consecutive records, as in the integrator.
+    Returns N increasing arrays. A crossing is a sign change of θ_i − δ_i from strictly
+    negative to strictly positive or back between consecutive records, as in the
+    integrator.
     """
     t = run.time
     out = []
-    for i in range(run.n):
-        y = run.theta[:, i]
+    for i, angle in enumerate(run.tick_angles):
+        y = run.theta[:, i] - angle
         k = np.flatnonzero(((y[:-1] < 0) & (y[1:] > 0)) | ((y[:-1] > 0) & (y[1:] < 0)))
         h = t[k + 1] - t[k]
         if run.every_step:

@@ -83,7 +83,12 @@ UNITS = {
     "l1": "m",
     "radius": "m",
     "g": "m/s2",
+    "forcing_amplitude": "N m",
+    "forcing_bpm": "BPM",
+    "escapement_offset": "rad",
 }
+#: Model switches: true/false in TOML, 0 or 1 on the command line.
+SWITCHES = ("escapement_reaction",)
 #: Grid size above which a typo (e.g. a step of 0.0025 for 2.5) is more likely than intent.
 MAX_POINTS_PER_AXIS = 100_000
 #: Sweep-level options (TOML top level) and their defaults.
@@ -113,6 +118,16 @@ def _kind(name: str) -> type:
 
 def _convert(name: str, value: Any) -> int | float:
     """One checked value of parameter ``name``."""
+    if name in SWITCHES:
+        words = {"0": 0, "1": 1, "false": 0, "true": 1}
+        if isinstance(value, str) and value.strip().lower() in words:
+            return words[value.strip().lower()]
+        number = isinstance(value, bool | int | float | np.integer | np.floating)
+        if not number or value not in (0, 1):
+            raise ParameterError(
+                f"`{name}` is a switch: give true or false (1 or 0), got {describe(value)}."
+            )
+        return int(value)
     if isinstance(value, bool) or not isinstance(
         value, int | float | np.integer | np.floating | str
     ):
@@ -388,7 +403,10 @@ class Grid:
         )
         if self.groups:
             attrs["groups"] = describe_groups(self.groups)
-        unswept = {k: v for k, v in self.model_parameters().as_dict().items() if k not in self.axes}
+        # Resolved at the first point: parameters checked together (a forcing amplitude
+        # with a swept forcing frequency) may not stand without the swept values.
+        first = self.model_parameters({name: values[0] for name, values in self.axes.items()})
+        unswept = {k: v for k, v in first.as_dict().items() if k not in self.axes}
         attrs.update({f"model_{k}": _attr(v) for k, v in unswept.items()})
         return attrs
 
