@@ -34,9 +34,12 @@ from ._kernel_parts import (
 from ._physics import (
     applied_torque,
     disk_acceleration,
+    disk_friction,
+    disk_friction_stop,
     disk_torque,
     disk_velocity,
     escapement,
+    momentum_at_rest,
     pendulum_terms,
     theta_ddot,
 )
@@ -117,6 +120,13 @@ def advance(st, c, settings, rec):
         phdd = np.empty(LANES)
         force = np.empty(LANES)
         ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
+        dry_lane = np.empty(LANES, dtype=np.bool_)
+        for w in range(LANES):
+            dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])  # fmt: skip  # noqa: E501
+        dry = dry_lane.any()
+        others = np.empty(LANES)
+        friction = np.empty(LANES)
+        held = np.empty(LANES, dtype=np.bool_)
         overs = np.empty(LANES, dtype=np.int64)
         until_record = record_every - step0 % record_every
         if step0 == 0:
@@ -149,6 +159,15 @@ def advance(st, c, settings, rec):
                 force[w] = disk_torque(c, (blk, w), phd_pred[w], s_kick[w]) + applied_torque(c, (blk, w), t_new)  # fmt: skip  # noqa: E501
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
+            if dry:  # the block has a run with dry friction on the disk (`verlet`)
+                for w in range(LANES):
+                    others[w] = force[w]
+                    friction[w] = 0.0
+                    held[w] = False
+                    if dry_lane[w]:
+                        friction[w], held[w] = disk_friction(c, (blk, w), phd[w], s_num[w], others[w])  # fmt: skip  # noqa: E501
+                        force[w] = others[w] + friction[w]
+                        phdd[w] = 0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])  # fmt: skip  # noqa: E501
             for w in range(lanes):
                 if alive[w] > 0.0 and not math.isfinite(phdd[w]):
                     status[b0 + w] |= STATUS_DIVERGED
@@ -169,6 +188,10 @@ def advance(st, c, settings, rec):
                     phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
+            if dry:
+                for w in range(lanes):
+                    if alive[w] > 0.0 and dry_lane[w]:
+                        _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -219,6 +242,35 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
             rest[i, w] = res
             q[i, w] = qi
     return n_far
+
+
+@nb.njit(cache=True)
+def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+    """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
+    velocity reached 0 within the step, stopped or reversed (`verlet`)."""
+    n = thd.shape[0]
+    if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step
+        end, held = disk_friction_stop(c, (blk, w), friction, phd[w], s_den, dt)
+        pp[w] += 0.5 * dt * (end - friction)
+        mean_phdd = disk_acceleration(c, (blk, w), s_num, s_den, others + end)
+        force = others + end
+        phdd = mean_phdd
+        if held:  # at rest at the end of the step: store the forces at rest
+            friction, rests = disk_friction(c, (blk, w), 0.0, s_num, others)
+            force = others + friction
+            phdd = 0.0 if rests else disk_acceleration(c, (blk, w), s_num, s_den, force)
+        s_p = 0.0
+        for i in range(n):
+            thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], mean_phdd)
+            thd[i, w] += 0.5 * dt * (thdd - acc[i, w])
+            acc[i, w] = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], phdd)
+            s_p += q[i, w] * thd[i, w]
+        phd[w] = disk_velocity(c, (blk, w), pp[w], s_p)
+        fph[w] = force
+        aph[w] = phdd
+    if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
+        pp[w] = momentum_at_rest(c, (blk, w), s_p)
+        phd[w] = 0.0
 
 
 @nb.njit(cache=True, inline="always")

@@ -8,6 +8,12 @@ linear law that matches both ends (docs/model.md §6.6),
 
 which makes the coupling mean-field as N grows. A fixed ``J`` (or ``inf`` for a rigid
 support) overrides the law.
+
+Besides the paper's viscous bearing friction −c_φ φ̇, the disk may have dry (Coulomb)
+friction, as Goldsztein, English, Behta, Finder, Nadeau and Strogatz measured for real
+metronome platforms (Chaos 32, 043119, 2022): the disk sticks while the torque needed to
+hold it stays within ``disk_dry_friction`` and slips against a torque of that size
+otherwise. Off (0) by default, as in the paper.
 """
 
 from __future__ import annotations
@@ -30,6 +36,8 @@ class Platform:
     c_phi : viscous friction of the disk's bearing, kg m²/s.
     j0, j_per_metronome : the law J(N) = j0 + N·j_per_metronome, kg m².
     inertia : if set, a fixed J that ignores the law; ``math.inf`` pins the disk.
+    disk_dry_friction : the disk's Coulomb friction torque, N m: the largest torque
+        that holds the disk at rest, and the torque against a slipping disk; 0 for none.
     """
 
     radius: float = 0.27
@@ -37,12 +45,14 @@ class Platform:
     j0: float = PAPER_J_MIN
     j_per_metronome: float = (PAPER_J_MAX - PAPER_J_MIN) / PAPER_N_MAX
     inertia: float | None = None
+    disk_dry_friction: float = 0.0
 
     def __post_init__(self) -> None:
         require_positive("radius", self.radius, unit="m")
         require_positive("c_phi", self.c_phi, allow_zero=True, unit="kg m²/s")
         require_positive("j0", self.j0, allow_zero=True, unit="kg m²")
         require_positive("j_per_metronome", self.j_per_metronome, allow_zero=True, unit="kg m²")
+        require_positive("disk_dry_friction", self.disk_dry_friction, allow_zero=True, unit="N m")
         if self.inertia is not None and not (self.inertia == math.inf or self.inertia > 0):
             raise ParameterError(
                 f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), "

@@ -34,6 +34,8 @@ class SystemArrays:
     omega : small-amplitude natural frequency on a rigid support, rad/s.
     radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
     in eq. (metron2a)); ``inf`` pins the disk.
+    dry_friction : the disk's Coulomb friction torque, N m (``Platform.disk_dry_friction``);
+    0 for none.
     """
 
     mh: np.ndarray
@@ -45,6 +47,7 @@ class SystemArrays:
     radius: np.ndarray
     c_phi: np.ndarray
     total_inertia: np.ndarray
+    dry_friction: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -103,5 +106,6 @@ def system_arrays(
         radius=radius,
         c_phi=np.full(runs, platform.c_phi),
         total_inertia=disk + radius**2 * mass.sum(axis=1),
+        dry_friction=np.full(runs, platform.disk_dry_friction),
     )
     return system, disk
