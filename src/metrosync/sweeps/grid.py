@@ -83,6 +83,7 @@ UNITS = {
     "l1": "m",
     "radius": "m",
     "g": "m/s2",
+    "disk_dry_friction": "N m",
 }
 #: Grid size above which a typo (e.g. a step of 0.0025 for 2.5) is more likely than intent.
 MAX_POINTS_PER_AXIS = 100_000
