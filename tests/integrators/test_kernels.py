@@ -30,7 +30,11 @@ def run(advance, ens, steps, **kwargs):
     return state
 
 
-#: Model features every layout must reproduce, switched on one at a time: name ->
+def dry_params(threshold):
+    return get_preset("default").with_changes(disk_dry_friction=threshold)
+
+
+#: Model features every layout must reproduce, one at a time and all at once: name ->
 #: keyword arguments of `build_ensemble` for n metronomes (``params`` included).
 FEATURES = {
     "plain": lambda n: {},
@@ -38,6 +42,13 @@ FEATURES = {
     "groups": lambda n: {
         "groups": [(1, 184.0), ((n - 1) // 2, 192.0), (n - 1 - (n - 1) // 2, 200.0, 1.0)]
     },
+    # Dry friction on the disk below the pendulums' reaction: stick-slip, with stops and
+    # reversals within steps.
+    "dry-friction": lambda n: {"params": dry_params(5e-3)},
+    # ... and near the kick's torque: held, jolted at kicks, held again.
+    "dry-friction-held": lambda n: {"params": dry_params(2e-2)},
+    # Every feature at once.
+    "all": lambda n: {**FEATURES["groups"](n), "params": dry_params(5e-3)},
 }
 
 
