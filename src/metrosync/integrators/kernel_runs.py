@@ -160,14 +160,7 @@ def advance(st, c, settings, rec):
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
             if dry:  # the block has a run with dry friction on the disk (`verlet`)
-                for w in range(LANES):
-                    others[w] = force[w]
-                    friction[w] = 0.0
-                    held[w] = False
-                    if dry_lane[w]:
-                        friction[w], held[w] = disk_friction(c, (blk, w), phd[w], s_num[w], others[w])  # fmt: skip  # noqa: E501
-                        force[w] = others[w] + friction[w]
-                        phdd[w] = 0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])  # fmt: skip  # noqa: E501
+                _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held)  # fmt: skip  # noqa: E501
             for w in range(lanes):
                 if alive[w] > 0.0 and not math.isfinite(phdd[w]):
                     status[b0 + w] |= STATUS_DIVERGED
@@ -189,9 +182,7 @@ def advance(st, c, settings, rec):
                     fph[w] = force[w]
                     aph[w] = phdd[w]
             if dry:
-                for w in range(lanes):
-                    if alive[w] > 0.0 and dry_lane[w]:
-                        _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
+                _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -245,29 +236,51 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
 
 
 @nb.njit(cache=True)
+def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held):  # fmt: skip  # noqa: E501
+    """The dry friction of each lane with it as the step starts resolving the disk
+    (`_physics.disk_friction`); adds it to ``force`` and recomputes ``phdd``. Called,
+    not inlined, like `_settle_disks`."""
+    for w in range(phd.shape[0]):
+        others[w] = force[w]
+        friction[w] = 0.0
+        held[w] = False
+        if dry_lane[w]:
+            friction[w], held[w] = disk_friction(c, (blk, w), phd[w], s_num[w], others[w])
+            force[w] = others[w] + friction[w]
+            phdd[w] = 0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])  # fmt: skip  # noqa: E501
+
+
+@nb.njit(cache=True)
+def _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+    """The disks with dry friction after a step (`_settle_disk`). One call per step, and
+    two levels deep: code of this in the step's loop slows the kernel without the
+    feature by about 6 % (benchmarks/kernel.py at (100, 7))."""
+    for w in range(lanes):
+        if alive[w] > 0.0 and dry_lane[w]:
+            _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
+
+
+@nb.njit(cache=True)
 def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
     """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (`verlet`)."""
-    n = thd.shape[0]
     if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step
         end, held = disk_friction_stop(c, (blk, w), friction, phd[w], s_den, dt)
         pp[w] += 0.5 * dt * (end - friction)
         mean_phdd = disk_acceleration(c, (blk, w), s_num, s_den, others + end)
-        force = others + end
-        phdd = mean_phdd
+        fph[w] = others + end
+        aph[w] = mean_phdd
         if held:  # at rest at the end of the step: store the forces at rest
-            friction, rests = disk_friction(c, (blk, w), 0.0, s_num, others)
-            force = others + friction
-            phdd = 0.0 if rests else disk_acceleration(c, (blk, w), s_num, s_den, force)
+            at_rest, rests = disk_friction(c, (blk, w), 0.0, s_num, others)
+            fph[w] = others + at_rest
+            aph[w] = 0.0 if rests else disk_acceleration(c, (blk, w), s_num, s_den, fph[w])
         s_p = 0.0
-        for i in range(n):
+        for i in range(thd.shape[0]):
             thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], mean_phdd)
             thd[i, w] += 0.5 * dt * (thdd - acc[i, w])
-            acc[i, w] = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], phdd)
+            acc[i, w] = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], aph[w])
             s_p += q[i, w] * thd[i, w]
         phd[w] = disk_velocity(c, (blk, w), pp[w], s_p)
-        fph[w] = force
-        aph[w] = phdd
     if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
         pp[w] = momentum_at_rest(c, (blk, w), s_p)
         phd[w] = 0.0
