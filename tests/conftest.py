@@ -37,6 +37,7 @@ def random_system(rng):
             radius=radius,
             c_phi=rng.uniform(0, 1e-4, b),
             total_inertia=rng.uniform(0.05, 0.5, b) + radius**2 * mass.sum(axis=1),
+            dry_friction=np.zeros(b),
         )
 
     return make

@@ -51,7 +51,8 @@ def test_rigid_support_leaves_the_disk_still(rng, random_system):
 
 def with_features(sys, rng):
     """``sys`` with the features beyond the paper on, at random strengths: an applied
-    torque, escapement offsets, and the escapement's reaction on or off per run."""
+    torque, escapement offsets, the escapement's reaction on or off per run, and dry
+    friction on the disk."""
     b, n = sys.shape
     return replace(
         sys,
@@ -59,6 +60,7 @@ def with_features(sys, rng):
         forcing_omega=rng.uniform(5, 30, b),
         escapement_offset=rng.uniform(-0.2, 0.2, (b, n)),
         escapement_reaction=rng.choice([0.0, 1.0], b),
+        dry_friction=rng.uniform(0, 0.05, b),
     )
 
 
@@ -141,3 +143,22 @@ def test_escapement_kicks_where_theta_crosses_its_offset(random_system):
     ]:  # fmt: skip
         kick = escapement(sys, np.array([[before]]), np.array([[after]]), 0.01)
         assert kick[0, 0] == want, (before, after)
+def test_solved_form_with_dry_friction_obeys_the_coulomb_law(rng, random_system):
+    """Moving, held and breaking-free disks: the disk's equation holds with the friction
+    the law allows (−T sign φ̇, −T sign φ̈ from rest, or within ±T at rest)."""
+    for _ in range(20):
+        sys = random_system()
+        sys = SystemArrays(**{**vars(sys), "dry_friction": rng.uniform(0, 0.05, 4)})
+        theta = rng.uniform(-np.pi, np.pi, sys.shape)
+        theta_dot = rng.normal(0, 5, sys.shape)
+        phi_dot = np.where(rng.random(4) < 0.5, 0.0, rng.normal(0, 1, 4))
+        kick = rng.choice([-1.0, 0.0, 1.0], sys.shape) * sys.drive / 0.01
+        phi_ddot, theta_ddot = accelerations(sys, theta, theta_dot, phi_dot, kick)
+        disk, pendulum = residuals(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot)
+        scale = np.abs(kick).max() + 1.0
+        np.testing.assert_allclose(disk, 0, atol=1e-12 * scale)
+        np.testing.assert_allclose(pendulum, 0, atol=1e-12 * scale)
+        # Without the friction the disk's equation no longer holds where it acts.
+        bare = SystemArrays(**{**vars(sys), "dry_friction": np.zeros(4)})
+        disk, _ = residuals(bare, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot)
+        assert np.all(np.abs(disk) > 1e-6 * sys.dry_friction)

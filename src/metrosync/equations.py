@@ -19,6 +19,16 @@ All arrays broadcast over leading "batch" axes: per-metronome arrays have shape
 (..., N), per-run arrays shape (...). ``kick`` is the escapement torque 𝕄_i (N m) in
 force form; the fixed-step integrators supply ±M/dt or 0 (`escapement`). The constants
 come as `SystemArrays` (defined with their builder in `model.system`, re-exported here).
+
+Dry friction. The disk may also feel a Coulomb torque of at most T =
+``sys.dry_friction`` (Goldsztein et al., Chaos 32, 043119, 2022), added to the
+numerator of eq. (eqm1). `dry_friction` states the law: −T sign φ̇ on a moving disk;
+on a disk at rest, the torque that holds it, `holding_torque` (the one that makes
+φ̈ = 0), when that is within ±T, else ±T against it (the disk starts to slip). With
+T = 0 every result is the frictionless one, bit for bit. `accelerations` applies the
+law at the given φ̇ unless it is handed the friction torque (``friction=``), as a
+time-stepping scheme or an event-driven integrator does; `effective_inertia` is the
+denominator D, by which an extra torque on the disk divides into φ̈.
 """
 
 from __future__ import annotations
@@ -32,7 +42,10 @@ __all__ = [
     "accelerations",
     "applied_torque",
     "disk_torque",
+    "dry_friction",
+    "effective_inertia",
     "escapement",
+    "holding_torque",
     "residuals",
 ]
 
@@ -61,7 +74,7 @@ def escapement(sys: SystemArrays, theta, theta_next, dt: float) -> np.ndarray:
     return np.where(up, rate, np.where(down, -rate, 0.0))
 
 
-def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
+def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, friction=None):
     """Solved equations of motion, eqs. (eqm1)–(eqm2).
 
     Parameters
@@ -70,11 +83,52 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
     theta, theta_dot, kick : arrays (B, N).
     phi_dot : array (B,).
     t : time, s (for the applied torque).
+    friction : the disk's dry-friction torque (B,), N m; default the Coulomb law at
+        ``phi_dot`` (`dry_friction`).
 
     Returns
     -------
     phi_ddot : (B,), theta_ddot : (B, N)
     """
+    numerator, denominator, sin_t, cos_t = _disk_equation(sys, theta, theta_dot, phi_dot, kick, t)
+    if friction is None:
+        friction = dry_friction(sys, phi_dot, -numerator)
+    phi_ddot = (numerator + friction) / denominator
+    theta_ddot = (
+        kick
+        - sys.radius[:, None] * sys.mh * phi_ddot[:, None] * cos_t
+        - sys.mgh * sin_t
+        - sys.c_theta * theta_dot
+    ) / sys.inertia
+    return phi_ddot, theta_ddot
+
+
+def holding_torque(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
+    """The dry-friction torque that would keep the disk from accelerating (φ̈ = 0):
+    minus everything else in the numerator of eq. (eqm1), (B,) N m."""
+    return -_disk_equation(sys, theta, theta_dot, phi_dot, kick, t)[0]
+
+
+def dry_friction(sys: SystemArrays, phi_dot, holding):
+    """The Coulomb law of the disk's dry friction, (B,) N m, with T = ``sys.dry_friction``.
+
+    A moving disk (φ̇ ≠ 0) feels −T sign φ̇. A disk at rest feels ``holding`` (the
+    `holding_torque`) clipped to ±T: it stays at rest when |holding| ≤ T, else it
+    starts to slip the way the other torques push it, against a friction of T.
+    """
+    limit = sys.dry_friction
+    return np.where(phi_dot != 0, -limit * np.sign(phi_dot), np.clip(holding, -limit, limit))
+
+
+def effective_inertia(sys: SystemArrays, theta):
+    """D of eq. (eqm1), (B,) kg m²: J + R²Σm − R² Σ_i (m_i h_i cos θ_i)² / I_i. An extra
+    torque ΔF on the disk changes φ̈ by ΔF/D (and each θ̈_i by −R m_i h_i cos θ_i ΔF/(D I_i))."""
+    d_sum = (sys.radius[:, None] * sys.mh) ** 2 / sys.inertia * np.cos(theta) ** 2
+    return sys.total_inertia - np.sum(d_sum, axis=-1)
+
+
+def _disk_equation(sys, theta, theta_dot, phi_dot, kick, t):
+    """Numerator (without dry friction) and denominator of eq. (eqm1), sin θ, cos θ."""
     sin_t = np.sin(theta)
     cos_t = np.cos(theta)
     radius = sys.radius[:, None]
@@ -82,25 +136,18 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
     a_sum = radius * mh_over_i * sys.mgh * sin_t * cos_t  # A = m²gR Σ h² sin cos / I
     b_sum = radius * mh_over_i * sys.c_theta * theta_dot * cos_t  # B
     c_sum = radius * mh_over_i * kick * cos_t  # C
-    d_sum = (radius * sys.mh) ** 2 / sys.inertia * cos_t**2
     numerator = (
         sys.radius * np.sum(sys.mh * theta_dot**2 * sin_t, axis=-1)
         + disk_torque(sys, phi_dot, kick, t)
         + np.sum(a_sum + b_sum - c_sum, axis=-1)
     )
-    denominator = sys.total_inertia - np.sum(d_sum, axis=-1)  # D
-    phi_ddot = numerator / denominator
-    theta_ddot = (
-        kick
-        - radius * sys.mh * phi_ddot[:, None] * cos_t
-        - sys.mgh * sin_t
-        - sys.c_theta * theta_dot
-    ) / sys.inertia
-    return phi_ddot, theta_ddot
+    return numerator, effective_inertia(sys, theta), sin_t, cos_t  # D
 
 
 def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t=0.0):
-    """Left minus right of the unsolved equations (metron2a) and (metron2).
+    """Left minus right of the unsolved equations (metron2a) and (metron2), the disk's
+    with the Coulomb law of its dry friction (`dry_friction`): −T sign φ̇ when it
+    moves, −T sign φ̈ when it starts from rest, anything within ±T when it stays at rest.
 
     Returns (disk residual (B,), pendulum residuals (B, N)); both vanish for
     accelerations that solve the system.
@@ -108,10 +155,16 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     sin_t = np.sin(theta)
     cos_t = np.cos(theta)
     radius = sys.radius[:, None]
-    disk = (
+    needed = (  # the dry-friction torque these accelerations need
         sys.total_inertia * phi_ddot
         + sys.radius * np.sum(sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t), axis=-1)
         - disk_torque(sys, phi_dot, kick, t)
+    )
+    limit = sys.dry_friction
+    allowed = np.where(
+        phi_dot != 0,
+        -limit * np.sign(phi_dot),
+        np.where(phi_ddot != 0, -limit * np.sign(phi_ddot), np.clip(needed, -limit, limit)),
     )
     pendulum = (
         sys.inertia * theta_ddot
@@ -120,4 +173,4 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
         + sys.c_theta * theta_dot
         - kick
     )
-    return disk, pendulum
+    return needed - allowed, pendulum

@@ -34,18 +34,30 @@ def run(advance, ens, steps, **kwargs):
 #: name -> keyword arguments of `build_ensemble` for n metronomes (``params`` included).
 FORCING = {"forcing_amplitude": 0.02, "forcing_bpm": 189.0}
 ESCAPEMENT = {"escapement_offset": 0.07, "escapement_reaction": False}
+#: Dry friction on the disk below the pendulums' reaction: stick-slip, with stops and
+#: reversals within steps.
+DRY = {"disk_dry_friction": 5e-3}
+
+
+def with_changes(**changes):
+    return {"params": get_preset("default").with_changes(**changes)}
+
+
 FEATURES = {
     "plain": lambda n: {},
     # Three groups at their own frequencies, the first of a single metronome.
     "groups": lambda n: {
         "groups": [(1, 184.0), ((n - 1) // 2, 192.0), (n - 1 - (n - 1) // 2, 200.0, 1.0)]
     },
-    "forcing": lambda n: {"params": get_preset("default").with_changes(**FORCING)},
-    "escapement": lambda n: {"params": get_preset("default").with_changes(**ESCAPEMENT)},
+    "forcing": lambda n: with_changes(**FORCING),
+    "escapement": lambda n: with_changes(**ESCAPEMENT),
+    "dry-friction": lambda n: with_changes(**DRY),
+    # ... and near the kick's torque: held, jolted at kicks, held again.
+    "dry-friction-held": lambda n: with_changes(disk_dry_friction=2e-2),
 }
 FEATURES["all"] = lambda n: {
     **FEATURES["groups"](n),
-    "params": get_preset("default").with_changes(**FORCING, **ESCAPEMENT),
+    **with_changes(**FORCING, **ESCAPEMENT, **DRY),
 }
 
 

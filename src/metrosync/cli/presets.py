@@ -23,13 +23,14 @@ def run(args) -> int:
     from ..sweeps.grid import UNITS
 
     units = {**UNITS, "l2_bounds": "m"}
+    width = max(16, *(len(key) for params in PRESETS.values() for key in params.as_dict()))
     for name, params in PRESETS.items():
         print(f"{name}: {params.description}")
         for key, value in params.as_dict().items():
             if key != "preset":
-                print(f"    {key:20s} {value} {units.get(key, '')}".rstrip())
+                print(f"    {key:{width}s} {value} {units.get(key, '')}".rstrip())
         low, high = params.metronome.bpm_range()
-        print(f"    {'steady amp.':20s} {params.steady_amplitude:.3f} rad"
+        print(f"    {'steady amp.':{width}s} {params.steady_amplitude:.3f} rad"
               + ("  (OVERTURNS: > pi/2)" if params.overturns else ""))  # fmt: skip
-        print(f"    {'tunable BPM':20s} {low:.1f} .. {high:.1f}")
+        print(f"    {'tunable BPM':{width}s} {low:.1f} .. {high:.1f}")
     return 0

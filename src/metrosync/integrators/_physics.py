@@ -35,6 +35,13 @@ escapement's reaction −Σ𝕄_i (unless ``escapement_reaction`` is off), and t
 torque A sin(Ω t) (when ``forcing_amplitude`` is not 0). A kernel sums the per-metronome
 parts (`pendulum_terms`), then calls `disk_acceleration` once per run and
 `theta_ddot` once per metronome.
+
+Dry friction
+------------
+The disk's Coulomb friction (threshold T = ``c.dry_friction[r]``) is part of F. The
+fixed-step scheme resolves it per step with `disk_friction` and `disk_friction_stop`
+(the scheme is in `verlet`'s docstring); `momentum_at_rest` is p_φ of a disk held at
+rest. A run without dry friction never calls them.
 """
 
 from __future__ import annotations
@@ -122,6 +129,49 @@ def disk_velocity(c, r, p_phi, sum_q_theta_dot):
     return (p_phi - c.radius[r] * sum_q_theta_dot) / total
 
 
+@nb.njit(cache=True, inline="always")
+def disk_friction(c, r, phi_dot, sum_num, force):
+    """The disk's dry friction for a step that starts at disk velocity ``phi_dot``, and
+    whether it holds the disk at rest, from the sums of the step and the other torques
+    ``force`` (F without friction).
+
+    Moving (φ̇ ≠ 0): −T sign φ̇, not held. At rest: the torque that keeps φ̈ = 0,
+    −(R Σ_i num_i + F), held, when it is within ±T; else ±T against the torques that
+    move the disk, not held (the twin of `equations.dry_friction`).
+    """
+    limit = c.dry_friction[r]
+    if phi_dot != 0.0:
+        return (-limit if phi_dot > 0.0 else limit), False
+    need = -(c.radius[r] * sum_num + force)
+    if abs(need) <= limit:
+        return need, True
+    return (limit if need > 0.0 else -limit), False
+
+
+@nb.njit(cache=True, inline="always")
+def disk_friction_stop(c, r, friction, phi_dot_next, sum_den, dt):
+    """The friction at the end of a slipping step whose end velocity ``phi_dot_next``,
+    computed with ``friction`` = −T sign(direction), no longer points that way: the disk
+    reached rest within the step.
+
+    The end velocity is affine in the friction's end value F, φ̇' = φ̇'(F₀) + (F − F₀)
+    dt/(2D) (trapezoid rule, D the denominator of eq. (eqm1)). Returns the F that makes
+    φ̇' = 0 and True when it is within ±T (the disk stops); else −``friction`` and False
+    (the disk reverses, and the friction turns against the new direction).
+    """
+    rad = c.radius[r]
+    stop = friction - 2.0 * (c.total_inertia[r] - rad * rad * sum_den) * phi_dot_next / dt
+    if abs(stop) <= c.dry_friction[r]:
+        return stop, True
+    return -friction, False
+
+
+@nb.njit(cache=True, inline="always")
+def momentum_at_rest(c, r, sum_q_theta_dot):
+    """p_φ of a disk at rest (φ̇ = 0): R Σ_i q_i θ̇_i."""
+    return c.radius[r] * sum_q_theta_dot
+
+
 #: Every function above, for `kernel_cuda` and the tests.
 FUNCTIONS = (
     escapement,
@@ -132,4 +182,7 @@ FUNCTIONS = (
     disk_acceleration,
     theta_ddot,
     disk_velocity,
+    disk_friction,
+    disk_friction_stop,
+    momentum_at_rest,
 )

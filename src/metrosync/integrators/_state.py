@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations, disk_torque
+from ..equations import SystemArrays, accelerations, disk_torque, dry_friction, holding_torque
 from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
 from ._abi import Recording, State
@@ -29,7 +29,7 @@ class StepState:
     p_phi : (B,) the disk's angular momentum (J + R²Σm) φ̇ + R Σ m h cos θ θ̇, carried as
         state so that it changes only by the external torque impulse.
     force_phi : (B,) torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄 + τ(t)
-        (`equations.disk_torque`).
+        (`equations.disk_torque`) plus the dry friction (`equations.dry_friction`).
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
     r : (B, n_rec) analytic-phase order parameter at each record.
@@ -82,6 +82,8 @@ class StepState:
         with np.errstate(over="ignore", invalid="ignore"):
             acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
             p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
+            holding = holding_torque(sys, theta, theta_dot, phi_dot, no_kick)
+            friction = np.where(rigid, 0.0, dry_friction(sys, phi_dot, holding))
         finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
         state = State(
@@ -92,7 +94,7 @@ class StepState:
             acc_theta=np.ascontiguousarray(acc_theta),
             acc_phi=np.ascontiguousarray(acc_phi),
             p_phi=p_phi,
-            force_phi=disk_torque(sys, phi_dot, no_kick, 0.0),
+            force_phi=disk_torque(sys, phi_dot, no_kick, 0.0) + friction,
             last_up=np.full((b, n), -1.0),
             status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
         )

@@ -12,6 +12,15 @@ function. Integration then restarts. The upward zero crossings that define the
 crossing phase are the events themselves when δ_i = 0, and are located on the dense
 output (without a restart) otherwise.
 
+Dry friction on the disk (T = ``disk_dry_friction`` > 0) is event-driven too. The run
+is in one of three modes, each with a smooth right-hand side: slipping forwards or
+backwards (friction ∓T), or stuck (φ̇ ≡ 0, the friction being the `holding_torque`,
+which keeps φ̈ = 0 exactly, so the pendulums move as on a rigid support). A slipping
+disk's φ̇ = 0 and a stuck disk's |holding torque| = T are events, located like the
+crossings: at rest the disk sticks if |holding torque| ≤ T, else slips the way the
+other torques push it. An escapement impulse always jolts the disk (no finite
+friction holds an impulse); it then slips the way it was jolted.
+
 It is slow (Python-level stepping) and meant for checking the fixed-step scheme on
 small ensembles and short horizons.
 """
@@ -24,7 +33,7 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from ..equations import SystemArrays, accelerations
+from ..equations import SystemArrays, accelerations, holding_torque
 from ..observables.order import analytic_phase, crossing_order, order_parameter
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._state import Records
@@ -95,14 +104,28 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     off_zero = np.nonzero(offset != 0.0)[0]  # their zero crossings are not events
     zero_kick = np.zeros((1, n))
     rigid = bool(np.isinf(sys.total_inertia[0]))
+    limit = 0.0 if rigid else float(sys.dry_friction[0])
     period = 2 * np.pi / sys.omega.max()
 
-    def rhs(t, y):
-        th, thd, phd = y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
-        phdd, thdd = accelerations(sys, th, thd, phd, zero_kick, t)
+    def split(y):
+        return y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
+
+    def holding(t, y):
+        return holding_torque(sys, *split(y), zero_kick, t)
+
+    def friction(t, y, mode):
+        """The dry friction of a mode: none, ∓T slipping, or the holding torque stuck."""
+        if limit == 0.0:
+            return np.zeros(1)
+        return holding(t, y) if mode == 0 else np.array([-mode * limit])
+
+    def rhs(t, y, mode):
+        th, thd, phd = split(y)
+        phdd, thdd = accelerations(sys, th, thd, phd, zero_kick, t, friction=friction(t, y, mode))
         return np.concatenate(([y[n + 1]], y[n + 2 :], phdd, thdd[0]))
 
     y = np.concatenate(([0.0], theta0, [0.0 if rigid else phi_dot0], theta_dot0))
+    mode = _disk_mode(limit, y[n + 1], holding(0.0, y))
     samples = np.full((grid.size, y.size), np.nan)
     samples[0] = y
     next_sample = 1
@@ -110,7 +133,10 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     status = 0
     t = 0.0
     while t < duration:
-        solver = DOP853(rhs, t, y, duration, rtol=RTOL, atol=ATOL, max_step=period / 8)
+        solver = DOP853(
+            lambda s, u, m=mode: rhs(s, u, m), t, y, duration,
+            rtol=RTOL, atol=ATOL, max_step=period / 8,
+        )  # fmt: skip
         restarted = False
         while solver.status == "running":
             y_old = solver.y.copy()
@@ -118,30 +144,37 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 return samples, upcrossings, status | STATUS_DIVERGED
             dense = solver.dense_output()
-            th_old, th_new = y_old[1 : n + 1], solver.y[1 : n + 1]
-            crossing = np.nonzero((th_old - offset) * (th_new - offset) < 0)[0]
+            events = _crossings(dense, y_old, solver.y, offset, n)
+            if limit > 0.0:
+                events += _disk_events(dense, mode, limit, n, holding)
             t_end = solver.t
             event = None
-            if crossing.size:
-                roots = [_crossing(dense, 1 + i, offset[i], dense.t) for i in crossing]
-                k = int(np.argmin(roots))
-                event, t_end = int(crossing[k]), roots[k]
-            if off_zero.size:
-                th_end = th_new if event is None else dense(t_end)[1 : n + 1]
+            if events:
+                t_end, event = min(events, key=lambda e: e[0])
+            if off_zero.size:  # upward zero crossings that are not events
+                th_old = y_old[1 : n + 1]
+                th_end = solver.y[1 : n + 1] if event is None else dense(t_end)[1 : n + 1]
                 for i in off_zero[(th_old[off_zero] < 0) & (th_end[off_zero] > 0)]:
                     upcrossings[i].append(_crossing(dense, 1 + i, 0.0, t_end))
             while next_sample < grid.size and grid[next_sample] <= t_end:
                 samples[next_sample] = dense(grid[next_sample])
                 next_sample += 1
-            if np.any(np.abs(th_new) > overturn_angle):
+            if np.any(np.abs(solver.y[1 : n + 1]) > overturn_angle):
                 status |= STATUS_OVERTURNED
             if event is not None:
                 y = dense(t_end)
-                y[1 + event] = offset[event]
-                direction = np.sign(y[n + 2 + event])
-                if direction > 0 and offset[event] == 0.0:
-                    upcrossings[event].append(t_end)
-                y = _apply_impulse(sys, y, n, event, direction, rigid)
+                if event == "break":  # |holding torque| reached T: slip against it
+                    mode = -int(np.sign(holding(t_end, y)[0]))
+                elif event == "stop":  # φ̇ reached 0: stick, or slip the other way
+                    y[n + 1] = 0.0
+                    mode = _disk_mode(limit, 0.0, holding(t_end, y))
+                else:
+                    y[1 + event] = offset[event]
+                    direction = np.sign(y[n + 2 + event])
+                    if direction > 0 and offset[event] == 0.0:
+                        upcrossings[event].append(t_end)
+                    y = _apply_impulse(sys, y, n, event, direction, rigid)
+                    mode = _disk_mode(limit, y[n + 1], holding(t_end, y))
                 t = t_end
                 restarted = True
                 break
@@ -150,9 +183,50 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     return samples, [np.asarray(c) for c in upcrossings], status
 
 
+def _crossings(dense, y_old, y_new, offset, n):
+    """(time, pendulum) of each strict crossing of a pendulum's escapement angle in the step."""
+    th_old, th_new = y_old[1 : n + 1] - offset, y_new[1 : n + 1] - offset
+    return [
+        (_crossing(dense, 1 + i, offset[i], dense.t), int(i))
+        for i in np.nonzero(th_old * th_new < 0)[0]
+    ]
+
+
 def _crossing(dense, k, level, t_end):
     """When component ``k`` of the dense output crosses ``level`` in (t_old, t_end)."""
     return brentq(lambda s: dense(s)[k] - level, dense.t_old, t_end, xtol=1e-14)
+
+
+def _disk_events(dense, mode, limit, n, holding):
+    """A dry-friction event in the step, as [(time, "stop" or "break")], or []: a
+    slipping disk's φ̇ reaching 0, a stuck disk's |holding torque| reaching T."""
+    if mode == 0:
+
+        def margin(s):
+            return limit - abs(holding(s, dense(s))[0])
+
+        kind = "break"
+    else:
+
+        def margin(s):
+            return mode * dense(s)[n + 1]
+
+        kind = "stop"
+    if margin(dense.t) > 0:
+        return []
+    if margin(dense.t_old) <= 0:  # the mode began at this event's edge: take it at the end
+        return [(dense.t, kind)]
+    return [(brentq(margin, dense.t_old, dense.t, xtol=1e-14), kind)]
+
+
+def _disk_mode(limit, phi_dot, holding):
+    """The disk's mode at a state: None without dry friction, the sign of φ̇ when it
+    moves, 0 (stuck) at rest when |holding torque| ≤ T, else the way it starts to slip."""
+    if limit == 0.0:
+        return None
+    if phi_dot != 0.0:
+        return int(np.sign(phi_dot))
+    return 0 if abs(holding[0]) <= limit else -int(np.sign(holding[0]))
 
 
 def _apply_impulse(sys, y, n, event, direction, rigid):
@@ -161,8 +235,10 @@ def _apply_impulse(sys, y, n, event, direction, rigid):
     impulse = np.zeros((1, n))
     impulse[0, event] = direction * sys.drive[0, event]
     th, thd, phd = y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
-    with_kick = accelerations(sys, th, thd, phd, impulse)
-    without = accelerations(sys, th, thd, phd, np.zeros((1, n)))
+    # Dry friction is bounded, so it takes no part in an impulse.
+    no_friction = np.zeros(1)
+    with_kick = accelerations(sys, th, thd, phd, impulse, friction=no_friction)
+    without = accelerations(sys, th, thd, phd, np.zeros((1, n)), friction=no_friction)
     y = y.copy()
     y[n + 1] += 0.0 if rigid else (with_kick[0] - without[0])[0]
     y[n + 2 :] += (with_kick[1] - without[1])[0]

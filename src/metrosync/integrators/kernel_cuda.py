@@ -13,7 +13,8 @@ functions (`device_function`). The kernel takes the CPU kernels' argument list
 Status: verified in numba's CUDA simulator against the NumPy reference (see
 tests/integrators/test_kernel_cuda.py); not yet run or timed on a GPU. Known limits of
 this first version: one run per block (for small N most threads idle), the state
-travels between host and device once per chunk of steps, and no trajectories.
+travels between host and device once per chunk of steps, no trajectories, and no dry
+friction on the disk (refused with a `ParameterError`).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import math
 import numpy as np
 from numba import cuda, float64
 
+from ..errors import ParameterError
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from . import _kernel_parts, _physics
 from ._abi import Constants, Recording, State, constants_of, settings_of
@@ -232,6 +234,11 @@ def advance_state(
     the GPU in this version."""
     if state.traj_theta.shape[0]:
         raise NotImplementedError("trajectories are not recorded by the GPU backend yet")
+    if np.any(sys.dry_friction > 0):
+        raise ParameterError(
+            f"`disk_dry_friction` = {float(np.max(sys.dry_friction))!r} N m: the GPU backend "
+            f"has no dry friction on the disk yet; use backend='numba' (or 'numpy')."
+        )
     b, n = state.theta.shape
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
     constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))

@@ -34,9 +34,12 @@ from ._kernel_parts import (
 from ._physics import (
     applied_torque,
     disk_acceleration,
+    disk_friction,
+    disk_friction_stop,
     disk_torque,
     disk_velocity,
     escapement,
+    momentum_at_rest,
     pendulum_terms,
     theta_ddot,
 )
@@ -69,6 +72,7 @@ def advance(st, c, settings, rec):
         q = np.empty(n)
         crossed = np.empty(n, dtype=np.bool_)
         pinned = math.isinf(c.total_inertia[b])
+        dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
             r[b, 0] = analytic_order(theta[b], theta_dot[b], c.omega[b])
@@ -97,7 +101,13 @@ def advance(st, c, settings, rec):
                             break
             phi_next, phd_pred = drift(phi[b], phi_dot[b], acc_phi[b], dt, dt2)
             force = disk_torque(c, b, phd_pred, sum_kick) + applied_torque(c, b, (s + 1) * dt)
-            phdd = disk_acceleration(c, b, sum_num, sum_den, force)
+            others = force
+            friction = 0.0
+            held = False
+            if dry:
+                friction, held = disk_friction(c, b, phi_dot[b], sum_num, others)
+                force = others + friction
+            phdd = 0.0 if held else disk_acceleration(c, b, sum_num, sum_den, force)
             if not math.isfinite(phdd):
                 status[b] |= STATUS_DIVERGED
                 break
@@ -112,6 +122,27 @@ def advance(st, c, settings, rec):
                 sum_p += q[i] * v
             p_phi[b] = momentum(p_phi[b], force_phi[b], force, dt, pinned)
             phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
+            if dry and not held and friction * phi_dot[b] >= 0.0:
+                # Rare: the disk's velocity reached 0 within the step (`verlet`).
+                end, held = disk_friction_stop(c, b, friction, phi_dot[b], sum_den, dt)
+                p_phi[b] += 0.5 * dt * (end - friction)
+                mean_phdd = disk_acceleration(c, b, sum_num, sum_den, others + end)
+                force = others + end
+                phdd = mean_phdd
+                if held:  # at rest at the end of the step: store the forces at rest
+                    friction, rests = disk_friction(c, b, 0.0, sum_num, others)
+                    force = others + friction
+                    phdd = 0.0 if rests else disk_acceleration(c, b, sum_num, sum_den, force)
+                sum_p = 0.0
+                for i in range(n):
+                    thdd = theta_ddot(c, (b, i), b, rest[i], q[i], mean_phdd)
+                    theta_dot[b, i] += 0.5 * dt * (thdd - acc_theta[b, i])
+                    acc_theta[b, i] = theta_ddot(c, (b, i), b, rest[i], q[i], phdd)
+                    sum_p += q[i] * theta_dot[b, i]
+                phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
+            if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
+                p_phi[b] = momentum_at_rest(c, b, sum_p)
+                phi_dot[b] = 0.0  # not from p_φ: a fused multiply-add would leave ~1e-20
             force_phi[b] = force
             acc_phi[b] = phdd
             until_record -= 1

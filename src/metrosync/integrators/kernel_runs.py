@@ -34,10 +34,13 @@ from ._kernel_parts import (
 from ._physics import (
     applied_torque,
     disk_acceleration,
+    disk_friction,
+    disk_friction_stop,
     disk_torque,
     disk_velocity,
     escapement,
     forced,
+    momentum_at_rest,
     pendulum_terms,
     theta_ddot,
 )
@@ -122,6 +125,13 @@ def advance(st, c, settings, rec):
         for w in range(LANES):
             block_forced |= forced(c, (blk, w))
         ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
+        dry_lane = np.empty(LANES, dtype=np.bool_)
+        for w in range(LANES):
+            dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])  # fmt: skip  # noqa: E501
+        dry = dry_lane.any()
+        others = np.empty(LANES)
+        friction = np.empty(LANES)
+        held = np.empty(LANES, dtype=np.bool_)
         overs = np.empty(LANES, dtype=np.int64)
         until_record = record_every - step0 % record_every
         if step0 == 0:
@@ -157,6 +167,8 @@ def advance(st, c, settings, rec):
                 force[w] = disk_torque(c, (blk, w), phd_pred[w], s_kick[w]) + tau[w]
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
+            if dry:  # the block has a run with dry friction on the disk (`verlet`)
+                _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held)  # fmt: skip  # noqa: E501
             for w in range(lanes):
                 if alive[w] > 0.0 and not math.isfinite(phdd[w]):
                     status[b0 + w] |= STATUS_DIVERGED
@@ -177,6 +189,8 @@ def advance(st, c, settings, rec):
                     phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
+            if dry:
+                _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -227,6 +241,57 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
             rest[i, w] = res
             q[i, w] = qi
     return n_far
+
+
+@nb.njit(cache=True)
+def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held):  # fmt: skip  # noqa: E501
+    """The dry friction of each lane with it as the step starts resolving the disk
+    (`_physics.disk_friction`); adds it to ``force`` and recomputes ``phdd``. Called,
+    not inlined, like `_settle_disks`."""
+    for w in range(phd.shape[0]):
+        others[w] = force[w]
+        friction[w] = 0.0
+        held[w] = False
+        if dry_lane[w]:
+            friction[w], held[w] = disk_friction(c, (blk, w), phd[w], s_num[w], others[w])
+            force[w] = others[w] + friction[w]
+            phdd[w] = 0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])  # fmt: skip  # noqa: E501
+
+
+@nb.njit(cache=True)
+def _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+    """The disks with dry friction after a step (`_settle_disk`). One call per step, and
+    two levels deep: code of this in the step's loop slows the kernel without the
+    feature by about 6 % (benchmarks/kernel.py at (100, 7))."""
+    for w in range(lanes):
+        if alive[w] > 0.0 and dry_lane[w]:
+            _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
+
+
+@nb.njit(cache=True)
+def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+    """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
+    velocity reached 0 within the step, stopped or reversed (`verlet`)."""
+    if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step
+        end, held = disk_friction_stop(c, (blk, w), friction, phd[w], s_den, dt)
+        pp[w] += 0.5 * dt * (end - friction)
+        mean_phdd = disk_acceleration(c, (blk, w), s_num, s_den, others + end)
+        fph[w] = others + end
+        aph[w] = mean_phdd
+        if held:  # at rest at the end of the step: store the forces at rest
+            at_rest, rests = disk_friction(c, (blk, w), 0.0, s_num, others)
+            fph[w] = others + at_rest
+            aph[w] = 0.0 if rests else disk_acceleration(c, (blk, w), s_num, s_den, fph[w])
+        s_p = 0.0
+        for i in range(thd.shape[0]):
+            thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], mean_phdd)
+            thd[i, w] += 0.5 * dt * (thdd - acc[i, w])
+            acc[i, w] = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], aph[w])
+            s_p += q[i, w] * thd[i, w]
+        phd[w] = disk_velocity(c, (blk, w), pp[w], s_p)
+    if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
+        pp[w] = momentum_at_rest(c, (blk, w), s_p)
+        phd[w] = 0.0
 
 
 @nb.njit(cache=True, inline="always")

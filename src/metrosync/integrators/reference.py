@@ -10,7 +10,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..equations import SystemArrays, accelerations, disk_torque, escapement
+from ..equations import (
+    SystemArrays,
+    accelerations,
+    disk_torque,
+    dry_friction,
+    effective_inertia,
+    escapement,
+    holding_torque,
+)
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._state import StepState
 
@@ -28,14 +36,15 @@ def advance_state(
     """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
     n_rec = state.r.shape[1]
     rigid = np.isinf(sys.total_inertia)
+    dry = (sys.dry_friction > 0) & ~rigid
     grid_dt = record_every * dt
     if step0 == 0:
         _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
     with np.errstate(over="ignore", invalid="ignore"):
-        _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, grid_dt, n_rec)
+        _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, dry, grid_dt, n_rec)  # fmt: skip  # noqa: E501
 
 
-def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, grid_dt, n_rec):
+def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, dry, grid_dt, n_rec):  # fmt: skip  # noqa: E501
     for s in range(step0, step0 + n_steps):
         alive = (state.status & STATUS_DIVERGED) == 0
         if not alive.any():
@@ -56,14 +65,31 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
         overturned = np.any(np.abs(th_new) > overturn_angle, axis=1) & alive
         state.status[overturned] |= STATUS_OVERTURNED
         t_new = (s + 1) * dt
-        phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, kick, t_new)
+        forces = (sys, th_new, vel_pred, phd_pred, kick, t_new)
+        others = disk_torque(sys, phd_pred, kick, t_new)
+        friction, held = _dry_friction(sys, dry, state.phi_dot, forces)
+        phdd, thdd = accelerations(*forces, friction=friction)
         diverged = ~np.isfinite(phdd) & alive
         state.status[diverged] |= STATUS_DIVERGED
         ok = alive & ~diverged
-        force = disk_torque(sys, phd_pred, kick, t_new)
+        force = others + friction
         new_theta_dot = state.theta_dot + 0.5 * (acc + thdd) * dt
-        coupling = sys.radius * np.sum(sys.mh * np.cos(th_new) * new_theta_dot, axis=1)
         new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt
+        stopping = dry & ~held & (friction * _disk_velocity(sys, new_p, th_new, new_theta_dot) >= 0)
+        if stopping.any():  # rare: the disk's velocity reached 0 within the step
+            end, stops = _friction_at_stop(sys, friction, new_p, th_new, new_theta_dot, dt)
+            end = np.where(stopping, end, friction)
+            stops &= stopping
+            mean_phdd, mean_thdd = accelerations(*forces, friction=end)
+            new_theta_dot = state.theta_dot + 0.5 * (acc + mean_thdd) * dt
+            new_p = state.p_phi + 0.5 * (state.force_phi + others + end) * dt
+            at_rest, _ = _dry_friction(sys, dry, np.zeros_like(state.phi_dot), forces)
+            friction = np.where(stops, at_rest, end)
+            phdd, thdd = accelerations(*forces, friction=friction)
+            force = others + friction
+            held |= stops
+        coupling = sys.radius * np.sum(sys.mh * np.cos(th_new) * new_theta_dot, axis=1)
+        new_p = np.where(held, coupling, new_p)  # a disk at rest: p_φ = R Σ m h cos θ θ̇
         with np.errstate(invalid="ignore"):
             new_phi_dot = np.where(rigid, 0.0, (new_p - coupling) / sys.total_inertia)
         ok2 = ok[:, None]
@@ -78,6 +104,30 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
         state.acc_phi[ok] = phdd[ok]
         if (s + 1) % record_every == 0:
             _record(state, (s + 1) // record_every, sys.omega, ok)
+
+
+def _dry_friction(sys, dry, phi_dot, forces):
+    """The disk's dry friction as a step starts resolving the disk, (B,), and where it
+    holds the disk at rest (the twin of `_physics.disk_friction`); 0 where ``dry`` is off."""
+    if not dry.any():
+        return np.zeros_like(phi_dot), np.zeros(phi_dot.shape, dtype=bool)
+    holding = holding_torque(*forces)
+    friction = np.where(dry, dry_friction(sys, phi_dot, holding), 0.0)
+    return friction, dry & (phi_dot == 0) & (np.abs(holding) <= sys.dry_friction)
+
+
+def _disk_velocity(sys, p_phi, theta, theta_dot):
+    coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=1)
+    with np.errstate(invalid="ignore"):
+        return (p_phi - coupling) / sys.total_inertia
+
+
+def _friction_at_stop(sys, friction, p_phi, theta, theta_dot, dt):
+    """The twin of `_physics.disk_friction_stop`: the friction's end value that brings the
+    disk to rest, where it is within ±T (then True), else the reversed friction."""
+    stop = friction - 2.0 * effective_inertia(sys, theta) * _disk_velocity(sys, p_phi, theta, theta_dot) / dt  # fmt: skip  # noqa: E501
+    stops = np.abs(stop) <= sys.dry_friction
+    return np.where(stops, stop, -friction), stops
 
 
 def _add_crossing_phase(state, b, grp, t_prev, t_next, grid_dt, n_rec):

@@ -20,6 +20,31 @@ ensemble statistics converge to the ``exact`` integrator at first order in dt.
 
 The same step also records, for each run, the analytic-phase order parameter and the
 running sums of the crossing-interpolated phase (docs/model.md §7).
+
+Dry friction on the disk (``disk_dry_friction`` = T > 0; `_physics.disk_friction`,
+`_physics.disk_friction_stop`). Coulomb friction is set-valued at φ̇ = 0, so a scheme
+that simply evaluates −T sign φ̇ chatters around rest at the step size. Here the
+friction torque F_d is part of F in steps 3 and 5, chosen per step:
+
+* At rest (φ̇ = 0 exactly): F_d is first the torque that holds the disk, the one that
+  makes φ̈' = 0, H = −(R Σ_i num_i + F) with the step's sums. If |H| ≤ T the disk is
+  held: φ̈' = 0, φ' = φ, the pendulums step exactly as on a rigid support, φ̇' = 0
+  and p_φ' = R Σ m h cos θ' θ̇' (the disk's angular momentum at rest; the friction took
+  the rest). Otherwise it breaks free: F_d = ±T against H.
+* Slipping (φ̇ ≠ 0): F_d = −T sign φ̇.
+* If the velocity φ̇' the step ends with does not have the direction F_d assumed, the
+  disk reached rest within the step. φ̇' is affine in F_d's end value (p_φ' by the
+  trapezoid rule, θ̇' through θ̈'), so the end value that makes φ̇' = 0 is solved
+  for (an implicit, Moreau-type treatment of the friction's set-valued law): within
+  ±T the disk stops, φ̇' = 0 exactly, and the accelerations and torque stored for the
+  next step are those at rest; beyond ±T the disk reverses and F_d turns to ±T
+  against the new direction. θ̇' and p_φ' are then recomputed with that end value.
+
+So a held disk has exactly zero velocity, sticking never chatters, and stops and
+reversals are resolved to the step (first order, like the kicks). Note that the
+escapement's kick is a torque ±M/dt here: the disk slips at a kick when that torque
+(with the pendulum's recoil) beats T, which, as dt → 0, it always does: `exact` treats
+the kick as an impulse, which no finite friction can hold.
 """
 
 from __future__ import annotations

@@ -13,6 +13,12 @@ Beyond the paper, two switches of the disk's equation (metron2a), both off by de
 an external periodic torque τ(t) = A sin(Ω t) with Ω = π·BPM/60 (the metronomes'
 convention, so forcing at a metronome's BPM is resonant), and ``escapement_reaction``,
 which the paper has on: the escapement's torque −Σ𝕄_i reacts on the disk.
+
+Besides the paper's viscous bearing friction −c_φ φ̇, the disk may have dry (Coulomb)
+friction, as Goldsztein, English, Behta, Finder, Nadeau and Strogatz measured for real
+metronome platforms (Chaos 32, 043119, 2022): the disk sticks while the torque needed to
+hold it stays within ``disk_dry_friction`` and slips against a torque of that size
+otherwise. Off (0) by default, as in the paper.
 """
 
 from __future__ import annotations
@@ -45,6 +51,8 @@ class Platform:
         −Σ𝕄_i term of eq. (metron2a) (True, as the paper writes it). False keeps the
         kicks on the pendulums but takes their reaction off the disk, as if the
         escapement were driven from outside the platform. Accepts 0 or 1.
+    disk_dry_friction : the disk's Coulomb friction torque, N m: the largest torque
+        that holds the disk at rest, and the torque against a slipping disk; 0 for none.
     """
 
     radius: float = 0.27
@@ -55,12 +63,14 @@ class Platform:
     forcing_amplitude: float = 0.0
     forcing_bpm: float = 0.0
     escapement_reaction: bool = True
+    disk_dry_friction: float = 0.0
 
     def __post_init__(self) -> None:
         require_positive("radius", self.radius, unit="m")
         require_positive("c_phi", self.c_phi, allow_zero=True, unit="kg m²/s")
         require_positive("j0", self.j0, allow_zero=True, unit="kg m²")
         require_positive("j_per_metronome", self.j_per_metronome, allow_zero=True, unit="kg m²")
+        require_positive("disk_dry_friction", self.disk_dry_friction, allow_zero=True, unit="N m")
         if self.inertia is not None and not (self.inertia == math.inf or self.inertia > 0):
             raise ParameterError(
                 f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), "

@@ -42,6 +42,8 @@ class SystemArrays:
     escapement_offset : (B, N) angle δ_i at which metronome i's escapement acts, rad.
     escapement_reaction : (B,) 1.0 when the escapement's reaction −Σ𝕄_i acts on the
         disk (the paper), 0.0 when it does not.
+    dry_friction : (B,) the disk's Coulomb friction torque, N m
+        (``Platform.disk_dry_friction``); 0 for none.
     """
 
     mh: np.ndarray
@@ -57,6 +59,7 @@ class SystemArrays:
     forcing_omega: np.ndarray | None = None
     escapement_offset: np.ndarray | None = None
     escapement_reaction: np.ndarray | None = None
+    dry_friction: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         runs = np.shape(self.radius)
@@ -65,10 +68,12 @@ class SystemArrays:
             "forcing_omega": np.zeros(runs),
             "escapement_offset": np.zeros(np.shape(self.mh)),
             "escapement_reaction": np.ones(runs),
+            "dry_friction": np.zeros(runs),
         }
         for name, value in off.items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
+    dry_friction: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -131,5 +136,6 @@ def system_arrays(
         forcing_omega=np.full(runs, float(bpm_to_omega(platform.forcing_bpm))),
         escapement_offset=np.array(values["escapement_offset"], dtype=float),
         escapement_reaction=np.full(runs, 1.0 if platform.escapement_reaction else 0.0),
+        dry_friction=np.full(runs, platform.disk_dry_friction),
     )
     return system, disk

@@ -86,6 +86,7 @@ UNITS = {
     "forcing_amplitude": "N m",
     "forcing_bpm": "BPM",
     "escapement_offset": "rad",
+    "disk_dry_friction": "N m",
 }
 #: Model switches: true/false in TOML, 0 or 1 on the command line.
 SWITCHES = ("escapement_reaction",)
