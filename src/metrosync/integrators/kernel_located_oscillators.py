@@ -17,7 +17,7 @@ import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import analytic_order, drift, momentum, save_state, upward_crossing, velocity
-from ._located_parts import crossing_time, kick
+from ._located_parts import crossing_fraction, kick
 from ._physics import (
     applied_torque,
     disk_acceleration,
@@ -38,7 +38,7 @@ def advance(st, c, settings, rec, ks):
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
-    q_state, den_state = ks
+    (q_state,) = ks
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
@@ -51,7 +51,6 @@ def advance(st, c, settings, rec, ks):
         rest = np.empty(n)
         q = np.empty(n)
         q_prev = q_state[b].copy()  # q at the step's start: the last step's q
-        den_prev = den_state[b]
         fired = np.empty(n)
         pinned = math.isinf(c.total_inertia[b])
         until_record = record_every - step0 % record_every
@@ -86,40 +85,46 @@ def advance(st, c, settings, rec, ks):
                 phi[b] = phi_next
                 p_phi[b] = momentum(p_phi[b], force_phi[b], force, dt, pinned)
             else:
-                early = 0.0  # Σ (1 − s_k) Δφ̇_k: the jumps that use the step's start geometry
-                late = 0.0  # Σ s_k Δφ̇_k + (τ_k − dt/2) Δφ̈_k: its end geometry
-                shift = 0.0  # Σ τ_k Δφ̇_k: the disk's extra travel
-                jump_p = 0.0  # the disk's momentum jumps
-                jump_phdd = 0.0
-                jump_force = 0.0
+                # Sums over the impulses of the step; the disk's jumps are linear in them.
+                num_early = 0.0  # Σ (1 − s_k) × impulse k: jumps at the step's start geometry
+                force_early = 0.0
+                num_late = 0.0  # Σ s_k × impulse k, and (τ_k − dt/2) × its force change: its end
+                force_late = 0.0
+                num_shift = 0.0  # Σ τ_k × impulse k: the distance the disk's jumps travel
+                force_shift = 0.0
+                num_change = 0.0  # the change of the forces on the disk
+                jump_p = 0.0  # the disk's momentum jump
                 t_old = s * dt
                 for i in range(n):  # scalar pass; stops at the last of the n_kick impulses
                     if fired[i] == 0.0:
                         continue
-                    sigma = crossing_time(c, (b, i), theta[b, i], th_new[i], dt)
-                    frac = sigma / dt
+                    frac = crossing_fraction(c, (b, i), theta[b, i], th_new[i])
+                    sigma = frac * dt
                     after = dt - sigma
                     if fired[i] > 0.0:
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
-                    sn, cs = sincos(th_new[i])
-                    vp = theta_dot[b, i] + acc_theta[b, i] * dt
-                    dv, dforce, dphid, jrest, jforce, jphi = kick(c, (b, i), b, fired[i] * dt, frac, den_prev, sum_den, sn, cs, vp, q[i], phd_pred)  # fmt: skip  # noqa: E501
-                    # Folded into the second pass's terms: its velocity update adds dt/2
-                    # of the new accelerations, which now include the jumps' effect.
+                    vel = theta_dot[b, i] + acc_theta[b, i] * sigma
+                    dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fired[i] * dt, vel)
+                    # The second pass's velocity update adds dt/2 of the new accelerations,
+                    # which include the forces' change: its terms are net of that.
                     theta_dot[b, i] += dv + (after - half) * jrest
                     th_new[i] += after * dv
                     rest[i] += jrest
-                    early += (1.0 - frac) * dphid
-                    late += frac * dphid + (after - half) * jphi
-                    shift += after * dphid
-                    jump_p += dforce + (after - half) * jforce
-                    jump_phdd += jphi
-                    jump_force += jforce
+                    num_early += (1.0 - frac) * dnum
+                    force_early += (1.0 - frac) * dforce
+                    num_late += frac * dnum + (after - half) * jnum
+                    force_late += frac * dforce
+                    num_shift += after * dnum
+                    force_shift += after * dforce
+                    num_change += jnum
+                    jump_p += dforce
                     n_kick -= 1
                     if n_kick == 0:
                         break
-                phdd += jump_phdd
-                force += jump_force
+                early = disk_acceleration(c, b, num_early, sum_den, force_early)
+                late = disk_acceleration(c, b, num_late, sum_den, force_late)
+                shift = disk_acceleration(c, b, num_shift, sum_den, force_shift)
+                phdd += disk_acceleration(c, b, num_change, sum_den, 0.0)
                 for i in range(n):  # vectorized pass, with the jumps through the disk
                     thdd = theta_ddot(c, (b, i), b, rest[i], q[i], phdd)
                     v = (
@@ -138,7 +143,6 @@ def advance(st, c, settings, rec, ks):
             force_phi[b] = force
             acc_phi[b] = phdd
             q, q_prev = q_prev, q
-            den_prev = sum_den
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -148,7 +152,6 @@ def advance(st, c, settings, rec, ks):
                     save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for i in range(n):
             q_state[b, i] = q_prev[i]
-        den_state[b] = den_prev
 
 
 @nb.njit(cache=True, inline="always")

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import drift, momentum, upward_crossing, velocity
-from ._located_parts import crossing_time, kick
+from ._located_parts import crossing_fraction, kick
 from ._physics import (
     applied_torque,
     disk_acceleration,
@@ -37,7 +37,7 @@ def advance(st, c, settings, rec, ks):
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
-    q_state, den_state = ks
+    (q_state,) = ks
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
@@ -67,7 +67,6 @@ def advance(st, c, settings, rec, ks):
         pp = np.empty(LANES)
         fph = np.empty(LANES)
         alive = np.empty(LANES)
-        den_prev = np.empty(LANES)
         for w in range(LANES):
             b = b0 + min(w, lanes - 1)
             ph[w] = phi[b]
@@ -76,7 +75,6 @@ def advance(st, c, settings, rec, ks):
             pp[w] = p_phi[b]
             fph[w] = force_phi[b]
             alive[w] = 0.0 if status[b] & STATUS_DIVERGED else 1.0
-            den_prev[w] = den_state[b]
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
@@ -123,29 +121,41 @@ def advance(st, c, settings, rec, ks):
                 if kicks[w] == 0:
                     continue
                 any_kick = True
+                num_early = 0.0  # as in `kernel_located_oscillators`
+                force_early = 0.0
+                num_late = 0.0
+                force_late = 0.0
+                num_shift = 0.0
+                force_shift = 0.0
+                num_change = 0.0
                 for i in range(n):
                     if fired[i, w] == 0.0:
                         continue
-                    sigma = crossing_time(c, (blk, i, w), th[i, w], tn_s[i, w], dt)
-                    frac = sigma / dt
+                    frac = crossing_fraction(c, (blk, i, w), th[i, w], tn_s[i, w])
+                    sigma = frac * dt
                     after = dt - sigma
                     if fired[i, w] > 0.0:
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
-                    sn, cs = sincos(tn_s[i, w])
-                    vp = thd[i, w] + acc[i, w] * dt
-                    dv, dforce, dphid, jrest, jforce, jphi = kick(c, (blk, i, w), (blk, w), fired[i, w] * dt, frac, den_prev[w], s_den[w], sn, cs, vp, q[i, w], phd_pred[w])  # fmt: skip  # noqa: E501
+                    vel = thd[i, w] + acc[i, w] * sigma
+                    dv, dnum, dforce, jrest, jnum = kick(c, (blk, i, w), (blk, w), fired[i, w] * dt, vel)  # fmt: skip  # noqa: E501
                     thd[i, w] += dv + (after - half) * jrest
                     tn_s[i, w] += after * dv
                     rest[i, w] += jrest
-                    early[w] += (1.0 - frac) * dphid
-                    late[w] += frac * dphid + (after - half) * jphi
-                    shift[w] += after * dphid
-                    jump_p[w] += dforce + (after - half) * jforce
-                    phdd[w] += jphi
-                    force[w] += jforce
+                    num_early += (1.0 - frac) * dnum
+                    force_early += (1.0 - frac) * dforce
+                    num_late += frac * dnum + (after - half) * jnum
+                    force_late += frac * dforce
+                    num_shift += after * dnum
+                    force_shift += after * dforce
+                    num_change += jnum
+                    jump_p[w] += dforce
                     kicks[w] -= 1
                     if kicks[w] == 0:
                         break
+                early[w] = disk_acceleration(c, (blk, w), num_early, s_den[w], force_early)
+                late[w] = disk_acceleration(c, (blk, w), num_late, s_den[w], force_late)
+                shift[w] = disk_acceleration(c, (blk, w), num_shift, s_den[w], force_shift)
+                phdd[w] += disk_acceleration(c, (blk, w), num_change, s_den[w], 0.0)
             if any_kick:
                 for i in range(n):
                     for w in range(LANES):  # vectorized across runs
@@ -183,7 +193,6 @@ def advance(st, c, settings, rec, ks):
                     phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
-                    den_prev[w] = s_den[w]
                 early[w] = 0.0
                 late[w] = 0.0
                 shift[w] = 0.0
@@ -207,7 +216,6 @@ def advance(st, c, settings, rec, ks):
             acc_phi[b] = aph[w]
             p_phi[b] = pp[w]
             force_phi[b] = fph[w]
-            den_state[b] = den_prev[w]
 
 
 @nb.njit(cache=True, inline="always")

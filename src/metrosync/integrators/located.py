@@ -51,23 +51,19 @@ LAYOUTS = {"runs": kernel_located_runs, "oscillators": kernel_located_oscillator
 
 
 class KickState(NamedTuple):
-    """What the scheme carries from step to step beyond `State`: the geometry at the
-    step's start, which the impulses of the next step interpolate.
+    """What the scheme carries from step to step beyond `State`.
 
-    q : (B, N) m h cos θ at the last force evaluation.
-    den : (B,) Σ q²/(m h² + J_i) there.
+    q : (B, N) m h cos θ at the last force evaluation: the geometry at a step's
+        start, between which and its end the impulses interpolate.
     """
 
     q: np.ndarray
-    den: np.ndarray
 
 
 def kick_state(state: StepState, sys) -> KickState:
     """The `KickState` of ``state``, made from its angles on first use."""
     if state.scheme_state is None:
-        q = np.ascontiguousarray(sys.mh * np.cos(state.theta))
-        inv = 1.0 / sys.inertia
-        state.scheme_state = KickState(q=q, den=np.ascontiguousarray(np.sum(q * q * inv, axis=1)))
+        state.scheme_state = KickState(q=np.ascontiguousarray(sys.mh * np.cos(state.theta)))
     return state.scheme_state
 
 

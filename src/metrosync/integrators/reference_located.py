@@ -1,10 +1,13 @@
 """Plain NumPy implementation of the kick-located scheme in `located` (same steps, same
 records), vectorised over runs and metronomes.
 
-It is the oracle the compiled ``located`` kernels are tested against. Its smooth
-forces come from `equations.accelerations` and `equations.disk_torque`; the impulse
-and its interpolated geometry are written out as the kernels compute them (see
-`located` for the scheme).
+It is the oracle the compiled ``located`` kernels are tested against: the same
+arithmetic in plain loops and whole-array expressions, so that a kernel's indexing,
+memory layout or parallel writes cannot go wrong unnoticed. Its smooth forces come
+from `equations.accelerations` and `equations.disk_torque`; each impulse's pieces
+from the compiled scalar `_located_parts.kick` and `_physics.disk_acceleration`,
+called once per impulse (the physics of an impulse is checked against ``exact``
+instead, tests/integrators/test_located.py).
 """
 
 from __future__ import annotations
@@ -13,6 +16,9 @@ import numpy as np
 
 from ..equations import SystemArrays, accelerations, disk_torque
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
+from ._abi import constants_of
+from ._located_parts import kick
+from ._physics import disk_acceleration
 from ._state import StepState
 from .located import kick_state
 from .reference import _add_crossing_phase, _record
@@ -30,36 +36,35 @@ def advance_state(
 ) -> None:
     """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
     kicks = kick_state(state, sys)
+    c = constants_of(sys, dt)
     if step0 == 0:
         _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for s in range(step0, step0 + n_steps):
-            if not _step(state, kicks, sys, dt, s, overturn_angle, record_every):
+            if not _step(state, kicks, sys, c, dt, s, overturn_angle, record_every):
                 break
 
 
-def _step(state, kicks, sys, dt, s, overturn_angle, record_every) -> bool:
+def _step(state, kicks, sys, c, dt, s, overturn_angle, record_every) -> bool:
     alive = (state.status & STATUS_DIVERGED) == 0
     if not alive.any():
         return False
     n_rec = state.r.shape[1]
     rigid = np.isinf(sys.total_inertia)
     inv = 1.0 / sys.inertia
+    half = 0.5 * dt
     t_old, t_new = s * dt, (s + 1) * dt
     th, thd, acc = state.theta, state.theta_dot, state.acc_theta
     th_new = th + thd * dt + 0.5 * acc * (dt * dt)
     vel_pred = thd + acc * dt
     phd_pred = state.phi_dot + state.acc_phi * dt
     phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * (dt * dt)
-
-    # The escapement, as `_physics.escapement`: ±M/dt when θ crosses 0; here only
-    # its impulse (that torque times dt) is used, applied at the crossing instant.
-    up = (th < 0) & (th_new > 0) & alive[:, None]
-    down = (th > 0) & (th_new < 0) & alive[:, None]
+    # The escapement as `_physics.escapement` states it: ±M/dt where θ crosses 0 (its
+    # angle) in the step; the scheme applies that torque times dt as an impulse.
+    up = (th < 0) & (th_new > 0)
+    down = (th > 0) & (th_new < 0)
     rate = sys.drive / dt
-    impulse = np.where(up, rate, np.where(down, -rate, 0.0)) * dt
-    kicked = impulse != 0.0
-    sigma = np.where(kicked, crossing_time(th, thd, acc, th_new, dt), 0.0)
+    fire = np.where(up, rate, np.where(down, -rate, 0.0))
     overturned = np.any(np.abs(th_new) > overturn_angle, axis=1) & alive
     state.status[overturned] |= STATUS_OVERTURNED
 
@@ -69,65 +74,53 @@ def _step(state, kicks, sys, dt, s, overturn_angle, record_every) -> bool:
     state.status[diverged] |= STATUS_DIVERGED
     ok = alive & ~diverged
     force = disk_torque(sys, phd_pred, no_kick, t_new)
-    for b, i in zip(*np.nonzero(up & ok[:, None]), strict=True):
-        t_cross = t_old + sigma[b, i]
-        if state.last_up[b, i] >= 0:
-            _add_crossing_phase(state, b, state.last_up[b, i], t_cross, record_every * dt, n_rec)
-        state.last_up[b, i] = t_cross
     q_new = sys.mh * np.cos(th_new)
     den_new = np.sum(q_new * q_new * inv, axis=1)
 
-    # The impulse of each crossing at its instant t_old + sigma: the kick-linear part
-    # of eqs. (eqm1)-(eqm2) with the kicked pendulum at the escapement's angle (0) and
-    # the others' geometry interpolated between the step's ends.
-    frac = sigma / dt
-    rest_jump = impulse * inv
-    num_jump = -(sys.mh * 1.0) * rest_jump
-    force_jump = np.zeros_like(th)
-    for i in range(th.shape[1]):
-        force_jump[:, i] = disk_torque(sys, 0.0, impulse[:, i : i + 1]) - disk_torque(
-            sys, 0.0, no_kick[:, i : i + 1]
-        )
-    den_c = kicks.den[:, None] + frac * (den_new - kicks.den)[:, None]
-    radius = sys.radius[:, None]
-    with np.errstate(invalid="ignore"):
-        disk_jump = (radius * num_jump + force_jump) / (
-            sys.total_inertia[:, None] - radius * radius * den_c
-        )
-    disk_jump = np.where(kicked, np.where(rigid[:, None], 0.0, disk_jump), 0.0)
-    rest_after = np.where(kicked, dt - sigma, 0.0)
-    # What the jump changes in the velocity-dependent forces (friction, θ̇² sin θ) over
-    # the rest of the step: the kicked pendulum's and the disk's, at the step's end.
-    own_jump = rest_jump - radius * inv * q_new * disk_jump
-    j_phi = np.zeros(th.shape[0])  # the jump in the accelerations and the disk torque ...
-    j_theta = np.zeros_like(th)
-    j_force = np.zeros(th.shape[0])
-    j_theta_rest = np.zeros_like(th)  # ... and its integral over the rest of the step
-    for i in np.nonzero(kicked.any(axis=0))[0]:
-        vel = vel_pred.copy()
-        vel[:, i] += own_jump[:, i]
-        phdd_k, thdd_k = accelerations(sys, th_new, vel, phd_pred + disk_jump[:, i], no_kick, t_new)
-        kicked_i = kicked[:, i]
-        j_phi += np.where(kicked_i, phdd_k - phdd, 0.0)
-        j_theta += np.where(kicked_i[:, None], thdd_k - thdd, 0.0)
-        j_theta_rest += rest_after[:, i, None] * np.where(kicked_i[:, None], thdd_k - thdd, 0.0)
-        force_k = disk_torque(sys, phd_pred + disk_jump[:, i], no_kick, t_new)
-        j_force += np.where(kicked_i, force_k - force, 0.0)
-        force_jump[:, i] += np.where(kicked_i, rest_after[:, i] * (force_k - force), 0.0)
-    early = np.sum((1.0 - frac) * disk_jump, axis=1)
-    late = np.sum(disk_jump, axis=1) - early
-    shift = np.sum(rest_after * disk_jump, axis=1)
-    momentum_jump = np.sum(force_jump, axis=1)
+    # Each impulse at its instant: `_located_parts.kick` gives its pieces, summed here
+    # as the kernels sum them; the disk's jumps follow from the sums.
+    kicked = (fire != 0.0) & ok[:, None]
+    frac = np.where(kicked, (th - 0.0) / (th - th_new), 0.0)
+    sigma = frac * dt
+    after = np.where(kicked, dt - sigma, 0.0)
+    own = np.zeros_like(th)  # the pendulum's own jump, and its forces' change
+    own_change = np.zeros_like(th)
+    sums = np.zeros((th.shape[0], 8))
+    for b, i in zip(*np.nonzero(kicked), strict=True):
+        if fire[b, i] > 0:
+            t_cross = t_old + sigma[b, i]
+            if state.last_up[b, i] >= 0:
+                _add_crossing_phase(
+                    state, b, state.last_up[b, i], t_cross, record_every * dt, n_rec
+                )
+            state.last_up[b, i] = t_cross
+        vel = thd[b, i] + acc[b, i] * sigma[b, i]
+        dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fire[b, i] * dt, vel)
+        own[b, i] = dv
+        own_change[b, i] = jrest
+        f, a = frac[b, i], after[b, i]
+        sums[b] += [
+            (1.0 - f) * dnum, (1.0 - f) * dforce, f * dnum + (a - half) * jnum, f * dforce,
+            a * dnum, a * dforce, jnum, dforce,
+        ]  # fmt: skip
+    early, late, shift, change = (np.zeros(th.shape[0]) for _ in range(4))
+    for b in np.nonzero(kicked.any(axis=1))[0]:
+        den = den_new[b]
+        early[b] = disk_acceleration(c, b, sums[b, 0], den, sums[b, 1])
+        late[b] = disk_acceleration(c, b, sums[b, 2], den, sums[b, 3])
+        shift[b] = disk_acceleration(c, b, sums[b, 4], den, sums[b, 5])
+        change[b] = disk_acceleration(c, b, sums[b, 6], den, 0.0)
+    momentum_jump = sums[:, 7]
 
-    # Finish the step: the velocity jumps (direct, and through the disk at the crossing's
-    # geometry), their effect on the forces over the rest of the step, and the distance
-    # they travel in it.
-    coupling = radius * inv
+    # Finish the step. Every pendulum's jump through the disk, −R q Δφ̇/I (eq. (eqm2)
+    # for an impulse), with q at the step's end or, for `early`, at its start.
+    through_disk = sys.radius[:, None] * inv
+    acc_new = thdd + own_change - through_disk * q_new * change[:, None]
     new_theta_dot = (
-        thd + rest_jump + 0.5 * (acc + thdd) * dt + j_theta_rest
-        - coupling * q_new * late[:, None] - coupling * kicks.q * early[:, None]
+        thd + own + (after - half) * own_change + 0.5 * (acc + acc_new) * dt
+        - through_disk * q_new * late[:, None] - through_disk * kicks.q * early[:, None]
     )  # fmt: skip
-    new_theta = th_new + rest_after * rest_jump - coupling * q_new * shift[:, None]
+    new_theta = th_new + after * own - through_disk * q_new * shift[:, None]
     sum_p = sys.radius * np.sum(q_new * new_theta_dot, axis=1)
     new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt + momentum_jump
     with np.errstate(invalid="ignore"):
@@ -137,20 +130,12 @@ def _step(state, kicks, sys, dt, s, overturn_angle, record_every) -> bool:
     state.phi[ok] = (phi_new + shift)[ok]
     state.theta[...] = np.where(ok2, new_theta, th)
     state.theta_dot[...] = np.where(ok2, new_theta_dot, thd)
-    state.acc_theta[...] = np.where(ok2, thdd + j_theta, acc)
+    state.acc_theta[...] = np.where(ok2, acc_new, acc)
     state.p_phi[ok] = np.where(rigid, state.p_phi, new_p)[ok]
     state.phi_dot[ok] = new_phi_dot[ok]
-    state.force_phi[ok] = (force + j_force)[ok]
-    state.acc_phi[ok] = (phdd + j_phi)[ok]
+    state.force_phi[ok] = force[ok]
+    state.acc_phi[ok] = (phdd + change)[ok]
     kicks.q[...] = np.where(ok2, q_new, kicks.q)
-    kicks.den[ok] = den_new[ok]
     if (s + 1) % record_every == 0:
         _record(state, (s + 1) // record_every, sys.omega, ok)
     return True
-
-
-def crossing_time(th, thd, acc, th_new, dt):
-    """Time from the step's start at which θ crosses 0, (B, N): linear interpolation
-    between the step's ends."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return dt * th / (th - th_new)
