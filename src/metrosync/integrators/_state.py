@@ -43,9 +43,6 @@ class StepState:
 
     state: State
     recording: Recording
-    #: What a scheme carries beyond `State` (``located``: `located.KickState`), made
-    #: by the scheme on its first step.
-    scheme_state: tuple | None = None
 
     def __getattr__(self, name: str):
         # Called only for names the dataclass itself lacks; vars() rather than

@@ -32,13 +32,11 @@ from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 
 @nb.njit(parallel=True, cache=True, fastmath=FASTMATH)
-def advance(st, c, settings, rec, ks):
-    """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place;
-    ``ks`` is the scheme's `located.KickState`."""
+def advance(st, c, settings, rec):
+    """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
-    (q_state,) = ks
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
@@ -50,7 +48,6 @@ def advance(st, c, settings, rec, ks):
         th_new = np.empty(n)
         rest = np.empty(n)
         q = np.empty(n)
-        q_prev = q_state[b].copy()  # q at the step's start: the last step's q
         fired = np.empty(n)
         pinned = math.isinf(c.total_inertia[b])
         until_record = record_every - step0 % record_every
@@ -86,10 +83,8 @@ def advance(st, c, settings, rec, ks):
                 p_phi[b] = momentum(p_phi[b], force_phi[b], force, dt, pinned)
             else:
                 # Sums over the impulses of the step; the disk's jumps are linear in them.
-                num_early = 0.0  # Σ (1 − s_k) × impulse k: jumps at the step's start geometry
-                force_early = 0.0
-                num_late = 0.0  # Σ s_k × impulse k, and (τ_k − dt/2) × its force change: its end
-                force_late = 0.0
+                num_jump = 0.0  # Σ impulse k, and (τ_k − dt/2) × its forces' change
+                force_jump = 0.0
                 num_shift = 0.0  # Σ τ_k × impulse k: the distance the disk's jumps travel
                 force_shift = 0.0
                 num_change = 0.0  # the change of the forces on the disk
@@ -103,17 +98,15 @@ def advance(st, c, settings, rec, ks):
                     after = dt - sigma
                     if fired[i] > 0.0:
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
-                    vel = theta_dot[b, i] + acc_theta[b, i] * sigma
-                    dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fired[i] * dt, vel)
+                    impulse = fired[i] * dt
+                    dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, impulse, theta_dot[b, i])
                     # The second pass's velocity update adds dt/2 of the new accelerations,
                     # which include the forces' change: its terms are net of that.
                     theta_dot[b, i] += dv + (after - half) * jrest
                     th_new[i] += after * dv
                     rest[i] += jrest
-                    num_early += (1.0 - frac) * dnum
-                    force_early += (1.0 - frac) * dforce
-                    num_late += frac * dnum + (after - half) * jnum
-                    force_late += frac * dforce
+                    num_jump += dnum + (after - half) * jnum
+                    force_jump += dforce
                     num_shift += after * dnum
                     force_shift += after * dforce
                     num_change += jnum
@@ -121,17 +114,13 @@ def advance(st, c, settings, rec, ks):
                     n_kick -= 1
                     if n_kick == 0:
                         break
-                early = disk_acceleration(c, b, num_early, sum_den, force_early)
-                late = disk_acceleration(c, b, num_late, sum_den, force_late)
+                jump = disk_acceleration(c, b, num_jump, sum_den, force_jump)
                 shift = disk_acceleration(c, b, num_shift, sum_den, force_shift)
                 phdd += disk_acceleration(c, b, num_change, sum_den, 0.0)
                 for i in range(n):  # vectorized pass, with the jumps through the disk
                     thdd = theta_ddot(c, (b, i), b, rest[i], q[i], phdd)
-                    v = (
-                        velocity(theta_dot[b, i], acc_theta[b, i], thdd, dt)
-                        + theta_ddot(c, (b, i), b, 0.0, q[i], late)
-                        + theta_ddot(c, (b, i), b, 0.0, q_prev[i], early)
-                    )
+                    v = velocity(theta_dot[b, i], acc_theta[b, i], thdd, dt)
+                    v += theta_ddot(c, (b, i), b, 0.0, q[i], jump)
                     theta_dot[b, i] = v
                     theta[b, i] = th_new[i] + theta_ddot(c, (b, i), b, 0.0, q[i], shift)
                     acc_theta[b, i] = thdd
@@ -142,7 +131,6 @@ def advance(st, c, settings, rec, ks):
             phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
             force_phi[b] = force
             acc_phi[b] = phdd
-            q, q_prev = q_prev, q
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -150,8 +138,6 @@ def advance(st, c, settings, rec, ks):
                 r[b, k] = analytic_order(theta[b], theta_dot[b], c.omega[b])
                 if save:
                     save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
-        for i in range(n):
-            q_state[b, i] = q_prev[i]
 
 
 @nb.njit(cache=True, inline="always")

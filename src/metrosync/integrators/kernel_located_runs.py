@@ -32,12 +32,11 @@ from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 
 @nb.njit(parallel=True, cache=True)
-def advance(st, c, settings, rec, ks):
+def advance(st, c, settings, rec):
     """Same contract as `kernel_located_oscillators.advance`; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
-    (q_state,) = ks
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
@@ -53,14 +52,12 @@ def advance(st, c, settings, rec, ks):
         th = np.empty((n, LANES))
         thd = np.empty((n, LANES))
         acc = np.empty((n, LANES))
-        q_prev = np.empty((n, LANES))
         for i in range(n):
             for w in range(LANES):
                 b = b0 + min(w, lanes - 1)
                 th[i, w] = theta[b, i]
                 thd[i, w] = theta_dot[b, i]
                 acc[i, w] = acc_theta[b, i]
-                q_prev[i, w] = q_state[b, i]
         ph = np.empty(LANES)
         phd = np.empty(LANES)
         aph = np.empty(LANES)
@@ -86,8 +83,7 @@ def advance(st, c, settings, rec, ks):
         s_p = np.empty(LANES)
         phdd = np.empty(LANES)
         force = np.empty(LANES)
-        early = np.zeros(LANES)  # per lane, as in `kernel_located_oscillators`
-        late = np.zeros(LANES)
+        jump = np.zeros(LANES)  # per lane, as in `kernel_located_oscillators`
         shift = np.zeros(LANES)
         jump_p = np.zeros(LANES)
         kicks = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
@@ -121,10 +117,8 @@ def advance(st, c, settings, rec, ks):
                 if kicks[w] == 0:
                     continue
                 any_kick = True
-                num_early = 0.0  # as in `kernel_located_oscillators`
-                force_early = 0.0
-                num_late = 0.0
-                force_late = 0.0
+                num_jump = 0.0  # as in `kernel_located_oscillators`
+                force_jump = 0.0
                 num_shift = 0.0
                 force_shift = 0.0
                 num_change = 0.0
@@ -136,15 +130,12 @@ def advance(st, c, settings, rec, ks):
                     after = dt - sigma
                     if fired[i, w] > 0.0:
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
-                    vel = thd[i, w] + acc[i, w] * sigma
-                    dv, dnum, dforce, jrest, jnum = kick(c, (blk, i, w), (blk, w), fired[i, w] * dt, vel)  # fmt: skip  # noqa: E501
+                    dv, dnum, dforce, jrest, jnum = kick(c, (blk, i, w), (blk, w), fired[i, w] * dt, thd[i, w])  # fmt: skip  # noqa: E501
                     thd[i, w] += dv + (after - half) * jrest
                     tn_s[i, w] += after * dv
                     rest[i, w] += jrest
-                    num_early += (1.0 - frac) * dnum
-                    force_early += (1.0 - frac) * dforce
-                    num_late += frac * dnum + (after - half) * jnum
-                    force_late += frac * dforce
+                    num_jump += dnum + (after - half) * jnum
+                    force_jump += dforce
                     num_shift += after * dnum
                     force_shift += after * dforce
                     num_change += jnum
@@ -152,8 +143,7 @@ def advance(st, c, settings, rec, ks):
                     kicks[w] -= 1
                     if kicks[w] == 0:
                         break
-                early[w] = disk_acceleration(c, (blk, w), num_early, s_den[w], force_early)
-                late[w] = disk_acceleration(c, (blk, w), num_late, s_den[w], force_late)
+                jump[w] = disk_acceleration(c, (blk, w), num_jump, s_den[w], force_jump)
                 shift[w] = disk_acceleration(c, (blk, w), num_shift, s_den[w], force_shift)
                 phdd[w] += disk_acceleration(c, (blk, w), num_change, s_den[w], 0.0)
             if any_kick:
@@ -162,16 +152,12 @@ def advance(st, c, settings, rec, ks):
                         keep = alive[w] > 0.0
                         m = (blk, i, w)
                         thdd = theta_ddot(c, m, (blk, w), rest[i, w], q[i, w], phdd[w])
-                        v = (
-                            velocity(thd[i, w], acc[i, w], thdd, dt)
-                            + theta_ddot(c, m, (blk, w), 0.0, q[i, w], late[w])
-                            + theta_ddot(c, m, (blk, w), 0.0, q_prev[i, w], early[w])
-                        )
+                        v = velocity(thd[i, w], acc[i, w], thdd, dt)
+                        v += theta_ddot(c, m, (blk, w), 0.0, q[i, w], jump[w])
                         moved = tn_s[i, w] + theta_ddot(c, m, (blk, w), 0.0, q[i, w], shift[w])
                         thd[i, w] = v if keep else thd[i, w]
                         th[i, w] = moved if keep else th[i, w]
                         acc[i, w] = thdd if keep else acc[i, w]
-                        q_prev[i, w] = q[i, w] if keep else q_prev[i, w]
                         s_p[w] += q[i, w] * v
             else:
                 for i in range(n):
@@ -182,7 +168,6 @@ def advance(st, c, settings, rec, ks):
                         thd[i, w] = v if keep else thd[i, w]
                         th[i, w] = tn_s[i, w] if keep else th[i, w]
                         acc[i, w] = thdd if keep else acc[i, w]
-                        q_prev[i, w] = q[i, w] if keep else q_prev[i, w]
                         s_p[w] += q[i, w] * v
             for w in range(LANES):
                 if alive[w] > 0.0:
@@ -193,8 +178,7 @@ def advance(st, c, settings, rec, ks):
                     phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
-                early[w] = 0.0
-                late[w] = 0.0
+                jump[w] = 0.0
                 shift[w] = 0.0
                 jump_p[w] = 0.0
             until_record -= 1
@@ -210,7 +194,6 @@ def advance(st, c, settings, rec, ks):
                 theta[b, i] = th[i, w]
                 theta_dot[b, i] = thd[i, w]
                 acc_theta[b, i] = acc[i, w]
-                q_state[b, i] = q_prev[i, w]
             phi[b] = ph[w]
             phi_dot[b] = phd[w]
             acc_phi[b] = aph[w]

@@ -20,7 +20,6 @@ from ._abi import constants_of
 from ._located_parts import kick
 from ._physics import disk_acceleration
 from ._state import StepState
-from .located import kick_state
 from .reference import _add_crossing_phase, _record
 
 
@@ -35,17 +34,16 @@ def advance_state(
     overturn_angle: float,
 ) -> None:
     """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
-    kicks = kick_state(state, sys)
     c = constants_of(sys, dt)
     if step0 == 0:
         _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         for s in range(step0, step0 + n_steps):
-            if not _step(state, kicks, sys, c, dt, s, overturn_angle, record_every):
+            if not _step(state, sys, c, dt, s, overturn_angle, record_every):
                 break
 
 
-def _step(state, kicks, sys, c, dt, s, overturn_angle, record_every) -> bool:
+def _step(state, sys, c, dt, s, overturn_angle, record_every) -> bool:
     alive = (state.status & STATUS_DIVERGED) == 0
     if not alive.any():
         return False
@@ -85,7 +83,7 @@ def _step(state, kicks, sys, c, dt, s, overturn_angle, record_every) -> bool:
     after = np.where(kicked, dt - sigma, 0.0)
     own = np.zeros_like(th)  # the pendulum's own jump, and its forces' change
     own_change = np.zeros_like(th)
-    sums = np.zeros((th.shape[0], 8))
+    sums = np.zeros((th.shape[0], 5))
     for b, i in zip(*np.nonzero(kicked), strict=True):
         if fire[b, i] > 0:
             t_cross = t_old + sigma[b, i]
@@ -94,31 +92,26 @@ def _step(state, kicks, sys, c, dt, s, overturn_angle, record_every) -> bool:
                     state, b, state.last_up[b, i], t_cross, record_every * dt, n_rec
                 )
             state.last_up[b, i] = t_cross
-        vel = thd[b, i] + acc[b, i] * sigma[b, i]
-        dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fire[b, i] * dt, vel)
+        dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fire[b, i] * dt, thd[b, i])
         own[b, i] = dv
         own_change[b, i] = jrest
-        f, a = frac[b, i], after[b, i]
-        sums[b] += [
-            (1.0 - f) * dnum, (1.0 - f) * dforce, f * dnum + (a - half) * jnum, f * dforce,
-            a * dnum, a * dforce, jnum, dforce,
-        ]  # fmt: skip
-    early, late, shift, change = (np.zeros(th.shape[0]) for _ in range(4))
+        a = after[b, i]
+        sums[b] += [dnum + (a - half) * jnum, dforce, a * dnum, a * dforce, jnum]
+    jump, shift, change = (np.zeros(th.shape[0]) for _ in range(3))
     for b in np.nonzero(kicked.any(axis=1))[0]:
         den = den_new[b]
-        early[b] = disk_acceleration(c, b, sums[b, 0], den, sums[b, 1])
-        late[b] = disk_acceleration(c, b, sums[b, 2], den, sums[b, 3])
-        shift[b] = disk_acceleration(c, b, sums[b, 4], den, sums[b, 5])
-        change[b] = disk_acceleration(c, b, sums[b, 6], den, 0.0)
-    momentum_jump = sums[:, 7]
+        jump[b] = disk_acceleration(c, b, sums[b, 0], den, sums[b, 1])
+        shift[b] = disk_acceleration(c, b, sums[b, 2], den, sums[b, 3])
+        change[b] = disk_acceleration(c, b, sums[b, 4], den, 0.0)
+    momentum_jump = sums[:, 1]
 
     # Finish the step. Every pendulum's jump through the disk, −R q Δφ̇/I (eq. (eqm2)
-    # for an impulse), with q at the step's end or, for `early`, at its start.
+    # for an impulse), with q at the step's end.
     through_disk = sys.radius[:, None] * inv
     acc_new = thdd + own_change - through_disk * q_new * change[:, None]
     new_theta_dot = (
         thd + own + (after - half) * own_change + 0.5 * (acc + acc_new) * dt
-        - through_disk * q_new * late[:, None] - through_disk * kicks.q * early[:, None]
+        - through_disk * q_new * jump[:, None]
     )  # fmt: skip
     new_theta = th_new + after * own - through_disk * q_new * shift[:, None]
     sum_p = sys.radius * np.sum(q_new * new_theta_dot, axis=1)
@@ -135,7 +128,6 @@ def _step(state, kicks, sys, c, dt, s, overturn_angle, record_every) -> bool:
     state.phi_dot[ok] = new_phi_dot[ok]
     state.force_phi[ok] = force[ok]
     state.acc_phi[ok] = (phdd + change)[ok]
-    kicks.q[...] = np.where(ok2, q_new, kicks.q)
     if (s + 1) % record_every == 0:
         _record(state, (s + 1) // record_every, sys.omega, ok)
     return True
