@@ -59,9 +59,7 @@ def main() -> None:
     steps = int(round(args.duration / args.dt))
     for size in args.sizes:
         b, n = (int(x) for x in size.lower().split("x"))
-        ens = build_ensemble(
-            n, 192.0, params=get_preset("default"), sigma_bpm=0.75, runs=b, seed=1
-        )
+        ens = build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=0.75, runs=b, seed=1)
         layout = args.layout or verlet.choose_layout(n, b)
         best = dict.fromkeys(SCHEMES, 0.0)
         for scheme in SCHEMES:
