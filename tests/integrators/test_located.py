@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from test_kernels import FEATURES  # the model features every layout must reproduce
 
 from metrosync import build_ensemble, get_preset, simulate
 from metrosync.integrators import REGISTRY, located, reference_located, verlet
@@ -14,7 +15,7 @@ from metrosync.integrators._state import StepState
 def run(advance, ens, steps, *, dt=0.01, chunks=1, **kwargs):
     state = StepState.start(
         ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
-        n_records=steps // 10 + 1, trajectories=True,
+        n_records=steps // 10 + 1, trajectories=True, group_start=ens.group_start,
     )  # fmt: skip
     per = steps // chunks
     for k in range(chunks):
@@ -23,17 +24,22 @@ def run(advance, ens, steps, *, dt=0.01, chunks=1, **kwargs):
     return state
 
 
+@pytest.mark.parametrize("feature", sorted(FEATURES))
 @pytest.mark.parametrize("layout", sorted(located.LAYOUTS))
 @pytest.mark.parametrize("n, runs", [(3, 11), (20, 3)])  # 11 runs: a partly filled block
-def test_every_layout_matches_the_numpy_twin_over_1000_steps(layout, n, runs):
-    ens = build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=2.0, runs=runs, seed=7)
+def test_every_layout_matches_the_numpy_twin_over_1000_steps(layout, n, runs, feature):
+    options = {"params": get_preset("default"), "sigma_bpm": 2.0, **FEATURES[feature](n)}
+    ens = build_ensemble(n, 192.0, runs=runs, seed=7, **options)
     ref = run(reference_located.advance_state, ens, 1000)
     got = run(located.advance_state, ens, 1000, layout=layout)
     assert np.count_nonzero(np.diff(np.sign(ref.traj_theta), axis=1)) > 50 * runs  # kicks
-    for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "acc_theta", "traj_theta", "r"):
+    names = ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "acc_theta", "traj_theta", "r")
+    for name in (*names, "r_group"):
         np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
-    np.testing.assert_allclose(got.crossing_order(), ref.crossing_order(), atol=1e-10)
+    for name in ("crossing_order", "group_crossing_order", "group_order"):
+        np.testing.assert_allclose(getattr(got, name)(), getattr(ref, name)(), atol=1e-10)
     np.testing.assert_array_equal(got.status, ref.status)
+    np.testing.assert_array_equal(got.cross_count, ref.cross_count)
 
 
 @pytest.mark.parametrize("layout", sorted(located.LAYOUTS))

@@ -16,7 +16,15 @@ import numba as nb
 import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._kernel_parts import analytic_order, drift, momentum, save_state, upward_crossing, velocity
+from ._kernel_parts import (
+    analytic_order,
+    drift,
+    group_orders,
+    momentum,
+    save_state,
+    upward_crossing,
+    velocity,
+)
 from ._located_parts import crossing_fraction, kick
 from ._physics import (
     applied_torque,
@@ -36,11 +44,12 @@ def advance(st, c, settings, rec):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
     save = traj_theta.shape[0] > 0
+    grouped = group_start.shape[0] > 2  # several groups
     dt2 = dt * dt
     half = 0.5 * dt
     grid_dt = record_every * dt
@@ -53,6 +62,8 @@ def advance(st, c, settings, rec):
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
             r[b, 0] = analytic_order(theta[b], theta_dot[b], c.omega[b])
+            if grouped:
+                group_orders(r_group, b, 0, theta[b], theta_dot[b], c.omega[b], group_start)
             if save:
                 save_state(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
@@ -97,7 +108,7 @@ def advance(st, c, settings, rec):
                     sigma = frac * dt
                     after = dt - sigma
                     if fired[i] > 0.0:
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_old + sigma, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                     impulse = fired[i] * dt
                     dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, impulse, theta_dot[b, i])
                     # The second pass's velocity update adds dt/2 of the new accelerations,
@@ -136,6 +147,8 @@ def advance(st, c, settings, rec):
                 until_record = record_every
                 k = (s + 1) // record_every
                 r[b, k] = analytic_order(theta[b], theta_dot[b], c.omega[b])
+                if grouped:
+                    group_orders(r_group, b, k, theta[b], theta_dot[b], c.omega[b], group_start)
                 if save:
                     save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
 

@@ -36,7 +36,7 @@ def advance(st, c, settings, rec):
     """Same contract as `kernel_located_oscillators.advance`; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = rec  # fmt: skip  # noqa: E501
+    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
@@ -92,7 +92,7 @@ def advance(st, c, settings, rec):
         if step0 == 0:
             for w in range(lanes):
                 if alive[w] > 0.0:
-                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
             n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, fired, s_num, s_den, kicks, overs, sincos)  # fmt: skip  # noqa: E501
             if n_far > 0:  # rare: redo the pass with libm trig
@@ -129,7 +129,7 @@ def advance(st, c, settings, rec):
                     sigma = frac * dt
                     after = dt - sigma
                     if fired[i, w] > 0.0:
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_old + sigma, grid_dt, n_rec)  # fmt: skip  # noqa: E501
+                        upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_old + sigma, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                     dv, dnum, dforce, jrest, jnum = kick(c, (blk, i, w), (blk, w), fired[i, w] * dt, thd[i, w])  # fmt: skip  # noqa: E501
                     thd[i, w] += dv + (after - half) * jrest
                     tn_s[i, w] += after * dv
@@ -187,7 +187,7 @@ def advance(st, c, settings, rec):
                 k = (s + 1) // record_every
                 for w in range(lanes):
                     if alive[w] > 0.0:
-                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for w in range(lanes):
             b = b0 + w
             for i in range(n):

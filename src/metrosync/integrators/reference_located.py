@@ -88,8 +88,9 @@ def _step(state, sys, c, dt, s, overturn_angle, record_every) -> bool:
         if fire[b, i] > 0:
             t_cross = t_old + sigma[b, i]
             if state.last_up[b, i] >= 0:
+                grp = np.searchsorted(state.group_start, i, side="right") - 1
                 _add_crossing_phase(
-                    state, b, state.last_up[b, i], t_cross, record_every * dt, n_rec
+                    state, b, grp, state.last_up[b, i], t_cross, record_every * dt, n_rec
                 )
             state.last_up[b, i] = t_cross
         dv, dnum, dforce, jrest, jnum = kick(c, (b, i), b, fire[b, i] * dt, thd[b, i])
