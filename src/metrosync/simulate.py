@@ -119,7 +119,8 @@ def simulate(
     preset : ``"default"``, ``"boda2013"`` or a `ModelParameters`.
     changes : model parameters to change by name, e.g. ``{"drive": 1e-4, "c_phi": 0}``.
     integrator : a name from `metrosync.integrators.REGISTRY`: ``"verlet"`` (the
-        paper's scheme) or ``"exact"`` (reference).
+        paper's scheme), ``"located"`` (the same with each kick at its crossing
+        instant: second order with kicks) or ``"exact"`` (reference).
     backend : for a fixed-step integrator, ``"numba"`` (compiled, parallel over runs),
         ``"numpy"`` (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through
         numba.cuda; no trajectories yet); see `metrosync.integrators.BACKENDS`.

@@ -31,7 +31,7 @@ def test_every_backend_of_every_integrator_is_implemented(name):
 def test_an_unknown_integrator_lists_the_valid_ones():
     with pytest.raises(ParameterError, match=r"unknown `integrator` 'rk4'; choose one of "):
         get_integrator("rk4")
-    with pytest.raises(ParameterError, match=r"\['verlet', 'exact'\]"):
+    with pytest.raises(ParameterError, match=r"\['verlet', 'located', 'exact'\]"):
         simulate(3, 192, duration=1, integrator="rk4")
 
 

@@ -97,6 +97,19 @@ REGISTRY: dict[str, Integrator] = {
         trajectories=("numba", "numpy"),
         fixed_step=True,
     ),
+    "located": Integrator(
+        name="located",
+        summary="the paper's fixed-step scheme with each escapement impulse applied at its "
+        "located crossing instant",
+        order=2,
+        order_with_kicks=2,
+        modules={
+            "numba": "metrosync.integrators.located",
+            "numpy": "metrosync.integrators.reference_located",
+        },
+        trajectories=("numba", "numpy"),
+        fixed_step=True,
+    ),
     "exact": Integrator(
         name="exact",
         summary="the accurate reference: DOP853 between impulses, each crossing located "

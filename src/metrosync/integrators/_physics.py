@@ -65,6 +65,15 @@ def escapement(c, m, theta, theta_next):
 
 
 @nb.njit(cache=True, inline="always")
+def escapement_angle(c, m):
+    """The angle, rad, at which metronome ``m``'s escapement gives its impulse: where
+    `escapement` fires (``escapement_offset``; 0, the vertical, in the paper). The
+    ``located`` scheme finds the crossing of this angle inside the step and applies
+    the impulse there."""
+    return c.escapement_offset[m]
+
+
+@nb.njit(cache=True, inline="always")
 def pendulum_terms(c, m, kick, sin_t, cos_t, theta_dot):
     """Metronome ``m``'s part of eqs. (eqm1)–(eqm2) at angle θ (given as sin θ, cos θ).
 
@@ -175,6 +184,7 @@ def momentum_at_rest(c, r, sum_q_theta_dot):
 #: Every function above, for `kernel_cuda` and the tests.
 FUNCTIONS = (
     escapement,
+    escapement_angle,
     pendulum_terms,
     disk_torque,
     applied_torque,
