@@ -41,7 +41,10 @@ def kick(c, m, r, impulse, theta_dot):
     jrest, jnum : what the jump ``dv`` changes in the pendulum's ``rest`` and in its
         share of φ̈'s numerator (friction, the θ̇² sin θ term), per unit time.
     """
-    s_lev, c_lev = sincos(escapement_angle(c, m))
+    level = escapement_angle(c, m)
+    # At the vertical (the paper's escapement) skip the trig: a sincos per impulse
+    # costs 10 % of the scheme's rate at N = 64.
+    s_lev, c_lev = (0.0, 1.0) if level == 0.0 else sincos(level)
     rest1, _, num1, _ = pendulum_terms(c, m, impulse, s_lev, c_lev, 0.0)
     rest0, _, num0, _ = pendulum_terms(c, m, 0.0, s_lev, c_lev, 0.0)
     dv = rest1 - rest0
