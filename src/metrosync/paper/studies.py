@@ -110,6 +110,8 @@ class TimeSeriesStudy:
     full: Statistics
     preset: str = "default"
     legend_title: str = ""
+    #: Model parameters changed from the preset, by name (a reading of the claims map).
+    changes: tuple[tuple[str, float | str], ...] = ()
 
     def statistics(self, mode: str) -> Statistics:
         return getattr(self, _check_mode(mode))
@@ -135,6 +137,8 @@ class SweepStudy:
     quick: SweepGrid
     full: SweepGrid
     preset: str = "default"
+    #: Model parameters changed from the preset, by name (a reading of the claims map).
+    changes: tuple[tuple[str, float | str], ...] = ()
 
     def grid(self, mode: str) -> SweepGrid:
         return getattr(self, _check_mode(mode))
