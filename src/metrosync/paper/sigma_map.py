@@ -16,7 +16,7 @@ and the reduced theory's prediction (`metrosync.theory.reduced_theory`) beside i
     omega_c_{peak,rise}(_err)          (tuning, sigma, n)
     omega_inf_{peak,rise}(_err)        (tuning, sigma)
     theory_omega_c(_low, _high)        (tuning, sigma)     linear threshold, N → ∞
-    sigma_at_target(_err)              (tuning, method)    method: peak, rise, theory
+    sigma_at_target(_err)              (tuning, estimator) peak, rise, theory
 
 Windows are declared per tuning and σ (``centres``), focused where the onset lies:
 the N → ∞ onset moves by about 45 BPM per BPM of σ, and a window of ±12.5 BPM holds
@@ -210,13 +210,13 @@ def analyse(study: SigmaMapStudy, mode: str, ds: xr.Dataset, theory_cache: Path)
                 row = ds[f"omega_inf_{m}"].isel(tuning=i).values
                 half = ds[f"omega_inf_{m}_err"].isel(tuning=i).values
             at[i, j], err[i, j] = sigma_at(sigmas, row, half, study.target, seed=i * 7 + j)
-    ds = ds.assign_coords(method=methods)
+    ds = ds.assign_coords(estimator=methods)
     ds["sigma_at_target"] = (
-        ("tuning", "method"),
+        ("tuning", "estimator"),
         at,
         {"units": "BPM", "long_name": f"σ at which ω_c(∞) = {study.target:g} BPM"},
     )
-    ds["sigma_at_target_err"] = (("tuning", "method"), err, {"units": "BPM"})
+    ds["sigma_at_target_err"] = (("tuning", "estimator"), err, {"units": "BPM"})
     return ds
 
 

@@ -224,7 +224,7 @@ class EstimationStudy:
         return getattr(self, _check_mode(mode))
 
 
-Study = TimeSeriesStudy | SweepStudy | ZStudy | EstimationStudy
+Study = TimeSeriesStudy | SweepStudy | ZStudy | EstimationStudy  # and SigmaMapStudy, ClaimsMapStudy
 
 
 def _check_mode(mode: str) -> str:
@@ -322,8 +322,15 @@ ESTIMATION = EstimationStudy(
     full=EstimationGrid(c_phi_scan=tuple(np.geomspace(1e-6, 10.0, 43))),
 )
 
+# The σ map and the claims map are declared in their own modules, which build on the
+# types and studies above (hence the import here, after them).
+from .readings import CLAIMS_MAP  # noqa: E402
+from .sigma_map import SIGMA_MAP  # noqa: E402
+
 #: Every study `metrosync reproduce` runs, in report order.
-STUDIES: tuple[Study, ...] = (FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY, ESTIMATION)
+STUDIES: tuple[Study, ...] = (
+    FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY, ESTIMATION, SIGMA_MAP, CLAIMS_MAP,
+)  # fmt: skip
 
 
 def get_studies(names: Sequence[str] | None = None) -> tuple[Study, ...]:
@@ -347,11 +354,13 @@ def reduced(study: Study, **statistics) -> Study:
 
 
 __all__ = [
+    "CLAIMS_MAP",
     "ESTIMATION",
     "FIG8_BOTTOM",
     "FIG8_TOP",
     "FIG10",
     "FIG11",
+    "SIGMA_MAP",
     "STUDIES",
     "TABLE1_SIGMA",
     "TABLE2_SIGMA",
