@@ -254,7 +254,7 @@ CLAIMS_MAP = ClaimsMapStudy(
     name="claims_map",
     figure="claims map",
     title="Which reading of the paper's parameters reproduces which claim",
-    readings=tuple(r for r in READINGS if r.tuning == "small-amplitude"),  # until wired
+    readings=READINGS,
     quick=ClaimsMapGrid(screen=SCREEN, one_axis=True),
     full=ClaimsMapGrid(screen=SCREEN, best=BEST, top=2),
 )

@@ -189,6 +189,8 @@ def run_study(
 
         dataset, specs, computed = run_claims_map(study, mode, compute)
         return _summarise(study, mode, out, dataset, started, specs, computed, computed.loaded)
+    if isinstance(study, SigmaMapStudy):
+        sigma_map.check(study, mode)
     specs = points_of(study, mode)
     computed = compute_points(
         study.name, specs, out, label=lambda spec: point_label(study, spec), progress=progress,

@@ -31,7 +31,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import ParameterError, describe
 from ..groups import as_groups, describe_groups, shifted
-from ..model import MetronomeDesign, Platform, get_preset
+from ..model import TUNINGS, MetronomeDesign, Platform, get_preset
 from .points import PointSpec, canonical_json, make_point
 
 #: Ensemble settings of `simulate`, with their type and default in a sweep.
@@ -56,6 +56,8 @@ MODEL_PARAMETERS = tuple(
         if name != "l2_bounds"
     )
 )
+#: Model parameters that take a name rather than a number, and their choices.
+CHOICES = {"tuning": TUNINGS}
 #: Other names people use for the same parameter.
 ALIASES = {
     "N": "n",
@@ -111,8 +113,14 @@ def _kind(name: str) -> type:
     return ENSEMBLE_SETTINGS[name][0] if name in ENSEMBLE_SETTINGS else float
 
 
-def _convert(name: str, value: Any) -> int | float:
+def _convert(name: str, value: Any) -> int | float | str:
     """One checked value of parameter ``name``."""
+    if name in CHOICES:
+        if not isinstance(value, str) or value.strip() not in CHOICES[name]:
+            raise ParameterError(
+                f"`{name}` takes one of {list(CHOICES[name])}, got {describe(value)}."
+            )
+        return value.strip()
     if isinstance(value, bool) or not isinstance(
         value, int | float | np.integer | np.floating | str
     ):

@@ -55,6 +55,7 @@ LONG_NAMES = {
     "radius": "disk radius",
     "g": "gravitational acceleration",
     "group_offset_bpm": "BPM added to every group after the first",
+    "tuning": "how a nominal BPM becomes a slider position",
 }
 
 
