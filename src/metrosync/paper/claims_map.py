@@ -15,7 +15,8 @@ r says; and claim 4's sweep is not simulated for a reading whose energy-balance
 swing already exceeds π/2 (every run overturns; claims 1–3 measure it).
 
 Returns ``(dataset, specs, computed)``; the dataset holds, over ``reading`` × ``claim``
-× ``level`` (``screen``, ``best``): ``verdict``, ``numbers`` (text) and ``score``, plus
+× ``level`` (``screen``, ``best``): ``verdict``, ``numbers`` (text), ``failed`` (the parts
+of the claim found missing, joined by `` | ``) and ``score``, plus
 the reading's axes as coordinates, its ``total`` score per level and ``rank``.
 """
 
@@ -106,6 +107,33 @@ def _judge(reading, claim, study, specs, loaded) -> Verdict:
                    {**verdict.values, "overturned": turned})  # fmt: skip
 
 
+def failed_checks(verdict: Verdict) -> list[str]:
+    """The parts of a claim that its verdict finds missing, in words."""
+    v, values = verdict.verdict, verdict.values
+    if v == "reproduced":
+        return []
+    if values.get("overturned", 0.0) > OVERTURNED_LIMIT or verdict.numbers.startswith(
+        "not simulated"
+    ):
+        return ["runs that stay below the horizontal (they overturn)"]
+    if verdict.claim == 1:
+        return ["every run of every N synchronizing completely"]
+    if verdict.claim == 2:
+        return ["a significant rise of r with ω₀ at N = 7"]
+    if verdict.claim == 3:
+        return ["a significant fall of r with N from 2 to 7"]
+    if verdict.claim == 4:
+        return [name for name, ok in values.get("checks", {}).items() if not ok]
+    if verdict.claim == 5:
+        parts = {
+            "no locking without friction and drive": values.get("free_intermediate", 0) >= 0.5,
+            "both in- and anti-phase locking with the small drive": values.get("small_both"),
+            "only in-phase locking with the large drive": values.get("large_only_in_phase"),
+        }
+        return [name for name, ok in parts.items() if not ok]
+    return [v]
+
+
 def _position_gap(verdict: Verdict) -> float:
     """|σ_r peak − 185 BPM| at the largest N of a claim-4 verdict (inf when absent)."""
     feats = verdict.values.get("features")
@@ -156,17 +184,24 @@ def _dataset(study: ClaimsMapStudy, mode: str, verdicts: dict, order) -> xr.Data
     shape = (len(readings), len(CLAIMS), len(LEVELS))
     verdict = np.full(shape, "", dtype=object)
     numbers = np.full(shape, "", dtype=object)
+    failed = np.full(shape, "", dtype=object)
     score = np.full(shape, np.nan)
     for k, level in enumerate(LEVELS):
         for (reading, claim), v in verdicts.get(level, {}).items():
             i, j = readings.index(reading), CLAIMS.index(claim)
             verdict[i, j, k], numbers[i, j, k] = v.verdict, v.numbers
+            failed[i, j, k] = " | ".join(failed_checks(v))
             score[i, j, k] = SCORES.get(v.verdict, 0.0)
     dims = ("reading", "claim", "level")
     ds = xr.Dataset(
         {
             "verdict": (dims, verdict.astype(str), {"long_name": "verdict ('' = not run)"}),
             "numbers": (dims, numbers.astype(str), {"long_name": "what was measured"}),
+            "failed": (
+                dims,
+                failed.astype(str),
+                {"long_name": "parts of the claim missing, ' | '"},
+            ),
             "score": (dims, score, {"long_name": "1 reproduced, 0.5 partly, 0 otherwise"}),
         },
         coords={

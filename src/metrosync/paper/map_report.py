@@ -202,18 +202,32 @@ def conclusion(datasets: dict[str, xr.Dataset]) -> list[str]:
             int(c) for c in cmap.claim.values if not (judged.sel(claim=c) == "reproduced").any()
         ]
         for c in nobody:
-            s.append(
-                f"No reading reproduces claim {c} in full ({CLAIM_TEXT[c]}): "
-                + _why_not(cmap, judged, c)
-            )
+            s += [
+                "",
+                f"No reading reproduces claim {c} in full ({CLAIM_TEXT[c].rstrip('.')}): "
+                + _why_not(cmap, judged, c),
+            ]
     if smap is not None:
-        s.append(sigma_sentence(smap))
+        s += ["", sigma_sentence(smap)]
     return s + [""]
 
 
 def _why_not(ds, judged, claim: int) -> str:
+    """What every reading misses of ``claim``, and how many reproduce it partly."""
+    best = ds.failed.sel(level="best")
+    failed = xr.where(ds.verdict.sel(level="best") != "", best, ds.failed.sel(level="screen"))
+    sets = [set(filter(None, str(f).split(" | "))) for f in failed.sel(claim=claim).values]
+    # Overturning readings miss everything; what the others miss in common is the finding.
+    sets = [x for x in sets if not any("overturn" in part for part in x)] or sets
+    common = set.intersection(*sets) if sets else set()
     partly = int((judged.sel(claim=claim) == "partly reproduced").sum())
-    return f"{partly} of {ds.sizes['reading']} readings reproduce it partly."
+    missing = (
+        "what no reading whose pendulums stay below the horizontal shows is: "
+        + _list(sorted(common))
+        if common
+        else "each reading misses a different part of it"
+    )
+    return f"{missing}; {partly} of {ds.sizes['reading']} readings reproduce it partly."
 
 
 def sigma_sentence(ds: xr.Dataset) -> str:
@@ -229,6 +243,41 @@ def sigma_sentence(ds: xr.Dataset) -> str:
         "transition sits is set by the spread of the metronomes' frequencies, which the paper "
         "prints in a unit that admits two readings, and by what a nominal BPM means."
     )
+
+
+def tuning_bullet(datasets: dict[str, xr.Dataset]) -> str:
+    """The discrepancy bullet on the tuning: what each study used and what the other gives."""
+    used = {name: str(ds.attrs["tuning"]) for name, ds in datasets.items() if "tuning" in ds.attrs}
+    kinds = sorted(set(used.values())) or ["small-amplitude"]
+    s = (
+        "- **Tuning.** A metronome's marking is its tick rate; the model's default tuning puts "
+        "the *small-amplitude* frequency on the nominal BPM, so a metronome marked 192 BPM "
+        "ticks at about 184.7 BPM at its 0.76 rad swing (docs/model.md §6.3). The studies "
+        f"above ({', '.join(f'`{n}`' for n in used) or 'all'}) used the {' and '.join(kinds)} "
+        "tuning; `--set tuning=steady-swing` makes a metronome tick at its marking."
+    )
+    smap, cmap = datasets.get("sigma_map"), datasets.get("claims_map")
+    if smap is not None and len(smap.tuning) > 1 and 0.75 in smap.sigma.values:
+        x = smap.sel(sigma=0.75)
+        onsets = []
+        for t in smap.tuning.values:
+            one = x.sel(tuning=t)
+            onsets.append(f"{_pm(float(one.omega_inf_rise), float(one.omega_inf_rise_err))} BPM "
+                          f"with the {t} tuning")  # fmt: skip
+        s += " At σ = 0.75 BPM the onset ω_c(∞) (steepest rise) is " + "; ".join(onsets)
+        s += " (the σ map)."
+    if cmap is not None:
+        rows = [r for r in cmap.reading.values if str(r).startswith("σ-beat/")
+                and str(r).endswith("/M/10/J-law")]  # fmt: skip
+        judged = _judged(cmap)
+        s += " Claims 1–5 with today's other readings (σ per beat, M/10, J by the law): "
+        s += "; ".join(
+            f"{r.split('/')[1]}: "
+            + " ".join(f"{c}{VERDICT_MARKS.get(str(judged.sel(reading=r, claim=c).item()), '?')}"
+                       for c in cmap.claim.values)
+            for r in rows
+        ) + " (the claims map)."  # fmt: skip
+    return s
 
 
 def _list(items) -> str:

@@ -20,7 +20,7 @@ from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
-from .map_report import claims_map_section, conclusion, sigma_map_section
+from .map_report import claims_map_section, conclusion, sigma_map_section, tuning_bullet
 from .studies import (
     ESTIMATION,
     FIG10_SIGMA,
@@ -169,6 +169,7 @@ def _discrepancies(rep) -> list[str]:
         "scale J/c_φ within the measuring window, which a linear detrend leaves as an apparent "
         f"amplitude. At the published c_φ, J(7)/c_φ ≈ {tau:.1e} s: over a {run:g} s run "
         f"the disk's drift slows by about {run / tau:.1%}, and its swing not measurably.",
+        tuning_bullet(rep.datasets),
         "- **z-study frequency.** The paper does not say at which ω₀ the two metronomes "
         "swing; we use 192 BPM, its main experimental frequency. A fourth regime "
         "(M = 1×10⁻⁴, ours) probes a large drive that does not overturn.",
