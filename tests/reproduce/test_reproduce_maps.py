@@ -180,7 +180,8 @@ def test_quick_maps_produce_their_tables_and_the_report_ends_with_a_conclusion(t
     section = text[text.index("## The σ map") : text.index("## The claims map")]
     for sigma in smap.sigma.values:
         assert f"| small-amplitude | {sigma:g} |" in section
-    assert "σ* from the rise" in section and "Agreement of theory and simulation" in section
+    assert "σ* from ω_c(∞), peak" in section and "Agreement of theory and simulation" in section
+    assert set(smap.estimator.values) == {"peak", "rise", "rise, largest N", "theory"}
     assert np.isfinite(smap.theory_omega_c).all()
     assert {"omega_c_rise", "omega_inf_peak", "sigma_at_target"} <= set(smap.data_vars)
     cmap = tiny.datasets["claims_map"]

@@ -57,9 +57,9 @@ def sigma_map_section(ds: xr.Dataset) -> list[str]:
         "model (`metrosync theory`): K(ω₀) and α(ω₀) measured on the full model, and the onset "
         "where K reaches the exact threshold K_c(α, σ_ω) for N → ∞ (its range: K ± its error).",
         "",
-        "| tuning | σ (BPM) | ω_c(∞), peak | ω_c(∞), rise | theory: threshold | "
-        "theory: r = 1/2 | rise − threshold |",
-        "|---|---|---|---|---|---|---|",
+        f"| tuning | σ (BPM) | ω_c(∞), peak | ω_c(∞), rise | rise at N = {int(ds.n[-1])} "
+        "| theory: threshold | theory: r = 1/2 | rise − threshold |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for tuning in ds.tuning.values:
         for sigma in ds.sigma.values:
@@ -67,26 +67,51 @@ def sigma_map_section(ds: xr.Dataset) -> list[str]:
             th, lo, hi = (float(x[k]) for k in ("theory_omega_c", "theory_omega_c_low",
                                                  "theory_omega_c_high"))  # fmt: skip
             gap, se = _gap(x)
-            peak = _pm(float(x.omega_inf_peak), float(x.omega_inf_peak_err))
+            peak, rise = (
+                _pm(float(x[f"omega_inf_{m}"]), float(x[f"omega_inf_{m}_err"]))
+                + (" †" if str(x[f"fit_note_{m}"].item()) else "")
+                for m in ("peak", "rise")
+            )
+            largest = _pm(float(x.omega_c_rise.isel(n=-1)), float(x.omega_c_rise_err.isel(n=-1)))
             s.append(
-                f"| {tuning} | {sigma:g} | {peak} "
-                f"| {_pm(float(x.omega_inf_rise), float(x.omega_inf_rise_err))} "
+                f"| {tuning} | {sigma:g} | {peak} | {rise} | {largest} "
                 f"| {th:.1f} [{lo:.1f}, {hi:.1f}] | {_num(float(x.theory_omega_half))} "
                 f"| {gap:+.1f} ({gap / se:+.1f} SE) |"
             )
-    s += ["", f"Where ω_c(∞) reaches the paper's {target:g} BPM:", ""]
-    s += ["| tuning | σ* from the peak | σ* from the rise | σ* from the theory | reading of "
-          "Tables 1–2 (rise) |", "|---|---|---|---|---|"]  # fmt: skip
+    notes = [
+        f"{t}, σ = {sg:g}, {m}: {note}"
+        for t in ds.tuning.values
+        for sg in ds.sigma.values
+        for m in ("peak", "rise")
+        if (note := str(ds[f"fit_note_{m}"].sel(tuning=t, sigma=sg).item()))
+    ]
+    if notes:
+        s += ["", "† `metrosync.sweeps.critical` does not trust this extrapolation (left out "
+              "of σ* below): " + "; ".join(notes) + "."]  # fmt: skip
+    s += ["", f"Where ω_c reaches the paper's {target:g} BPM:", ""]
+    s += [f"| tuning | σ* from ω_c(∞), peak | from ω_c(∞), rise | from the rise at N = "
+          f"{int(ds.n[-1])} | from the theory | reading of Tables 1–2 |",
+          "|---|---|---|---|---|---|"]  # fmt: skip
     for tuning in ds.tuning.values:
         x = ds.sel(tuning=tuning)
         cells = [_pm(float(x.sigma_at_target.sel(estimator=m)),
                      float(x.sigma_at_target_err.sel(estimator=m)), 2)
-                 for m in ("peak", "rise", "theory")]  # fmt: skip
-        rise = float(x.sigma_at_target.sel(estimator="rise"))
-        rise_err = float(x.sigma_at_target_err.sel(estimator="rise"))
-        s.append(f"| {tuning} | " + " | ".join(cells) + f" | {which_reading(rise, rise_err)} |")
+                 for m in ("peak", "rise", "rise, largest N", "theory")]  # fmt: skip
+        value, err, source = headline_sigma(x)
+        s.append(f"| {tuning} | " + " | ".join(cells)
+                 + f" | {which_reading(value, err)} ({source}) |")  # fmt: skip
     s += ["", agreement(ds), ""]
     return s
+
+
+def headline_sigma(x: xr.Dataset) -> tuple[float, float, str]:
+    """σ* of one tuning from the steepest rise: extrapolated to N → ∞ where `critical`
+    trusts the fit, else at the largest N. Returns (σ*, error, which)."""
+    for estimator, text in (("rise", "ω_c(∞)"), ("rise, largest N", f"N = {int(x.n[-1])}")):
+        value = float(x.sigma_at_target.sel(estimator=estimator))
+        if math.isfinite(value):
+            return value, float(x.sigma_at_target_err.sel(estimator=estimator)), text
+    return math.nan, math.nan, "no estimate"
 
 
 def _gap(x: xr.Dataset) -> tuple[float, float]:
@@ -209,6 +234,8 @@ def conclusion(datasets: dict[str, xr.Dataset]) -> list[str]:
             ]
     if smap is not None:
         s += ["", sigma_sentence(smap)]
+    while len(s) > 2 and s[2] == "":  # one blank line under the heading
+        del s[2]
     return s + [""]
 
 
@@ -234,10 +261,9 @@ def sigma_sentence(ds: xr.Dataset) -> str:
     target = ds.attrs.get("target_bpm", 185.0)
     parts = []
     for tuning in ds.tuning.values:
-        x = ds.sel(tuning=tuning, estimator="rise")
-        value, err = float(x.sigma_at_target), float(x.sigma_at_target_err)
+        value, err, source = headline_sigma(ds.sel(tuning=tuning))
         parts.append(f"σ = {_pm(value, err, 2)} BPM with the {tuning} tuning "
-                     f"({which_reading(value, err)})")  # fmt: skip
+                     f"(steepest rise, {source}: {which_reading(value, err)})")  # fmt: skip
     return (
         f"The paper's onset at {target:g} BPM needs " + "; ".join(parts) + ". Where the "
         "transition sits is set by the spread of the metronomes' frequencies, which the paper "

@@ -15,8 +15,12 @@ and the reduced theory's prediction (`metrosync.theory.reduced_theory`) beside i
 
     omega_c_{peak,rise}(_err)          (tuning, sigma, n)
     omega_inf_{peak,rise}(_err)        (tuning, sigma)
+    fit_note_{peak,rise}               (tuning, sigma)     why `critical` distrusts a fit
     theory_omega_c(_low, _high)        (tuning, sigma)     linear threshold, N → ∞
-    sigma_at_target(_err)              (tuning, estimator) peak, rise, theory
+    sigma_at_target(_err)              (tuning, estimator) from ω_c(∞) by the peak and
+                                                           the rise (trusted fits only),
+                                                           the rise at the largest N,
+                                                           and the theory
 
 Windows are declared per tuning and σ (``centres``), focused where the onset lies:
 the N → ∞ onset moves by about 45 BPM per BPM of σ, and a window of ±12.5 BPM holds
@@ -208,7 +212,7 @@ def analyse(study: SigmaMapStudy, mode: str, ds: xr.Dataset, theory_cache: Path)
     """Add ω_c(N), ω_c(∞), the theory's ω_c and σ* to an assembled σ map."""
     ds = _critical(ds)
     ds = _theory(study, mode, ds, theory_cache)
-    methods = [*METHODS, "theory"]
+    methods = [*METHODS, "rise, largest N", "theory"]
     at = np.full((ds.sizes["tuning"], len(methods)), np.nan)
     err = np.full_like(at, np.nan)
     sigmas = ds.sigma.values
@@ -217,8 +221,13 @@ def analyse(study: SigmaMapStudy, mode: str, ds: xr.Dataset, theory_cache: Path)
             if m == "theory":
                 row = ds.theory_omega_c.isel(tuning=i).values
                 half = 0.5 * (ds.theory_omega_c_high - ds.theory_omega_c_low).isel(tuning=i).values
+            elif m == "rise, largest N":
+                row = ds.omega_c_rise.isel(tuning=i, n=-1).values
+                half = ds.omega_c_rise_err.isel(tuning=i, n=-1).values
             else:
-                row = ds[f"omega_inf_{m}"].isel(tuning=i).values
+                # An extrapolation `critical` does not trust says nothing about σ*.
+                trusted = ds[f"fit_note_{m}"].isel(tuning=i).values == ""
+                row = np.where(trusted, ds[f"omega_inf_{m}"].isel(tuning=i).values, np.nan)
                 half = ds[f"omega_inf_{m}_err"].isel(tuning=i).values
             at[i, j], err[i, j] = sigma_at(sigmas, row, half, study.target, seed=i * 7 + j)
     ds = ds.assign_coords(estimator=methods)
@@ -236,6 +245,7 @@ def _critical(ds: xr.Dataset) -> xr.Dataset:
     per_n = {f"omega_c_{m}{e}": np.full((*shape, ds.sizes["n"]), np.nan)
              for m in METHODS for e in ("", "_err")}  # fmt: skip
     inf = {f"omega_inf_{m}{e}": np.full(shape, np.nan) for m in METHODS for e in ("", "_err")}
+    notes = {m: np.full(shape, "", dtype=object) for m in METHODS}
     r_mean = np.full((*shape, ds.sizes["n"], ds.sizes["bpm"]), np.nan)
     sigma_r = np.full_like(r_mean, np.nan)
     forms = {}
@@ -249,6 +259,7 @@ def _critical(ds: xr.Dataset) -> xr.Dataset:
                     per_n[f"omega_c_{m}{e}"][i, j] = crit[f"omega_c_{m}{e}"].values
                     inf[f"omega_inf_{m}{e}"][i, j] = crit.attrs[f"omega_c_inf_{m}{e}"]
                 forms[m] = crit.attrs[f"fit_form_{m}"]
+                notes[m][i, j] = crit.attrs.get(f"fit_note_{m}", "")
             r_mean[i, j][:, mask] = crit.r_mean.values
             sigma_r[i, j][:, mask] = crit.sigma_r.values
     bpm = {"units": "BPM"}
@@ -256,6 +267,9 @@ def _critical(ds: xr.Dataset) -> xr.Dataset:
         ds[name] = (("tuning", "sigma", "n"), values, bpm)
     for name, values in inf.items():
         ds[name] = (("tuning", "sigma"), values, {**bpm, "long_name": "ω_c extrapolated to N → ∞"})
+    untrusted = {"long_name": "why the N → ∞ fit is not trusted ('' = trusted)"}
+    for m, values in notes.items():
+        ds[f"fit_note_{m}"] = (("tuning", "sigma"), values.astype(str), untrusted)
     ds["r_mean"] = (("tuning", "sigma", "n", "bpm"), r_mean, {"long_name": "mean r_eq"})
     ds["sigma_r"] = (("tuning", "sigma", "n", "bpm"), sigma_r, {"long_name": "σ_r"})
     ds.attrs.update({f"fit_form_{m}": f for m, f in forms.items()}, n_boot=N_BOOT)
@@ -326,15 +340,16 @@ SIGMA_MAP = SigmaMapStudy(
         ("small-amplitude", (160.0, 172.5, 185.0, 192.5, 200.0)),
         ("steady-swing", (155.0, 167.5, 180.0, 187.5, 195.0)),
     ),
-    quick=SigmaMapGrid(ns=(16, 32, 64), half_width=10.0, step=5.0, stats=Statistics(8, 300.0)),
+    # A window of at least 7 points: the steepest rise is a 5-point local fit.
+    quick=SigmaMapGrid(ns=(16, 32, 64), half_width=15.0, step=5.0, stats=Statistics(8, 300.0)),
     # 750 s: at N = 256 near the onset the mean r_eq over the last quarter is within 0.03
-    # of its value at 1000 or 1500 s (measured, 20 runs); 12 runs place the steepest
-    # rise within about 1 BPM at N = 256.
+    # of its value at 1000 or 1500 s (measured, 20 runs); 10 runs place the steepest
+    # rise within about 1-2 BPM at N = 256.
     full=SigmaMapGrid(
         ns=(64, 128, 256),
-        half_width=10.0,
+        half_width=12.5,
         step=2.5,
-        stats=Statistics(12, 750.0),
+        stats=Statistics(10, 750.0),
         theory_simulate=True,
     ),  # fmt: skip
 )
