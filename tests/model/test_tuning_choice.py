@@ -89,3 +89,20 @@ def test_presets_show_the_tuning_and_what_192_bpm_ticks_at(capsys):
     text = capsys.readouterr().out
     assert "tuning           small-amplitude" in text
     assert "184.7 BPM (small-amplitude), 192.0 BPM (steady-swing)" in text
+
+
+def test_the_model_page_quotes_the_steady_swing_numbers():
+    from dataclasses import replace
+    from pathlib import Path
+
+    from metrosync.theory import steady_swing
+
+    text = " ".join((Path(__file__).parents[2] / "docs" / "model.md").read_text().split())
+    design = get_preset("default").metronome
+    steady = replace(design, tuning="steady-swing")
+    low, high = steady.bpm_range()
+    assert f"its tunable range is {low:.1f}–{high:.1f} BPM" in text
+    ticks = [steady_swing(d.with_l2(d.l2_for_bpm(192.0))).tick_bpm for d in (steady, design)]
+    assert f"ticks at {ticks[0]:.1f} instead of {ticks[1]:.1f} per minute" in text
+    l2 = [d.l2_for_bpm(192.0) for d in (steady, design)]
+    assert f"slider sits at {l2[0]:.4f} m instead of {l2[1]:.4f} m" in text
