@@ -10,8 +10,7 @@ from metrosync.lightgate import parse_log
 from metrosync.lightgate.messages import Gap, LoggerHeader, Overflow, format_gap, parse_message
 
 HEADER = (
-    "# metrosync gate-logger 1.0 channels=3 tick_us=64 counter_bits=32 baud=115200 "
-    "holdoff_ticks=4"
+    "# metrosync gate-logger 1.0 channels=3 tick_us=64 counter_bits=32 baud=115200 holdoff_ticks=4"
 )
 BODY = "0-0-0 0\n1-0-0 10\n0-0-0 20\n0-1-0 800\n0-0-0 810\n"
 

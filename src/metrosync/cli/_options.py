@@ -207,12 +207,21 @@ def ensemble_defaults(args) -> tuple[float, int, dict[str, str]]:
 PAIR_PARAMETERS = ("l2_bounds",)
 
 
-def parse_changes(items: list[str]) -> dict[str, float | tuple[float, ...]]:
+def parse_changes(items: list[str]) -> dict[str, float | tuple[float, ...] | str]:
     """``--set NAME=VALUE`` items as a dict of numbers; ``A,B`` gives a pair
-    (``--set l2_bounds=0,0.12``)."""
-    changes: dict[str, float | tuple[float, ...]] = {}
+    (``--set l2_bounds=0,0.12``) and ``tuning`` takes a name."""
+    from ..model import TUNINGS
+
+    changes: dict[str, float | tuple[float, ...] | str] = {}
     for item in items:
         name, sep, value = item.partition("=")
+        if name.strip() == "tuning" and sep:
+            if value.strip() not in TUNINGS:
+                raise ParameterError(
+                    f"`--set tuning` takes one of {list(TUNINGS)}, got {value.strip()!r}."
+                )
+            changes["tuning"] = value.strip()
+            continue
         try:
             parts = [float(part) for part in value.split(",")]
         except ValueError:

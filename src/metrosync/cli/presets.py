@@ -32,5 +32,28 @@ def run(args) -> int:
         low, high = params.metronome.bpm_range()
         print(f"    {'steady amp.':{width}s} {params.steady_amplitude:.3f} rad"
               + ("  (OVERTURNS: > pi/2)" if params.overturns else ""))  # fmt: skip
-        print(f"    {'tunable BPM':{width}s} {low:.1f} .. {high:.1f}")
+        print(f"    {'tunable BPM':{width}s} {low:.1f} .. {high:.1f} ({params.metronome.tuning})")
+        print(f"    {'tick at 192':{width}s} {_tick_at(params.metronome, 192.0)}")
+    print(
+        "tuning: 'small-amplitude' puts the small-swing frequency on the nominal BPM, "
+        "'steady-swing' the tick rate at the steady swing (--set tuning=steady-swing)."
+    )
     return 0
+
+
+def _tick_at(design, bpm: float) -> str:
+    """What a metronome marked ``bpm`` ticks at under each tuning (rigid support)."""
+    from dataclasses import replace
+
+    from ..errors import ParameterError
+    from ..theory.tuning import steady_swing
+
+    rows = []
+    for tuning in ("small-amplitude", "steady-swing"):
+        try:
+            one = replace(design, tuning=tuning)
+            tick = steady_swing(one.with_l2(one.l2_for_bpm(bpm))).tick_bpm
+            rows.append(f"{tick:.1f} BPM ({tuning})")
+        except ParameterError:
+            rows.append(f"no steady swing ({tuning})")
+    return ", ".join(rows)

@@ -24,13 +24,21 @@ def register(subparsers) -> None:
     parser.add_argument("--baud", type=int, default=115200, help="serial rate (the firmware's)")
     parser.add_argument("--duration", type=float, default=None, metavar="S",
                         help="stop after S seconds (default: at Ctrl-C)")  # fmt: skip
-    parser.add_argument("--channels", type=int_list, default=None, metavar="I,J,...",
-                        help="gates to show and use for the live r, 0-based (default: all)")
+    parser.add_argument(
+        "--channels",
+        type=int_list,
+        default=None,
+        metavar="I,J,...",
+        help="gates to show and use for the live r, 0-based (default: all)",
+    )
     parser.add_argument("--reconnect", action="store_true",
                         help="when the port vanishes, wait for it and mark the gap")  # fmt: skip
     parser.add_argument("--overwrite", action="store_true", help="replace an existing --out")
-    parser.add_argument("--plain", action="store_true",
-                        help="plain status lines instead of the panel, even on a terminal")
+    parser.add_argument(
+        "--plain",
+        action="store_true",
+        help="plain status lines instead of the panel, even on a terminal",
+    )
     add_aliases(parser, duration="--duration", baud="--baud", port="PORT")
     parser.set_defaults(func=run)
 

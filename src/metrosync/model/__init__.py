@@ -1,6 +1,7 @@
 """Model parameters: metronomes, the platform, and named presets."""
 
 from .metronome import (
+    TUNINGS,
     Metronome,
     MetronomeDesign,
     bpm_to_omega,
@@ -17,6 +18,7 @@ from .system import SystemArrays, system_arrays
 
 __all__ = [
     "PRESETS",
+    "TUNINGS",
     "Metronome",
     "MetronomeDesign",
     "ModelParameters",

@@ -15,10 +15,16 @@ These quantities are computed in one place, by array functions (`centre_of_mass`
 ensemble. `MetronomeDesign.check_tunable` is the one check (and message) that a BPM
 lies in the range the slider can reach.
 
-Tuning (docs/model.md §6.1–6.2): one beat is half a period, so ω = π·BPM/60, and ``L2`` for
-a nominal BPM inverts the model's own small-amplitude frequency on a rigid support,
-ω² = m g h / (m h² + J_i). That relation is quadratic in ``L2``, so it is solved in
-closed form.
+Tuning (docs/model.md §6.1–6.3): one beat is half a period, so
+ω = π·BPM/60. A design's ``tuning`` says how a nominal BPM becomes a slider position:
+
+``"small-amplitude"`` (the default) inverts the model's own small-amplitude frequency on
+    a rigid support, ω² = m g h / (m h² + J_i), a quadratic in ``L2`` solved in closed
+    form; a metronome tuned to "192 BPM" then ticks about 184.7 times a minute at its
+    steady swing of 0.76 rad.
+``"steady-swing"`` puts the *tick rate at the steady swing* on the nominal BPM, as a real
+    metronome's marking does (`metrosync.theory.tuning`, solved once per design and
+    cached); it needs friction and a drive that does not overturn.
 """
 
 from __future__ import annotations
@@ -31,6 +37,8 @@ import numpy as np
 from ..errors import ParameterError, describe, require_finite, require_positive
 
 STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
+#: How a nominal BPM becomes a slider position (see the module docstring).
+TUNINGS = ("small-amplitude", "steady-swing")
 
 
 def bpm_to_omega(bpm):
@@ -85,6 +93,7 @@ class MetronomeDesign:
         (paper: 0, the vertical). A metronome "out of beat" has δ ≠ 0: it is kicked
         where θ crosses δ, so tick and tock alternate short and long. Must lie in
         (−π/2, π/2); real metronomes are often a few per cent of the swing out.
+    tuning : how a nominal BPM becomes ``L2``, one of `TUNINGS` (module docstring).
     """
 
     w1: float = 0.025
@@ -95,8 +104,13 @@ class MetronomeDesign:
     l2_bounds: tuple[float, float] = (0.0, 0.1)
     g: float = STANDARD_GRAVITY
     escapement_offset: float = 0.0
+    tuning: str = "small-amplitude"
 
     def __post_init__(self) -> None:
+        if self.tuning not in TUNINGS:
+            raise ParameterError(
+                f"unknown `tuning` {self.tuning!r}; choose one of {list(TUNINGS)}."
+            )
         require_positive("w1", self.w1, unit="kg")
         require_positive("w2", self.w2, allow_zero=True, unit="kg")
         require_positive("l1", self.l1, unit="m")
@@ -131,7 +145,15 @@ class MetronomeDesign:
         return Metronome(design=self, l2=l2)
 
     def bpm_range(self) -> tuple[float, float]:
-        """Lowest and highest nominal BPM the slider can tune to."""
+        """Lowest and highest nominal BPM the slider can tune to, under `tuning`."""
+        if self.tuning == "steady-swing":
+            from ..theory.tuning import steady_swing_bpm_range  # needs scipy; loaded on use
+
+            return steady_swing_bpm_range(self)
+        return self.small_amplitude_range()
+
+    def small_amplitude_range(self) -> tuple[float, float]:
+        """Lowest and highest small-amplitude frequency (BPM) the slider reaches."""
         lo, hi = self.l2_bounds
         return (float(self.with_l2(hi).natural_bpm), float(self.with_l2(lo).natural_bpm))
 
@@ -203,13 +225,33 @@ class MetronomeDesign:
         )
 
     def l2_for_bpm(self, bpm):
-        """Slider position ``L2`` (m) that tunes the metronome to ``bpm``.
+        """Slider position ``L2`` (m) that tunes the metronome to ``bpm`` under `tuning`.
 
-        Solves ω²(m h² + J_i) = m g h, a quadratic in ``L2``, in closed form.
         Accepts scalars or arrays; raises `ParameterError` for BPM outside `bpm_range`.
         """
         self.check_tunable(bpm)
+        if self.tuning == "steady-swing":
+            from ..theory.tuning import steady_swing_l2
+
+            return steady_swing_l2(self, bpm)
+        return self.small_amplitude_l2(bpm)
+
+    def small_amplitude_l2(self, bpm):
+        """``L2`` (m) whose small-amplitude frequency is ``bpm``, whatever `tuning` says.
+
+        Solves ω²(m h² + J_i) = m g h, a quadratic in ``L2``, in closed form.
+        """
         bpm_arr = np.asarray(bpm, dtype=float)
+        if not np.all(np.isfinite(bpm_arr)):
+            raise ParameterError(f"`bpm` must be finite, got {describe(bpm)}.")
+        low, high = self.small_amplitude_range()
+        bad = (bpm_arr < low) | (bpm_arr > high)
+        if np.any(bad):
+            raise ParameterError(
+                f"`bpm` = {float(bpm_arr[bad].flat[0]):.6g} is outside the small-amplitude "
+                f"range [{low:.2f}, {high:.2f}] BPM of this metronome design (slider L2 in "
+                f"{self.l2_bounds} m)."
+            )
         w1, w2, l1, g = self.w1, self.w2, self.l1, self.g
         m = w1 + w2
         a = w1 * l1

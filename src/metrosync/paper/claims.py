@@ -125,7 +125,7 @@ def claim_identical(ds: xr.Dataset) -> Verdict:
         + (" Runs that do not synchronize completely: " + "; ".join(stuck) + "." if stuck else "")
     )
     values = {
-        "r_eq_min": float(np.nanmin(r_eq)),
+        "r_eq_min": float(np.nanmin(r_eq)) if np.isfinite(r_eq).any() else float("nan"),
         "r_eq_median": np.median(r_eq, axis=1).tolist(),
         "complete_fraction": complete.tolist(),
     }

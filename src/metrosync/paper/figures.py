@@ -240,10 +240,23 @@ def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
     return _save(fig, stem)
 
 
+def _deferred(name: str):
+    """A plotter of `metrosync.paper.map_figures`, which imports this module."""
+
+    def plot(ds: xr.Dataset, stem: Path) -> list[Path]:
+        from . import map_figures
+
+        return getattr(map_figures, name)(ds, stem)
+
+    return plot
+
+
 #: Which function draws each study kind (by the study's class name).
 PLOTTERS = {
     "TimeSeriesStudy": plot_order_in_time,
     "SweepStudy": plot_sweep,
     "ZStudy": plot_z,
     "EstimationStudy": plot_estimation,
+    "SigmaMapStudy": _deferred("plot_sigma_map"),
+    "ClaimsMapStudy": _deferred("plot_claims_map"),
 }

@@ -34,6 +34,7 @@ from .claims import Verdict, all_verdicts
 from .consistency import consistency_table
 from .experiment import compare_experiment, find_experiment, lightgate_analyze
 from .figures import PLOTTERS, plot_comparison
+from .readings import ClaimsMapStudy
 from .report import write_report
 from .runner import StudyResult, points_of, run_study
 from .studies import (
@@ -156,7 +157,7 @@ def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
         verdicts=[],
         consistency=consistency,
         figures=figures,
-        full_work={s.name: sum(p.work for p in points_of(s, "full")) for s in chosen},
+        full_work={s.name: _full_work(s) for s in chosen},
     )
     if experiment is not None:
         sim = rep.datasets.get(FIG8_TOP.name)
@@ -188,6 +189,16 @@ def kept_points(
     """(points of the reproduction already in the store of ``out``, points in all)."""
     specs = plan(mode, studies)
     return PointStore(out).kept(spec.key for spec in specs), len(specs)
+
+
+def _full_work(study: Study) -> float:
+    """Oscillator-steps of ``study`` in ``--full`` (the claims map's second pass included)."""
+    work = float(sum(p.work for p in points_of(study, "full")))
+    if isinstance(study, ClaimsMapStudy):
+        from .claims_map import best_work
+
+        work += best_work(study, "full")
+    return work
 
 
 def _resolve(studies) -> tuple[Study, ...]:

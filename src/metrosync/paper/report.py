@@ -20,6 +20,7 @@ from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
+from .map_report import claims_map_section, conclusion, sigma_map_section, tuning_bullet
 from .studies import (
     ESTIMATION,
     FIG10_SIGMA,
@@ -80,6 +81,11 @@ def write_report(path: Path, rep) -> Path:
         s += [f"### Claim {v.claim}: {v.verdict}", "", f"> {v.text}", "", v.numbers, ""]
     s += _experiment_section(rep, base)
     s += _discrepancies(rep)
+    data = rep.datasets
+    if "sigma_map" in data:
+        s += sigma_map_section(data["sigma_map"]) + _figure_line(rep, "sigma_map", base)
+    if "claims_map" in data:
+        s += claims_map_section(data["claims_map"]) + _figure_line(rep, "claims_map", base)
     s += ["## Parameter consistency", "", markdown_table(rep.consistency), ""]
     s += _timing_section(rep)
     s += ["## Figures", ""]
@@ -90,7 +96,13 @@ def write_report(path: Path, rep) -> Path:
         if pngs:
             s += ["", f"  ![{name}]({_rel(pngs[0], base)})", ""]
     s.append("")
+    s += conclusion(data)
     return write_text("\n".join(s), path)
+
+
+def _figure_line(rep, name: str, base: Path) -> list[str]:
+    pngs = [p for p in rep.figures.get(name, []) if p.suffix == ".png"]
+    return [f"![{name}]({_rel(pngs[0], base)})", ""] if pngs else []
 
 
 def _experiment_section(rep, base: Path) -> list[str]:
@@ -157,6 +169,7 @@ def _discrepancies(rep) -> list[str]:
         "scale J/c_φ within the measuring window, which a linear detrend leaves as an apparent "
         f"amplitude. At the published c_φ, J(7)/c_φ ≈ {tau:.1e} s: over a {run:g} s run "
         f"the disk's drift slows by about {run / tau:.1%}, and its swing not measurably.",
+        tuning_bullet(rep.datasets),
         "- **z-study frequency.** The paper does not say at which ω₀ the two metronomes "
         "swing; we use 192 BPM, its main experimental frequency. A fourth regime "
         "(M = 1×10⁻⁴, ours) probes a large drive that does not overturn.",
@@ -188,8 +201,9 @@ def _timing_section(rep) -> list[str]:
             missing.append(r.study.name)
         runs = ds.sizes.get("run", ds.sizes.get("theta2", 0))
         dur = ds.attrs.get("duration", math.nan)
+        shape = f"{runs} × {dur:g} s" if runs else "several"
         s.append(
-            f"| {r.study.name} | {r.points} | {r.cached_points} | {runs} × {dur:g} s "
+            f"| {r.study.name} | {r.points} | {r.cached_points} | {shape} "
             f"| {r.total_work:.3g} | {r.compute_s:.1f} | {rate:.3g} | {r.wall_s:.1f} "
             f"| {_seconds(est)} |"
         )

@@ -42,8 +42,11 @@ from ..errors import MetrosyncError
 from ..sweeps import PointStore
 from ..sweeps.executors import execute
 from ..sweeps.points import PointSpec, make_point
+from . import sigma_map
 from .assemble import assemble
 from .estimation import run_estimation
+from .readings import ClaimsMapStudy
+from .sigma_map import SigmaMapStudy
 from .studies import EstimationStudy, Study, SweepStudy, TimeSeriesStudy, ZStudy
 
 #: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
@@ -98,9 +101,10 @@ def points_of(study: Study, mode: str) -> list[PointSpec]:
             cells = [(f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, study.sigma_bpm, {"n": n, "bpm": bpm})
                      for n in grid.ns for bpm in grid.bpms]  # fmt: skip
         return [
-            _ensemble_point(study.name, i, key, n, bpm, sigma, stats, study.preset, coords)
+            _ensemble_point(study.name, i, key, n, bpm, sigma, stats, study.preset, coords,
+                            dict(study.changes))
             for i, (key, n, bpm, sigma, coords) in enumerate(cells)
-        ]
+        ]  # fmt: skip
     if isinstance(study, ZStudy):
         grid = study.grid(mode)
         theta2 = np.asarray(grid.theta2, dtype=float)
@@ -126,6 +130,12 @@ def points_of(study: Study, mode: str) -> list[PointSpec]:
                 where = {"regime": r, "start": start}
                 out.append(make_point(kwargs, keep="z", index=(len(out),), coords=where))
         return out
+    if isinstance(study, SigmaMapStudy):
+        return sigma_map.points(study, mode)
+    if isinstance(study, ClaimsMapStudy):
+        from .claims_map import planned_specs
+
+        return planned_specs(study, mode)
     if isinstance(study, EstimationStudy):
         return []
     raise TypeError(f"unknown study type {type(study).__name__}")
@@ -138,6 +148,8 @@ def point_label(study: Study, spec: PointSpec) -> str:
         return study.cases[c["case"]].label
     if isinstance(study, SweepStudy):
         return f"N = {c['n']}, ω₀ = {c['bpm']:g} BPM"
+    if isinstance(study, SigmaMapStudy):
+        return sigma_map.label(spec)
     if isinstance(study, ZStudy):
         runs = spec.kwargs["runs"]
         return f"regime {c['regime']}, θ₂(0) #{c['start']}–{c['start'] + runs - 1}"
@@ -166,48 +178,117 @@ def run_study(
         dataset = run_estimation(study, mode, out / "points" / study.name)
         wall = time.perf_counter() - started
         return _finish(study, mode, out, dataset, started, 0.0, 0.0, [], 0, wall)
-    specs = points_of(study, mode)
-    store = PointStore(out)
-    loaded = {spec.key: ds for spec in specs if (ds := _stored(store, spec)) is not None}
-    todo = [spec for spec in specs if spec.key not in loaded]
-    done_before = len(specs) - len(todo)
+    if isinstance(study, ClaimsMapStudy):
+        from .claims_map import run_claims_map
 
-    finished = done_before
+        def compute(name, specs, label):
+            return compute_points(
+                name, specs, out, label=label, progress=progress, log=log,
+                scheduler=scheduler, n_workers=n_workers, started=started,
+            )  # fmt: skip
+
+        dataset, specs, computed = run_claims_map(study, mode, compute)
+        return _summarise(study, mode, out, dataset, started, specs, computed, computed.loaded)
+    if isinstance(study, SigmaMapStudy):
+        sigma_map.check(study, mode)
+    specs = points_of(study, mode)
+    computed = compute_points(
+        study.name, specs, out, label=lambda spec: point_label(study, spec), progress=progress,
+        log=log, scheduler=scheduler, n_workers=n_workers, started=started,
+    )  # fmt: skip
+    reduced = [computed.loaded[spec.key] for spec in specs]
+    if isinstance(study, SigmaMapStudy):
+        dataset = sigma_map.assemble(study, mode, specs, reduced)
+        dataset = sigma_map.analyse(study, mode, dataset, out / "points" / "theory")
+    else:
+        dataset = assemble(study, mode, [spec.coords for spec in specs], reduced)
+    return _summarise(study, mode, out, dataset, started, specs, computed, computed.loaded)
+
+
+@dataclass
+class Computed:
+    """Points computed or reused by `compute_points`.
+
+    loaded : key -> stored point.   now : keys computed in this call.   work :
+    oscillator-steps computed in this call.   labels : key -> short name of the point.
+    """
+
+    loaded: dict[str, xr.Dataset]
+    now: set[str]
+    work: float
+    labels: dict[str, str]
+
+    def merge(self, other: Computed) -> Computed:
+        return Computed(
+            {**self.loaded, **other.loaded}, self.now | other.now, self.work + other.work,
+            {**self.labels, **other.labels},
+        )  # fmt: skip
+
+
+def compute_points(
+    name: str,
+    specs: list[PointSpec],
+    out: Path,
+    *,
+    label: Callable[[PointSpec], str],
+    progress: bool = False,
+    log: Callable[[str], None] | None = None,
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    started: float | None = None,
+) -> Computed:
+    """Compute the points of ``specs`` not yet in the store of ``out`` and load them all.
+
+    A key listed twice (two readings that share a simulation) is computed once. Raises
+    `StudyIncomplete` when a point fails or is lost with a Dask worker.
+    """
+    started = time.perf_counter() if started is None else started
+    store = PointStore(out)
+    unique = list({spec.key: spec for spec in specs}.values())
+    loaded = {spec.key: ds for spec in unique if (ds := _stored(store, spec)) is not None}
+    todo = [spec for spec in unique if spec.key not in loaded]
+    finished = len(unique) - len(todo)
 
     def tell(_spec: PointSpec) -> None:
         nonlocal finished
         finished += 1
-        if log is not None and len(specs) > 1:
+        if log is not None and len(unique) > 1:
             elapsed = time.perf_counter() - started
-            log(f"  {study.name}: {finished}/{len(specs)} points ({elapsed:.0f} s)")
+            log(f"  {name}: {finished}/{len(unique)} points ({elapsed:.0f} s)")
+
+    def keep(spec: PointSpec, ds: xr.Dataset) -> None:
+        loaded[spec.key] = ds  # as stored: reading the file back would cost as much again
 
     execution = execute(
         todo, store, scheduler=scheduler, n_workers=n_workers, progress=progress,
-        desc=study.name, on_done=tell,
+        desc=name, on_done=tell, on_result=keep,
     )  # fmt: skip
     if execution.failed:
         key, message = next(iter(execution.failed.items()))
-        spec = next(s for s in specs if s.key == key)
+        spec = next(s for s in unique if s.key == key)
         raise StudyIncomplete(
-            f"study {study.name!r}: the simulation of point {point_label(study, spec)!r} "
-            f"failed: {message}"
+            f"study {name!r}: the simulation of point {label(spec)!r} failed: {message}"
         )
     if execution.lost:
         raise StudyIncomplete(
-            f"study {study.name!r}: {len(execution.lost)} of {len(specs)} points were lost "
+            f"study {name!r}: {len(execution.lost)} of {len(unique)} points were lost "
             f"with their Dask workers ({next(iter(execution.lost.values()))}); the others are "
             f"kept in {store.points}: run the same command again to compute the rest."
         )
-    loaded.update({spec.key: store.read(spec.key) for spec in todo})
-    reduced = [loaded[spec.key] for spec in specs]
-    computed_now = {spec.key for spec in todo}
-    cached = [point_label(study, s) for s in specs if s.key not in computed_now]
-    compute = sum(float(ds.attrs.get("compute_seconds", np.nan)) for ds in reduced)
-    total = float(sum(spec.work for spec in specs))
-    dataset = assemble(study, mode, [spec.coords for spec in specs], reduced)
+    return Computed(
+        loaded, {spec.key for spec in todo}, float(execution.work),
+        {spec.key: label(spec) for spec in unique},
+    )  # fmt: skip
+
+
+def _summarise(study, mode, out, dataset, started, specs, computed: Computed, loaded):
+    """Stamp and write a study's dataset with what its points cost (reused or not)."""
+    unique = list({spec.key: spec for spec in specs}.values())
+    cached = [computed.labels[s.key] for s in unique if s.key not in computed.now]
+    compute = sum(float(loaded[s.key].attrs.get("compute_seconds", np.nan)) for s in unique)
+    total = float(sum(spec.work for spec in unique))
     return _finish(
-        study, mode, out, dataset, started, total, float(execution.work), cached, len(specs),
-        compute,
+        study, mode, out, dataset, started, total, computed.work, cached, len(unique), compute,
     )  # fmt: skip
 
 
@@ -250,7 +331,9 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def _ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords) -> PointSpec:
+def _ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes=None):
+    """One ensemble point; its seed depends on the study's and the cell's names only, so
+    every reading of the claims map draws the same frequencies and starts."""
     kwargs = {
         "n": int(n),
         "bpm": float(bpm),
@@ -261,4 +344,6 @@ def _ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords) -> Poin
         "preset": preset,
         "seed": point_seed(study, key),
     }
+    if changes:
+        kwargs["changes"] = changes
     return make_point(kwargs, keep="run_mean_r", index=(i,), coords=coords)

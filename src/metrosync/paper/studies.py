@@ -110,6 +110,8 @@ class TimeSeriesStudy:
     full: Statistics
     preset: str = "default"
     legend_title: str = ""
+    #: Model parameters changed from the preset, by name (a reading of the claims map).
+    changes: tuple[tuple[str, float | str], ...] = ()
 
     def statistics(self, mode: str) -> Statistics:
         return getattr(self, _check_mode(mode))
@@ -135,6 +137,8 @@ class SweepStudy:
     quick: SweepGrid
     full: SweepGrid
     preset: str = "default"
+    #: Model parameters changed from the preset, by name (a reading of the claims map).
+    changes: tuple[tuple[str, float | str], ...] = ()
 
     def grid(self, mode: str) -> SweepGrid:
         return getattr(self, _check_mode(mode))
@@ -220,7 +224,7 @@ class EstimationStudy:
         return getattr(self, _check_mode(mode))
 
 
-Study = TimeSeriesStudy | SweepStudy | ZStudy | EstimationStudy
+Study = TimeSeriesStudy | SweepStudy | ZStudy | EstimationStudy  # and SigmaMapStudy, ClaimsMapStudy
 
 
 def _check_mode(mode: str) -> str:
@@ -318,8 +322,15 @@ ESTIMATION = EstimationStudy(
     full=EstimationGrid(c_phi_scan=tuple(np.geomspace(1e-6, 10.0, 43))),
 )
 
+# The σ map and the claims map are declared in their own modules, which build on the
+# types and studies above (hence the import here, after them).
+from .readings import CLAIMS_MAP  # noqa: E402
+from .sigma_map import SIGMA_MAP  # noqa: E402
+
 #: Every study `metrosync reproduce` runs, in report order.
-STUDIES: tuple[Study, ...] = (FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY, ESTIMATION)
+STUDIES: tuple[Study, ...] = (
+    FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY, ESTIMATION, SIGMA_MAP, CLAIMS_MAP,
+)  # fmt: skip
 
 
 def get_studies(names: Sequence[str] | None = None) -> tuple[Study, ...]:
@@ -343,11 +354,13 @@ def reduced(study: Study, **statistics) -> Study:
 
 
 __all__ = [
+    "CLAIMS_MAP",
     "ESTIMATION",
     "FIG8_BOTTOM",
     "FIG8_TOP",
     "FIG10",
     "FIG11",
+    "SIGMA_MAP",
     "STUDIES",
     "TABLE1_SIGMA",
     "TABLE2_SIGMA",

@@ -31,6 +31,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+import xarray as xr
 from tqdm import tqdm
 
 from .. import interrupts
@@ -120,11 +121,13 @@ def execute(
     progress: bool = False,
     desc: str = "sweep",
     on_done: Callable[[PointSpec], None] | None = None,
+    on_result: Callable[[PointSpec, xr.Dataset], None] | None = None,
 ) -> Execution:
     """Compute ``specs`` with the chosen executor, storing each point when it is done.
 
     ``desc`` labels the progress bar; ``on_done(spec)`` is called after each point is
-    stored (e.g. to log progress).
+    stored (e.g. to log progress); ``on_result(spec, ds)`` gets the point as stored
+    (cost attributes included), so a caller need not read it back.
     """
     check_scheduler(scheduler, n_workers)
     report = Execution()
@@ -137,7 +140,7 @@ def execute(
 
         def done(spec: PointSpec, ds, seconds: float, host: str) -> None:
             failed = bool(ds.attrs["error"])
-            store.write(ds, seconds=seconds, host=host, work=0 if failed else spec.work)
+            ds = store.write(ds, seconds=seconds, host=host, work=0 if failed else spec.work)
             report.computed.append(spec.key)
             if failed:
                 report.failed[spec.key] = ds.attrs["error"]
@@ -145,6 +148,8 @@ def execute(
                 report.work += spec.work
             bar.update(spec.work)
             bar.set_postfix_str(f"{len(report.computed)}/{len(specs)} points", refresh=False)
+            if on_result is not None:
+                on_result(spec, ds)
             if on_done is not None:
                 on_done(spec)
 

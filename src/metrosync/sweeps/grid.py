@@ -31,7 +31,7 @@ import numpy as np
 from .._version import __version__
 from ..errors import ParameterError, describe
 from ..groups import as_groups, describe_groups, shifted
-from ..model import MetronomeDesign, Platform, get_preset
+from ..model import TUNINGS, MetronomeDesign, Platform, get_preset
 from .points import PointSpec, canonical_json, make_point
 
 #: Ensemble settings of `simulate`, with their type and default in a sweep.
@@ -56,6 +56,8 @@ MODEL_PARAMETERS = tuple(
         if name != "l2_bounds"
     )
 )
+#: Model parameters that take a name rather than a number, and their choices.
+CHOICES = {"tuning": TUNINGS}
 #: Other names people use for the same parameter.
 ALIASES = {
     "N": "n",
@@ -117,7 +119,7 @@ def _kind(name: str) -> type:
     return ENSEMBLE_SETTINGS[name][0] if name in ENSEMBLE_SETTINGS else float
 
 
-def _convert(name: str, value: Any) -> int | float:
+def _convert(name: str, value: Any) -> int | float | str:
     """One checked value of parameter ``name``."""
     if name in SWITCHES:
         words = {"0": 0, "1": 1, "false": 0, "true": 1}
@@ -129,6 +131,12 @@ def _convert(name: str, value: Any) -> int | float:
                 f"`{name}` is a switch: give true or false (1 or 0), got {describe(value)}."
             )
         return int(value)
+    if name in CHOICES:
+        if not isinstance(value, str) or value.strip() not in CHOICES[name]:
+            raise ParameterError(
+                f"`{name}` takes one of {list(CHOICES[name])}, got {describe(value)}."
+            )
+        return value.strip()
     if isinstance(value, bool) or not isinstance(
         value, int | float | np.integer | np.floating | str
     ):

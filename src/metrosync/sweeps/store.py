@@ -55,6 +55,7 @@ LONG_NAMES = {
     "radius": "disk radius",
     "g": "gravitational acceleration",
     "group_offset_bpm": "BPM added to every group after the first",
+    "tuning": "how a nominal BPM becomes a slider position",
 }
 
 
@@ -86,8 +87,9 @@ class PointStore:
         seconds: float = float("nan"),
         host: str = "",
         work: int | None = None,
-    ) -> Path:
-        """Write one point atomically with what it cost, then log it.
+    ) -> xr.Dataset:
+        """Write one point atomically with what it cost, then log it; returns the
+        point as written (with its cost attributes).
 
         ``seconds`` : compute time of the point.   ``host`` : the machine that ran it.
         ``work`` : oscillator-steps simulated (0 for a failed point; default 0).
@@ -95,11 +97,11 @@ class PointStore:
         key = ds.attrs["key"]
         host = host or socket.gethostname()
         ds = ds.assign_attrs(compute_seconds=float(seconds), osc_steps=int(work or 0), host=host)
-        final = write_netcdf(ds, self.path(key))
+        write_netcdf(ds, self.path(key))
         line = json.dumps({"key": key, "seconds": round(seconds, 4), "host": host})
         with open(self.log_path, "a") as log:
             log.write(line + "\n")
-        return final
+        return ds
 
     def read(self, key: str) -> xr.Dataset:
         """Load the point ``key``; `OSError` if its file holds another key."""

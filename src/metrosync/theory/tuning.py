@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -253,8 +253,13 @@ class _Table:
     ratio: CubicSpline
 
 
-@functools.lru_cache(maxsize=32)
 def _table(design: MetronomeDesign) -> _Table:
+    # One table per physical design: the `tuning` field does not change the swing.
+    return _design_table(replace(design, tuning="small-amplitude"))
+
+
+@functools.lru_cache(maxsize=32)
+def _design_table(design: MetronomeDesign) -> _Table:
     lo, hi = design.l2_bounds
     # Chebyshev–Lobatto nodes: the ends (the tunable range) are exact, and the spline
     # of the slowly varying ratio stays accurate near them.
@@ -274,7 +279,8 @@ def steady_swing_bpm_range(design: MetronomeDesign) -> tuple[float, float]:
 def steady_swing_l2(design: MetronomeDesign, bpm):
     """Slider position ``L2`` (m) at which ``design`` ticks at ``bpm`` at its steady swing.
 
-    The steady-swing counterpart of `MetronomeDesign.l2_for_bpm`: scalars or arrays;
+    The steady-swing counterpart of `MetronomeDesign.small_amplitude_l2` (what
+    `MetronomeDesign.l2_for_bpm` calls for ``tuning="steady-swing"``): scalars or arrays;
     raises `ParameterError` for a BPM outside `steady_swing_bpm_range` or a design
     without a steady swing. The first call for a design builds its table (about two
     seconds); later calls cost a few closed-form small-amplitude inversions.
@@ -297,10 +303,10 @@ def steady_swing_l2(design: MetronomeDesign, bpm):
     # iteration L2 ← (small-amplitude tuning of bpm/ρ(L2)) contracts by |d ln ρ/d ln ω₀|,
     # a few per cent, so a handful of rounds reach machine precision.
     x = np.full(bpm_arr.shape, (lo + hi) / 2)
+    natural_lo, natural_hi = design.small_amplitude_range()
     for _ in range(MAX_ROUNDS):
         target = bpm_arr / table.ratio(x)
-        natural_lo, natural_hi = design.bpm_range()
-        x_new = np.asarray(design.l2_for_bpm(np.clip(target, natural_lo, natural_hi)))
+        x_new = np.asarray(design.small_amplitude_l2(np.clip(target, natural_lo, natural_hi)))
         done = np.max(np.abs(x_new - x), initial=0.0) < 1e-14
         x = x_new
         if done:
@@ -310,7 +316,7 @@ def steady_swing_l2(design: MetronomeDesign, bpm):
 
 #: Tuning names: how a nominal BPM becomes a slider position.
 TUNINGS = {
-    "small-amplitude": lambda design, bpm: design.l2_for_bpm(bpm),
+    "small-amplitude": lambda design, bpm: design.small_amplitude_l2(bpm),
     "steady-swing": steady_swing_l2,
 }
 
