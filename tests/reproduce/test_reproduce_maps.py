@@ -169,6 +169,26 @@ def test_a_claims_map_interrupted_midway_resumes_and_equals_an_uninterrupted_one
         xr.testing.assert_identical(resumed.dataset[name], clean.dataset[name])
 
 
+def test_a_steady_swing_reading_whose_drive_overturns_is_not_tuned_to_a_missing_swing():
+    """No steady swing exists under the published drive, so the steady-swing tuning has
+    nothing to tune to: claims 1–4 are not simulated, and the z-study's large regime keeps
+    the small-amplitude tuning (every point is buildable)."""
+    from metrosync.paper.claims_map import _judge, _plan
+
+    reading = Reading(tuning="steady-swing", drive="published")
+    assert reading.overturns and not reading.tunable
+    assert Reading(drive="published").tunable and Reading(tuning="steady-swing").tunable
+    plan = _plan([reading], SCREEN)
+    assert [claim for _, claim, _, specs in plan if specs] == [5]
+    for _, claim, study, specs in plan:
+        if claim < 5:
+            verdict = _judge(reading, claim, study, specs, {})
+            assert verdict.verdict == "not reproduced"
+            assert "no steady swing" in verdict.numbers
+    large = reading_studies(reading, SCREEN)[5].regimes[-1]
+    assert "tuning" not in dict(large.changes) and dict(large.changes)["drive"] == 6e-4
+
+
 def test_the_claims_map_guards_overturning_readings(tiny):
     ds = tiny.datasets["claims_map"]
     published = ds.sel(reading=Reading(drive="published").name, level="screen")

@@ -127,3 +127,14 @@ def group_orders(r_group, b, k, theta_row, theta_dot_row, omega_row, group_start
         lo = group_start[g]
         hi = group_start[g + 1]
         r_group[b, k, g] = analytic_order(theta_row[lo:hi], theta_dot_row[lo:hi], omega_row[lo:hi])
+
+
+@nb.njit(cache=True, inline="always")
+def record_run(b, k, theta, theta_dot, phi, phi_dot, omega_row, r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+    """Record ``k`` of run ``b`` (metronomes innermost): r, each group's r when there are
+    several groups, and the state when trajectories are kept."""
+    r[b, k] = analytic_order(theta[b], theta_dot[b], omega_row)
+    if group_start.shape[0] > 2:  # several groups
+        group_orders(r_group, b, k, theta[b], theta_dot[b], omega_row, group_start)
+    if traj_theta.shape[0] > 0:
+        save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501

@@ -29,7 +29,7 @@ from ._physics import (
     theta_ddot,
 )
 from .kernel_oscillators import FASTMATH
-from .kernel_runs import LANES, _record, arrange  # noqa: F401  (same memory order)
+from .kernel_runs import LANES, _record, arrange, load_block, store_block  # noqa: F401  (same memory order)
 from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 
@@ -52,30 +52,7 @@ def advance(st, c, settings, rec):
     for blk in nb.prange(n_blocks):
         b0 = blk * LANES
         lanes = min(LANES, n_runs - b0)
-        # Block-local copies; missing lanes repeat the last run and are never written back.
-        th = np.empty((n, LANES))
-        thd = np.empty((n, LANES))
-        acc = np.empty((n, LANES))
-        for i in range(n):
-            for w in range(LANES):
-                b = b0 + min(w, lanes - 1)
-                th[i, w] = theta[b, i]
-                thd[i, w] = theta_dot[b, i]
-                acc[i, w] = acc_theta[b, i]
-        ph = np.empty(LANES)
-        phd = np.empty(LANES)
-        aph = np.empty(LANES)
-        pp = np.empty(LANES)
-        fph = np.empty(LANES)
-        alive = np.empty(LANES)
-        for w in range(LANES):
-            b = b0 + min(w, lanes - 1)
-            ph[w] = phi[b]
-            phd[w] = phi_dot[b]
-            aph[w] = acc_phi[b]
-            pp[w] = p_phi[b]
-            fph[w] = force_phi[b]
-            alive[w] = 0.0 if status[b] & STATUS_DIVERGED else 1.0
+        th, thd, acc, ph, phd, aph, pp, fph, alive = load_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes)  # fmt: skip  # noqa: E501
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
@@ -209,17 +186,7 @@ def advance(st, c, settings, rec):
                 for w in range(lanes):
                     if alive[w] > 0.0:
                         _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
-        for w in range(lanes):
-            b = b0 + w
-            for i in range(n):
-                theta[b, i] = th[i, w]
-                theta_dot[b, i] = thd[i, w]
-                acc_theta[b, i] = acc[i, w]
-            phi[b] = ph[w]
-            phi_dot[b] = phd[w]
-            acc_phi[b] = aph[w]
-            p_phi[b] = pp[w]
-            force_phi[b] = fph[w]
+        store_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, b0, lanes, th, thd, acc, ph, phd, aph, pp, fph)  # fmt: skip  # noqa: E501
 
 
 @nb.njit(cache=True, inline="always")

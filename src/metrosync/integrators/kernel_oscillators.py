@@ -22,11 +22,9 @@ import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import (
-    analytic_order,
     drift,
-    group_orders,
     momentum,
-    save_state,
+    record_run,
     upward,
     upward_crossing,
     velocity,
@@ -62,8 +60,6 @@ def advance(st, c, settings, rec):
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
-    save = traj_theta.shape[0] > 0
-    grouped = group_start.shape[0] > 2  # several groups
     dt2 = dt * dt
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
@@ -75,11 +71,7 @@ def advance(st, c, settings, rec):
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
-            r[b, 0] = analytic_order(theta[b], theta_dot[b], c.omega[b])
-            if grouped:
-                group_orders(r_group, b, 0, theta[b], theta_dot[b], c.omega[b], group_start)
-            if save:
-                save_state(b, 0, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+            record_run(b, 0, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
@@ -149,11 +141,7 @@ def advance(st, c, settings, rec):
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
-                r[b, k] = analytic_order(theta[b], theta_dot[b], c.omega[b])
-                if grouped:
-                    group_orders(r_group, b, k, theta[b], theta_dot[b], c.omega[b], group_start)
-                if save:
-                    save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                record_run(b, k, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
 
 
 @nb.njit(cache=True, inline="always")

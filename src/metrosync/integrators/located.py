@@ -42,10 +42,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from . import kernel_located_oscillators, kernel_located_runs
-from ._abi import constants_of, settings_of
-from ._cache import heal_compile_cache
 from ._state import StepState
-from .verlet import choose_layout
+from .verlet import advance_in_layout
 
 #: Kernel modules by memory layout, picked as for ``verlet`` (`verlet.choose_layout`).
 LAYOUTS = {"runs": kernel_located_runs, "oscillators": kernel_located_oscillators}
@@ -57,20 +55,10 @@ def advance_state(
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from the problem's size, as for ``verlet``)."""
     refuse_dry_friction(sys)
-    heal_compile_cache()
-    kernel = LAYOUTS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
-    kernel.advance(
-        state.kernel_state(),
-        kernel.arrange(constants_of(sys, dt)),
-        settings_of(
-            dt=dt,
-            step0=step0,
-            n_steps=n_steps,
-            record_every=record_every,
-            overturn_angle=overturn_angle,
-        ),
-        state.kernel_recording(),
-    )
+    advance_in_layout(
+        LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
+        overturn_angle=overturn_angle, layout=layout,
+    )  # fmt: skip
 
 
 def refuse_dry_friction(sys) -> None:

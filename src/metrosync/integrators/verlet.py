@@ -76,9 +76,19 @@ def advance_state(
     state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle, layout=None
 ):
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
-    ``layout`` (default: chosen from N)."""
+    ``layout`` (default: chosen from the problem's size)."""
+    advance_in_layout(
+        LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
+        overturn_angle=overturn_angle, layout=layout,
+    )  # fmt: skip
+
+
+def advance_in_layout(
+    layouts, state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle, layout
+):
+    """`advance_state` for a scheme whose kernel modules by layout are ``layouts``."""
     heal_compile_cache()
-    kernel = LAYOUTS[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
+    kernel = layouts[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
     kernel.advance(
         state.kernel_state(),
         kernel.arrange(constants_of(sys, dt)),

@@ -28,7 +28,6 @@ from collections.abc import Callable
 import numpy as np
 import xarray as xr
 
-from ..model import get_preset
 from ..status import STATUS_OVERTURNED
 from .assemble import assemble
 from .claims import CHECKS, OMEGA_C_PAPER, Verdict
@@ -42,7 +41,7 @@ OVERTURNED_LIMIT = 0.5
 
 def overturns(reading: Reading) -> bool:
     """True when the reading's energy-balance swing passes the horizontal."""
-    return get_preset("default", warn=False).with_changes(**reading.changes(tuned=False)).overturns
+    return reading.overturns
 
 
 def _plan(readings, level: ClaimStatistics):
@@ -52,7 +51,7 @@ def _plan(readings, level: ClaimStatistics):
     out = []
     for reading in readings:
         for claim, study in reading_studies(reading, level).items():
-            if claim == 4 and overturns(reading):
+            if (claim == 4 and overturns(reading)) or (claim < 5 and not reading.tunable):
                 out.append((reading, claim, study, []))
             else:
                 out.append((reading, claim, study, points_of(study, "quick")))
@@ -78,11 +77,16 @@ def best_work(study: ClaimsMapStudy, mode: str) -> float:
 
 def _judge(reading, claim, study, specs, loaded) -> Verdict:
     if not specs:
+        why = (
+            "claims 1–3 of the small-amplitude reading measure how many runs do"
+            if reading.tunable
+            else "and there is no steady swing for the steady-swing tuning to tune to"
+        )
         return Verdict(
             claim,
             "not reproduced",
             "not simulated: the energy-balance swing 2M/(π c_θ) exceeds π/2 under this "
-            "reading, so every ensemble overturns (claims 1–3 measure how many runs do).",
+            f"reading, so every ensemble overturns ({why}).",
             study.name,
         )
     parts = [loaded[spec.key] for spec in specs]

@@ -33,7 +33,9 @@ The z-study (claim 5) is read through each reading too: the paper's two drives,
 published M; a reading that corrects M or c_θ corrects both regimes alike, so its
 z-study runs free (c_θ = c_φ = M = 0), small (the reading's c_θ, M/10) and large
 (the reading's c_θ and M). The free regime has no steady swing to tune to, so it
-keeps the small-amplitude tuning (its swing starts at 0.1 rad, where both agree).
+keeps the small-amplitude tuning (its swing starts at 0.1 rad, where both agree); so
+does the large regime of a drive that overturns. Claims 1–4 of a steady-swing reading
+whose drive overturns are not simulated: there is no swing to tune to.
 
 Seeds depend only on the study's and the cell's names, so every reading draws the
 same frequencies and starts (common random numbers), and a point whose resolved
@@ -124,6 +126,20 @@ class Reading:
         if self.reaction == "off":
             out["escapement_reaction"] = False
         return out
+
+    @property
+    def overturns(self) -> bool:
+        """True when the reading's energy-balance swing passes the horizontal: there is
+        then no steady swing, and the steady-swing tuning has nothing to tune to."""
+        from ..model import get_preset
+
+        params = get_preset("default", warn=False).with_changes(**self.changes(tuned=False))
+        return params.overturns
+
+    @property
+    def tunable(self) -> bool:
+        """Whether the reading's tuning can be applied at its own drive."""
+        return self.tuning == "small-amplitude" or not self.overturns
 
     def describe(self) -> str:
         c_theta, drive = DRIVES[self.drive]
@@ -229,7 +245,9 @@ def reading_studies(reading: Reading, level: ClaimStatistics) -> dict[int, objec
             {**reading.changes(tuned=False), **dict(FREE)}.items()))),
         Regime(f"c_θ = {c_theta:g}, M = {drive / 10:g} (small)",
                changes=tuple(sorted(reading.changes(drive_factor=0.1).items()))),
-        Regime(f"c_θ = {c_theta:g}, M = {drive:g} (large)", changes=changes),
+        # An overturning drive has no steady swing to tune to: small-amplitude tuning.
+        Regime(f"c_θ = {c_theta:g}, M = {drive:g} (large)", changes=tuple(sorted(
+            reading.changes(tuned=reading.tunable).items()))),
     )  # fmt: skip
     return {
         1: replace(_both(FIG11, level.fig11), changes=changes),
