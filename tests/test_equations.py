@@ -143,6 +143,8 @@ def test_escapement_kicks_where_theta_crosses_its_offset(random_system):
     ]:  # fmt: skip
         kick = escapement(sys, np.array([[before]]), np.array([[after]]), 0.01)
         assert kick[0, 0] == want, (before, after)
+
+
 def test_solved_form_with_dry_friction_obeys_the_coulomb_law(rng, random_system):
     """Moving, held and breaking-free disks: the disk's equation holds with the friction
     the law allows (−T sign φ̇, −T sign φ̈ from rest, or within ±T at rest)."""

@@ -73,7 +73,6 @@ class SystemArrays:
         for name, value in off.items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, value)
-    dry_friction: np.ndarray
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -188,9 +188,14 @@ def sweep_budget(specs, todo, *, scheduler=None, n_workers=None) -> Budget:
         if spec.key in to_compute:
             sims.append(
                 simulation_budget(
-                    n=n, runs=k["runs"], steps=steps, records=records * max(1, len(groups)),
+                    n=n,
+                    runs=k["runs"],
+                    steps=steps,
+                    records=records * max(1, len(groups)),
                     trajectories=False,
-                    integrator=k["integrator"], backend=k["backend"], dt=k["dt"],
+                    integrator=k["integrator"],
+                    backend=k["backend"],
+                    dt=k["dt"],
                 )  # fmt: skip
             )
     workers = {None: 1, "local": n_workers or os.cpu_count() or 1}.get(scheduler, 0)
