@@ -35,7 +35,9 @@ z-study runs free (c_θ = c_φ = M = 0), small (the reading's c_θ, M/10) and la
 (the reading's c_θ and M). The free regime has no steady swing to tune to, so it
 keeps the small-amplitude tuning (its swing starts at 0.1 rad, where both agree); so
 does the large regime of a drive that overturns. Claims 1–4 of a steady-swing reading
-whose drive overturns are not simulated: there is no swing to tune to.
+whose drive overturns are not simulated: there is no swing to tune to. A reading whose
+tunable range is narrower than a study's ω₀ (the steady-swing tuning with c_θ × 10
+reaches only 212.7 BPM) runs that study on the ω₀ it can reach, 5 σ inside the range.
 
 Seeds depend only on the study's and the cell's names, so every reading draws the
 same frequencies and starts (common random numbers), and a point whose resolved
@@ -141,6 +143,14 @@ class Reading:
         """Whether the reading's tuning can be applied at its own drive."""
         return self.tuning == "small-amplitude" or not self.overturns
 
+    def bpm_range(self) -> tuple[float, float]:
+        """The nominal BPMs the slider reaches under this reading (its tuning, friction
+        and drive): the steady-swing range is narrower than the small-amplitude one."""
+        from ..model import get_preset
+
+        params = get_preset("default", warn=False).with_changes(**self.changes())
+        return params.metronome.bpm_range()
+
     def describe(self) -> str:
         c_theta, drive = DRIVES[self.drive]
         return (
@@ -231,14 +241,21 @@ def reading_studies(reading: Reading, level: ClaimStatistics) -> dict[int, objec
     """
     changes = tuple(sorted(reading.changes().items()))
     f = reading.sigma_factor
+    reach = _reach(reading)
     scaled = {
         study.name: replace(
             _both(study, level.fig8),
-            cases=tuple(Case(c.n, c.bpm, c.sigma_bpm * f, c.label) for c in study.cases),
+            cases=tuple(
+                Case(c.n, c.bpm, c.sigma_bpm * f, c.label)
+                for c in study.cases
+                if reach(c.bpm, c.sigma_bpm * f)
+            ),
             changes=changes,
         )
         for study in (FIG8_TOP, FIG8_BOTTOM)
     }
+    sigma10 = FIG10.sigma_bpm * f
+    fig10 = replace(level.fig10, bpms=tuple(b for b in level.fig10.bpms if reach(b, sigma10)))
     c_theta, drive = DRIVES[reading.drive]
     regimes = (
         Regime("no friction, no drive", changes=tuple(sorted(
@@ -253,9 +270,27 @@ def reading_studies(reading: Reading, level: ClaimStatistics) -> dict[int, objec
         1: replace(_both(FIG11, level.fig11), changes=changes),
         2: scaled[FIG8_TOP.name],
         3: scaled[FIG8_BOTTOM.name],
-        4: replace(_both(FIG10, level.fig10), sigma_bpm=FIG10.sigma_bpm * f, changes=changes),
+        4: replace(_both(FIG10, fig10), sigma_bpm=sigma10, changes=changes),
         5: replace(_both(Z_STUDY, level.z), regimes=regimes),
     }
+
+
+#: Standard deviations of the frequency draws kept inside the tunable range: a study's
+#: ω₀ closer than this to an end of the reading's range is left out (one draw in 3×10⁶
+#: would fall outside and fail its point).
+RANGE_MARGIN_SIGMAS = 5.0
+
+
+def _reach(reading: Reading):
+    """``reach(bpm, sigma)``: whether an ensemble at ``bpm`` with spread ``sigma`` stays
+    within the reading's tunable range. An untunable reading is not simulated at all
+    (`claims_map`), so every ω₀ is kept for it."""
+    if not reading.tunable:
+        return lambda bpm, sigma: True
+    low, high = reading.bpm_range()
+    return lambda bpm, sigma: (
+        low + RANGE_MARGIN_SIGMAS * sigma <= bpm <= high - RANGE_MARGIN_SIGMAS * sigma
+    )  # noqa: E501
 
 
 def _bpms(start: float, stop: float, step: float) -> tuple[float, ...]:
