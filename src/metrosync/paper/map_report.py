@@ -210,19 +210,30 @@ def conclusion(datasets: dict[str, xr.Dataset]) -> list[str]:
         judged = _judged(cmap)
         score = xr.where(judged == "reproduced", 1.0, xr.where(judged == "partly reproduced",
                                                                0.5, 0.0)).sum("claim")  # fmt: skip
-        best = int(np.argmax(score.values))
-        name = str(cmap.reading.values[best])
+        top = float(score.max())
+        # Ties are common (half-claims): name them all, in the map's rank order.
+        tied = sorted(np.flatnonzero(score.values == top), key=lambda i: int(cmap["rank"][i]))
+        best = int(tied[0])
         held = [int(c) for c in cmap.claim.values if judged.isel(reading=best).sel(claim=c) ==
                 "reproduced"]  # fmt: skip
         part = [int(c) for c in cmap.claim.values if judged.isel(reading=best).sel(claim=c) ==
                 "partly reproduced"]  # fmt: skip
-        s.append(
-            f"Of the {cmap.sizes['reading']} readings tried, the one that reproduces most of the "
-            f"paper is **{name}** ({cmap.description.values[best]}): score "
-            f"{float(score[best]):g} of 5, claims {_list(held)} reproduced"
-            + (f" and {_list(part)} partly" if part else "")
-            + "."
-        )
+        claims = f"claims {_list(held)} reproduced" + (f" and {_list(part)} partly" if part else "")
+        if len(tied) == 1:
+            s.append(
+                f"Of the {cmap.sizes['reading']} readings tried, the one that reproduces most "
+                f"of the paper is **{cmap.reading.values[best]}** "
+                f"({cmap.description.values[best]}): score {top:g} of 5, {claims}."
+            )
+        else:
+            names = _list(f"**{cmap.reading.values[i]}**" for i in tied)
+            s.append(
+                f"Of the {cmap.sizes['reading']} readings tried, {len(tied)} tie as the ones "
+                f"that reproduce most of the paper, each scoring {top:g} of 5 (at the paper's "
+                f"statistics where a reading was run again, else at the screen's): {names}. "
+                f"The map ranks first the one whose screen scored highest and whose onset "
+                f"sits nearest 185 BPM ({cmap.description.values[best]}): {claims}."
+            )
         nobody = [
             int(c) for c in cmap.claim.values if not (judged.sel(claim=c) == "reproduced").any()
         ]

@@ -40,10 +40,10 @@ MODES = ("quick", "full")
 #: 2-core x86-64 development machine. `reproduce --help`, the README and REPORT.md all
 #: quote these words (a test checks that they agree); REPORT.md adds its own timings.
 MEASURED_COST = {
-    "quick": "about 27 s of CPU time: under a minute on 2 idle cores, "
-    "80-90 s measured with the 2 cores shared (load average 9)",
-    "full": "12 min 40 s and 13 min 17 s measured on 2 shared cores "
-    "(1.2 cores' worth of CPU), nearly all of it Fig. 10",
+    "quick": "51 s measured on 2 cores (73 s of CPU), the σ map and the claims map "
+    "included",
+    "full": "9 min 41 s measured on 2 cores (17 min 26 s of CPU), "
+    "Fig. 10, the claims map and the σ map most of it",
 }
 
 
