@@ -1,10 +1,18 @@
 """Shared fixtures: small ensembles whose constants tests can reuse."""
 
+import signal
+
 import numpy as np
 import pytest
 
 from metrosync import build_ensemble, get_preset
 from metrosync.equations import SystemArrays
+
+# A suite started in the background of a non-interactive shell (`make test &`) inherits
+# SIGINT ignored, and so would every process it starts. The Ctrl-C tests need Python's
+# handler here and the default disposition in their children: restore it.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture

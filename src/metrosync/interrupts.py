@@ -38,6 +38,11 @@ def _discard_lost_interrupts(unraisable) -> None:
 _previous_hook = sys.unraisablehook
 
 
+def requested() -> bool:
+    """Whether SIGINT arrived inside the current `sigint_checked` block."""
+    return _requested.is_set()
+
+
 def check() -> None:
     """Raise `KeyboardInterrupt` if SIGINT arrived and was lost since it was raised."""
     if _requested.is_set():

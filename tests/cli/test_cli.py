@@ -55,7 +55,7 @@ def test_help_shows_each_default_once_and_only_real_ones(argv, capsys):
     assert not re.search(r"\(default [^:]", text), "a default written by hand and by argparse"
     if argv == ["simulate"]:
         assert "--runs RUNS independent runs (default: 20; 1 with --n 1 or --theta0)" in text
-        assert "--integrator {verlet,exact} verlet: the paper's fixed-step" in text
+        assert "--integrator {verlet,located,exact} verlet: the paper's fixed-step" in text
 
 
 def test_show_commands_default_to_one_run(capsys):

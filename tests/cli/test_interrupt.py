@@ -135,6 +135,27 @@ def test_a_lost_interrupt_is_raised_again_at_the_next_check(capsys):
     assert capsys.readouterr().err == ""  # and nothing was printed about it
 
 
+def test_a_library_error_after_ctrl_c_is_reported_as_the_interrupt(monkeypatch, capsys):
+    """SIGINT raised inside a library (matplotlib drawing a frame) can break it so that
+    it fails with an error of its own; after Ctrl-C that is the interrupt, not a bug."""
+    import metrosync.cli as cli
+
+    def interrupted_then_broken(argv):
+        interrupts._requested.set()  # as SIGINT does
+        raise ValueError("Invalid affine transformation matrix")
+
+    monkeypatch.setattr(cli, "_run", interrupted_then_broken)
+    assert cli.main(["animate"]) == 130
+    assert capsys.readouterr().err == "metrosync animate: interrupted: nothing was written\n"
+
+    def broken(argv):  # without an interrupt, an error stays an error
+        raise ValueError("a real bug")
+
+    monkeypatch.setattr(cli, "_run", broken)
+    with pytest.raises(ValueError, match="a real bug"):
+        cli.main(["animate"])
+
+
 def test_reproduce_says_how_many_points_it_kept(tmp_path, monkeypatch):
     from metrosync.paper import pipeline
 

@@ -65,7 +65,15 @@ def main(argv: list[str] | None = None) -> int:
     written: list = []
     try:
         with recording_writes() as written, interrupts.sigint_checked():
-            return _run(argv)
+            try:
+                return _run(argv)
+            except Exception:
+                # An interrupt raised inside a library can leave it broken, so that it
+                # fails next with an error of its own (matplotlib: "Invalid affine
+                # transformation matrix"). After Ctrl-C, that error is the interrupt.
+                if interrupts.requested():
+                    raise KeyboardInterrupt from None
+                raise
     except KeyboardInterrupt as interrupt:
         # The one handler for Ctrl-C: every subcommand's outputs are atomic, so what
         # exists is whole; say what that is, and how to go on.

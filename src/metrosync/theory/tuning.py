@@ -329,4 +329,6 @@ def l2_for_bpm(design: MetronomeDesign, bpm, *, tuning: str = "small-amplitude")
         raise ParameterError(
             f"unknown `tuning` {tuning!r}; choose one of {sorted(TUNINGS)}."
         ) from None
+    # The design's one range check and message (it names the range and a fix) first.
+    replace(design, tuning=tuning).check_tunable(bpm)
     return solve(design, bpm)
