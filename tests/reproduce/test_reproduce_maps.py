@@ -10,7 +10,7 @@ import xarray as xr
 
 from metrosync import ParameterError
 from metrosync.paper.claims import Verdict
-from metrosync.paper.claims_map import overturns, rank
+from metrosync.paper.claims_map import rank
 from metrosync.paper.map_report import which_reading
 from metrosync.paper.readings import (
     BEST,
@@ -45,7 +45,7 @@ def test_each_reading_changes_what_it_names():
     assert Reading(tuning="steady-swing").changes() == {"tuning": "steady-swing"}
     assert Reading(reaction="off").changes() == {"escapement_reaction": False}
     assert Reading(reaction="off").name.endswith("/no-reaction")
-    assert overturns(Reading(drive="published")) and not overturns(Reading(drive="c_theta*10"))
+    assert Reading(drive="published").overturns and not Reading(drive="c_theta*10").overturns
     with pytest.raises(ParameterError, match="`drive`"):
         Reading(drive="M/100")
 

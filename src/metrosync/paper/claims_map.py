@@ -39,11 +39,6 @@ CLAIMS = (1, 2, 3, 4, 5)
 OVERTURNED_LIMIT = 0.5
 
 
-def overturns(reading: Reading) -> bool:
-    """True when the reading's energy-balance swing passes the horizontal."""
-    return reading.overturns
-
-
 def _plan(readings, level: ClaimStatistics):
     """(reading, claim, study, specs) for every claim of every reading at ``level``."""
     from .runner import points_of
@@ -51,7 +46,7 @@ def _plan(readings, level: ClaimStatistics):
     out = []
     for reading in readings:
         for claim, study in reading_studies(reading, level).items():
-            if (claim == 4 and overturns(reading)) or (claim < 5 and not reading.tunable):
+            if (claim == 4 and reading.overturns) or (claim < 5 and not reading.tunable):
                 out.append((reading, claim, study, []))
             else:
                 out.append((reading, claim, study, points_of(study, "quick")))
@@ -71,7 +66,7 @@ def best_work(study: ClaimsMapStudy, mode: str) -> float:
     if grid.best is None:
         return 0.0
     per = [sum(s.work for *_, specs in _plan([r], grid.best) for s in specs)
-           for r in study.readings_of(mode) if not overturns(r)]  # fmt: skip
+           for r in study.readings_of(mode) if not r.overturns]  # fmt: skip
     return float(grid.top * (max(per) if per else 0.0))
 
 

@@ -129,14 +129,17 @@ class Reading:
             out["escapement_reaction"] = False
         return out
 
+    def params(self, *, tuned: bool = True):
+        """The `default` preset with this reading's changes (see `changes`)."""
+        from ..model import get_preset
+
+        return get_preset("default", warn=False).with_changes(**self.changes(tuned=tuned))
+
     @property
     def overturns(self) -> bool:
         """True when the reading's energy-balance swing passes the horizontal: there is
         then no steady swing, and the steady-swing tuning has nothing to tune to."""
-        from ..model import get_preset
-
-        params = get_preset("default", warn=False).with_changes(**self.changes(tuned=False))
-        return params.overturns
+        return self.params(tuned=False).overturns
 
     @property
     def tunable(self) -> bool:
@@ -146,10 +149,7 @@ class Reading:
     def bpm_range(self) -> tuple[float, float]:
         """The nominal BPMs the slider reaches under this reading (its tuning, friction
         and drive): the steady-swing range is narrower than the small-amplitude one."""
-        from ..model import get_preset
-
-        params = get_preset("default", warn=False).with_changes(**self.changes())
-        return params.metronome.bpm_range()
+        return self.params().metronome.bpm_range()
 
     def describe(self) -> str:
         c_theta, drive = DRIVES[self.drive]
@@ -290,7 +290,7 @@ def _reach(reading: Reading):
     low, high = reading.bpm_range()
     return lambda bpm, sigma: (
         low + RANGE_MARGIN_SIGMAS * sigma <= bpm <= high - RANGE_MARGIN_SIGMAS * sigma
-    )  # noqa: E501
+    )
 
 
 def _bpms(start: float, stop: float, step: float) -> tuple[float, ...]:
