@@ -24,7 +24,6 @@ import math
 import numpy as np
 from numba import cuda, float64
 
-from ..errors import ParameterError
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from . import _kernel_parts, _physics
 from ._abi import Constants, Recording, State, constants_of, settings_of
@@ -234,11 +233,9 @@ def advance_state(
     the GPU in this version."""
     if state.traj_theta.shape[0]:
         raise NotImplementedError("trajectories are not recorded by the GPU backend yet")
-    if np.any(sys.dry_friction > 0):
-        raise ParameterError(
-            f"`disk_dry_friction` = {float(np.max(sys.dry_friction))!r} N m: the GPU backend "
-            f"has no dry friction on the disk yet; use backend='numba' (or 'numpy')."
-        )
+    sys.refuse_dry_friction(
+        "the GPU backend has no dry friction on the disk yet", "backend='numba' (or 'numpy')"
+    )
     b, n = state.theta.shape
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
     constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))

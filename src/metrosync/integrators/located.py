@@ -38,9 +38,6 @@ friction on the disk (`refuse_dry_friction`).
 
 from __future__ import annotations
 
-import numpy as np
-
-from ..errors import ParameterError
 from . import kernel_located_oscillators, kernel_located_runs
 from ._state import StepState
 from .verlet import advance_in_layout
@@ -64,9 +61,6 @@ def advance_state(
 def refuse_dry_friction(sys) -> None:
     """`ParameterError` for dry friction on the disk, which this scheme does not have:
     its stick/slip events would need locating inside the step like the kicks."""
-    if np.any(sys.dry_friction > 0):
-        raise ParameterError(
-            f"`disk_dry_friction` = {float(np.max(sys.dry_friction))!r} N m: integrator "
-            "'located' has no dry friction on the disk; use integrator='verlet' (or "
-            "'exact')."
-        )
+    sys.refuse_dry_friction(
+        "integrator 'located' has no dry friction on the disk", "integrator='verlet' (or 'exact')"
+    )
