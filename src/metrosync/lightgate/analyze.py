@@ -40,7 +40,7 @@ import xarray as xr
 from .._version import __version__
 from ..errors import AnalysisError, ChannelCountError, ParameterError
 from ..observables.order import equilibrium_order
-from . import phases as ph
+from ..observables import crossings as ph
 from .cleaning import (
     DEFAULT_GLITCH,
     DEFAULT_MAX_INTERRUPTION,

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import phases as ph
+from ..observables import crossings as ph
 from .cleaning import clean_log
 from .gatelog import GateLog
 

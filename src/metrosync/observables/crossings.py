@@ -1,4 +1,8 @@
-"""Phases, r(t), frequencies and jitter from cleaned passes (paper §2, eq. (op)).
+"""Phases, r(t), frequencies and jitter from one kept pass per period (paper §2, eq. (op)).
+
+The experiment's method, shared by every instrument that times a metronome's passes
+(light gates, sound, video): each gives, per metronome, the kept pass times and the
+number of periods between consecutive ones, and everything below follows from them.
 
 Contract: pure functions over arrays.
 

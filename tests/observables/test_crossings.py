@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from metrosync.lightgate import phases as ph
+from metrosync.observables import crossings as ph
 
 
 def test_phase_rises_linearly_between_kept_passes_and_across_bridged_gaps():
