@@ -7,8 +7,9 @@
  * EDGES is a text file:
  *   init LLLLLLLL          levels of gates 1..8 before reset (1 = pin high)
  *   CYCLE GATE LEVEL       at CPU cycle CYCLE (16 per us), gate GATE (1..8) goes to LEVEL
+ *   CYCLE rx BYTE          at CPU cycle CYCLE the UART receives BYTE (0..255, decimal)
  *   end CYCLE              stop the simulation at this cycle
- * with edges in time order. Gate 1..6 is PD2..PD7 and gate 7..8 PB0..PB1, as in
+ * with edges and bytes in time order. Gate 1..6 is PD2..PD7 and gate 7..8 PB0..PB1, as in
  * the firmware.
  *
  * --speed S   pace the output: S simulated seconds per wall-clock second (0, the
@@ -39,13 +40,14 @@
 
 typedef struct {
     avr_cycle_count_t cycle;
-    int gate;
-    int level;
+    int gate;  /* 1..8, or 0: a byte for the UART */
+    int level; /* the gate's level, or the byte */
 } edge_t;
 
 static edge_t *edges;
 static size_t n_edges, next_edge;
 static avr_irq_t *gate_irq[8];
+static avr_irq_t *uart_in;
 static double speed;
 static struct timespec wall_start;
 static FILE *lines_out;
@@ -116,7 +118,7 @@ static avr_cycle_count_t apply_edges(avr_t *avr, avr_cycle_count_t when, void *p
     (void)when;
     while (next_edge < n_edges && edges[next_edge].cycle <= avr->cycle) {
         edge_t *e = &edges[next_edge++];
-        avr_raise_irq(gate_irq[e->gate - 1], (uint32_t)e->level);
+        avr_raise_irq(e->gate ? gate_irq[e->gate - 1] : uart_in, (uint32_t)e->level);
     }
     return next_edge < n_edges ? edges[next_edge].cycle : 0;
 }
@@ -157,9 +159,13 @@ int main(int argc, char **argv)
             continue;
         if (sscanf(row, "end %llu", &end) == 1)
             continue;
-        if (sscanf(row, "%llu %d %d", &c, &g, &l) != 3)
+        if (sscanf(row, "%llu rx %d", &c, &l) == 2) {
+            if (l < 0 || l > 255)
+                die("bad rx line");
+            g = 0;
+        } else if (sscanf(row, "%llu %d %d", &c, &g, &l) != 3)
             continue;
-        if (g < 1 || g > 8 || (l != 0 && l != 1))
+        else if (g < 1 || g > 8 || (l != 0 && l != 1))
             die("bad edge line");
         if (n_edges && c < edges[n_edges - 1].cycle)
             die("edges out of time order");
@@ -195,6 +201,7 @@ int main(int argc, char **argv)
     avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
                             uart_out, avr);
+    uart_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
 
     for (int g = 0; g < 8; g++) {
         char port = g < 6 ? 'D' : 'B';

@@ -66,10 +66,14 @@ class LoggerRun:
         return self.text.splitlines()
 
 
-def edge_file(path: Path, edges, *, end: float, init: str = "00000000") -> Path:
-    """Write the harness's input: ``edges`` are (time s, gate 1..8, level) in time order."""
+def edge_file(path: Path, edges, *, end: float, init: str = "00000000", rx=()) -> Path:
+    """Write the harness's input: ``edges`` are (time s, gate 1..8, level) in time order,
+    ``rx`` (time s, byte) what the UART receives."""
+    timed = sorted([(round(t * F_CPU), f"{g} {lv}") for t, g, lv in edges]
+                   + [(round(t * F_CPU), f"rx {byte}") for t, byte in rx],
+                   key=lambda row: row[0])  # fmt: skip
     rows = [f"init {init}"]
-    rows += [f"{round(t * F_CPU)} {g} {lv}" for t, g, lv in edges]
+    rows += [f"{cycle} {what}" for cycle, what in timed]
     rows.append(f"end {round(end * F_CPU)}")
     Path(path).write_text("\n".join(rows) + "\n")
     return Path(path)
@@ -77,15 +81,16 @@ def edge_file(path: Path, edges, *, end: float, init: str = "00000000") -> Path:
 
 def run_logger(harness: Path, elf: Path, edges, *, end: float, workdir: Path,
                init: str = "00000000", speed: float = 0.0, stdout=None,
-               timeout: float = 120) -> LoggerRun | subprocess.Popen:  # fmt: skip
-    """Run the firmware on ``edges`` until ``end`` s (simulated).
+               timeout: float = 120, rx=()) -> LoggerRun | subprocess.Popen:  # fmt: skip
+    """Run the firmware on ``edges`` until ``end`` s (simulated), sending it the bytes
+    ``rx`` [(time s, byte)] on its serial input.
 
     With ``stdout`` (a file descriptor, e.g. a pty's master end) the harness writes the
     UART there, paced at ``speed`` simulated seconds per second, and the started
     process is returned; otherwise the run is waited for and returned as `LoggerRun`.
     """
     workdir = Path(workdir)
-    edges_path = edge_file(workdir / "edges.txt", edges, end=end, init=init)
+    edges_path = edge_file(workdir / "edges.txt", edges, end=end, init=init, rx=rx)
     lines_path = workdir / "line_cycles.txt"
     argv = [str(harness), str(elf), str(edges_path), "--lines", str(lines_path)]
     if speed:

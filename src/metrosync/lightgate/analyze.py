@@ -39,8 +39,8 @@ import xarray as xr
 
 from .._version import __version__
 from ..errors import AnalysisError, ChannelCountError, ParameterError
-from ..observables.order import equilibrium_order
 from ..observables import crossings as ph
+from ..observables.order import equilibrium_order
 from .cleaning import (
     DEFAULT_GLITCH,
     DEFAULT_MAX_INTERRUPTION,

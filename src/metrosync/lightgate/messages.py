@@ -5,13 +5,14 @@ Contract: `parse_message` recognises one line and returns a `LoggerHeader`, an
 `parse_message` reads back as a `Gap`. Each message starts with ``#``, so a terminal
 program shows it and the record pattern never matches it.
 
-* The header, sent once by the gate-logger firmware at start-up (after a reset)::
+* The header, sent by the gate-logger firmware at start-up (after a reset)::
 
-      # metrosync gate-logger 1.0 channels=8 tick_us=64 counter_bits=32 baud=115200 holdoff_ticks=4
+      # metrosync gate-logger 1.1 channels=8 tick_us=64 counter_bits=32 baud=115200 holdoff_ticks=4
 
+  and again, ending ``requested=1``, when it receives `HEADER_REQUEST` (firmware 1.1).
   Keys may come in any order; unknown keys are kept in ``extra``, so a later firmware
   may add some. A header after the first record means the logger restarted and its
-  counter began again.
+  counter began again, unless it was requested.
 * The overflow line, where the logger's buffer was full and gate changes were lost::
 
       # overflow: 12 records lost
@@ -35,6 +36,8 @@ _HEADER = re.compile(r"^\s*#\s*metrosync gate-logger\s+(\S+)((?:\s+\w+=\S*)*)\s*
 _OVERFLOW = re.compile(r"^\s*#\s*overflow:\s*(\d+) records? lost\s*$")
 _GAP = re.compile(r"^\s*#\s*metrosync record: gap of ([0-9.]+(?:e[+-]?\d+)?) s\b.*$")
 _NEEDED = ("channels", "tick_us", "counter_bits")
+#: The byte that asks the gate-logger firmware (1.1 and later) for its header again.
+HEADER_REQUEST = b"?"
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,8 @@ class LoggerHeader:
     tick : seconds per counter tick.   counter_bits : the counter's width.
     baud : the serial rate, or None if not given.
     extra : other ``key=value`` pairs, as text.
+    requested : sent on request (`HEADER_REQUEST`), not at a start-up: the counter
+        went on.
     """
 
     version: str
@@ -53,6 +58,7 @@ class LoggerHeader:
     counter_bits: int
     baud: int | None = None
     extra: dict[str, str] = field(default_factory=dict)
+    requested: bool = False
 
 
 @dataclass(frozen=True)
@@ -96,6 +102,7 @@ def _header(version: str, pairs: dict[str, str], line: str) -> LoggerHeader:
         tick = float(pairs.pop("tick_us")) * 1e-6
         bits = int(pairs.pop("counter_bits"))
         baud = int(pairs.pop("baud")) if "baud" in pairs else None
+        requested = pairs.pop("requested", "0") == "1"
         if not (1 <= channels <= 8 and tick > 0 and math.isfinite(tick) and 8 <= bits <= 62):
             raise ValueError("a value out of range")
     except ValueError as error:
@@ -104,7 +111,7 @@ def _header(version: str, pairs: dict[str, str], line: str) -> LoggerHeader:
             f"channels=1..8, tick_us>0 and counter_bits=8..62. Delete the line to read the "
             f"capture without it."
         ) from None
-    return LoggerHeader(version, channels, tick, bits, baud, pairs)
+    return LoggerHeader(version, channels, tick, bits, baud, pairs, requested)
 
 
 def format_gap(seconds: float, port: str) -> str:

@@ -23,9 +23,10 @@ a terminal program are messy, so the reader
   the logger's start-up header (its tick must agree with ``tick``, and its counter
   width is used when ``counter_bits="auto"``), its overflow lines (``records_lost``),
   and a restart of the logger (a header after the first record, where its counter
-  began again): the records after it continue the time line after the wall-clock
-  gap that `record` marked before it. These lines are listed in ``skipped`` too (with
-  their reason), but ``strict`` does not refuse them.
+  began again; a header sent on request is not one): the records after it continue
+  the time line after the wall-clock gap that `record` marked before it. These lines
+  are listed in ``skipped`` too (with their reason), but ``strict`` does not refuse
+  them.
 
 It refuses, with a `LogFormatError` subclass, an empty capture (`EmptyLogError`), a
 number of gates that changes mid-file or differs from the header's
@@ -182,7 +183,8 @@ def assemble(
             _skip(skipped, number, line.reason, line.text, strict and message is None, source)
             if isinstance(message, LoggerHeader):
                 header = header or message
-                restart = restart or bool(records)  # a header after a record: a restart
+                # A header after a record is a restart, unless `record` asked for it.
+                restart = restart or (bool(records) and not message.requested)
             elif isinstance(message, Overflow):
                 lost += message.count
             elif isinstance(message, Gap):
