@@ -1,9 +1,10 @@
 """Lines in a capture that are not gate records but say something: the logger's and `record`'s.
 
 Contract: `parse_message` recognises one line and returns a `LoggerHeader`, an
-`Overflow` or a `Gap`, or None for any other line; `format_gap` writes the line
-`parse_message` reads back as a `Gap`. Each message starts with ``#``, so a terminal
-program shows it and the record pattern never matches it.
+`Overflow`, a `Gap` or a `Note`, or None for any other line; `format_gap` and
+`format_note` write the lines `parse_message` reads back as a `Gap` and a `Note`.
+Each message starts with ``#``, so a terminal program shows it and the record
+pattern never matches it.
 
 * The header, sent by the gate-logger firmware at start-up (after a reset)::
 
@@ -22,6 +23,11 @@ program shows it and the record pattern never matches it.
   after it::
 
       # metrosync record: gap of 12.345 s (port /dev/ttyACM0 vanished and came back)
+
+* Any other line of ``metrosync record``, a note for the reader of the capture (a line
+  cut off when the port vanished, no logger header seen)::
+
+      # metrosync record: no logger header seen ...
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ from ..errors import LogFormatError
 _HEADER = re.compile(r"^\s*#\s*metrosync gate-logger\s+(\S+)((?:\s+\w+=\S*)*)\s*$")
 _OVERFLOW = re.compile(r"^\s*#\s*overflow:\s*(\d+) records? lost\s*$")
 _GAP = re.compile(r"^\s*#\s*metrosync record: gap of ([0-9.]+(?:e[+-]?\d+)?) s\b.*$")
+_NOTE = re.compile(r"^\s*#\s*metrosync record: (.*?)\s*$")
 _NEEDED = ("channels", "tick_us", "counter_bits")
 #: The byte that asks the gate-logger firmware (1.1 and later) for its header again.
 HEADER_REQUEST = b"?"
@@ -75,7 +82,14 @@ class Gap:
     seconds: float
 
 
-def parse_message(line: str) -> LoggerHeader | Overflow | Gap | None:
+@dataclass(frozen=True)
+class Note:
+    """``metrosync record`` says ``text`` here; it does not change the time line."""
+
+    text: str
+
+
+def parse_message(line: str) -> LoggerHeader | Overflow | Gap | Note | None:
     """The message a line carries, or None when it is not one.
 
     Raises `LogFormatError` for a header that names the logger but lacks a needed key
@@ -87,7 +101,10 @@ def parse_message(line: str) -> LoggerHeader | Overflow | Gap | None:
         return Overflow(int(m[1]))
     if m := _GAP.match(line):
         seconds = float(m[1])
-        return Gap(seconds) if math.isfinite(seconds) else None
+        if math.isfinite(seconds):
+            return Gap(seconds)
+    if m := _NOTE.match(line):
+        return Note(m[1])
     if m := _HEADER.match(line):
         return _header(m[1], dict(pair.split("=", 1) for pair in m[2].split()), line)
     return None
@@ -112,6 +129,11 @@ def _header(version: str, pairs: dict[str, str], line: str) -> LoggerHeader:
             f"capture without it."
         ) from None
     return LoggerHeader(version, channels, tick, bits, baud, pairs, requested)
+
+
+def format_note(text: str) -> str:
+    """A note line of `record` (no line end)."""
+    return f"# metrosync record: {text}"
 
 
 def format_gap(seconds: float, port: str) -> str:

@@ -55,7 +55,7 @@ from ..errors import (
 )
 from .counter import check_bits, unwrap_segments
 from .gatelog import GateLog, SkippedLine
-from .messages import Gap, LoggerHeader, Overflow, parse_message
+from .messages import Gap, LoggerHeader, Note, Overflow, parse_message
 
 #: The logger follows at most this many gates.
 MAX_GATES = 8
@@ -129,10 +129,11 @@ class Line:
     gates: str | None = None
     value: int | None = None
     reason: str | None = None
-    message: LoggerHeader | Overflow | Gap | None = None
+    message: LoggerHeader | Overflow | Gap | Note | None = None
 
 
-_REASONS = {LoggerHeader: "logger header", Overflow: "logger overflow", Gap: "recording gap"}
+_REASONS = {LoggerHeader: "logger header", Overflow: "logger overflow", Gap: "recording gap",
+            Note: "note of metrosync record"}  # fmt: skip
 
 
 def split_lines(text: str) -> tuple[list[str], bool]:
