@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import select
 import time
 from pathlib import Path
@@ -184,7 +185,8 @@ def test_refusals_name_the_option(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "cannot open the serial port" in err and "list_ports" in err
     assert main(["record", "/dev/null", "--out", str(tmp_path / "b.log"), "--channels", "9"]) == 2
-    assert "`--channels` must be gates 0..7" in capsys.readouterr().err
+    assert ("`channels` (--channels) must be distinct gate indices in [0, 7] (a logger has at "
+            "most 8 gates), got [9]") in capsys.readouterr().err  # fmt: skip
     assert main(["record", "/dev/null", "--out", str(tmp_path / "c.log"), "--duration", "-1"]) == 2
     assert "`duration` (--duration) must be a time > 0 s" in capsys.readouterr().err
 
@@ -231,3 +233,32 @@ def test_channels_choose_the_gates_shown(tmp_path, gates):
     status = [line for _, line in record.lines if "gates 0:" in line]
     assert status and all(" 1:" not in line and " 2:" in line for line in status)
     assert "(duration)" in record.lines[-1][1]
+
+
+@pytest.mark.parametrize("header", [True, False])
+def test_channels_the_logger_lacks_are_refused_as_soon_as_it_says_how_many(tmp_path, header):
+    pty, out = Pty(), tmp_path / "run.log"
+    record = start(pty, out, "--channels", "0,7")
+    lines = CLEAN.splitlines(keepends=True)[:3]
+    pty.write(("" if not header else HEADER + "\n") + "".join(lines).replace("\n", "\r\n"))
+    sent = time.monotonic()
+    code, err = record.wait(timeout=20)
+    assert code == 2 and time.monotonic() - sent < 3
+    assert (f"`channels` (--channels) must be distinct gate indices in [0, 2] (the logger on "
+            f"{pty.path}: 3 gates per line), got [0, 7]") in err  # fmt: skip
+    # As `analyze` refuses the same list for the capture, which is kept.
+    assert f"lines recorded so far are in {str(out)!r}; give --overwrite" in err
+    assert out.read_text().startswith((HEADER + "\n" if header else "") + "".join(lines))
+    assert main(["analyze", str(out), "--channels", "0,7"]) == 2
+
+
+def test_a_gate_that_never_changes_is_shown_and_named(tmp_path):
+    pty, out = Pty(), tmp_path / "run.log"
+    record = start(pty, out, "--duration", "3")
+    unwired = re.sub(r"^([01](?:-[01])*) ", r"\1-1 ", CLEAN, flags=re.M)  # a steady 4th gate
+    replay(unwired, pty.master, speed=40)
+    code, err = record.wait()
+    assert code == 0, err
+    status = [line for _, line in record.lines if line.startswith("live ") and "r=" in line]
+    assert status and "3:never-changed" in status[-1] and "0:" in status[-1]
+    assert "warning: gate 3 never changed (not wired" in err and "analyze` leaves it out" in err

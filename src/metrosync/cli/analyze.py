@@ -66,7 +66,7 @@ def register(subparsers) -> None:
                      help="follow a LOG that is still being written (by `metrosync record` or "
                      "a terminal program), with a live panel; at Ctrl-C analyse it and write "
                      "--out/--plot")  # fmt: skip
-    add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt")
+    add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt", channels="--channels")
     add_audio_options(parser)
     parser.set_defaults(func=run)
 
