@@ -105,3 +105,58 @@ def test_without_avrdude_flash_says_what_to_install(build, tmp_path):
     done = make(f"BUILD={build}", "flash", f"AVRDUDE={tmp_path / 'no-avrdude'}")
     assert done.returncode != 0
     assert "no-avrdude not found" in done.stderr and "apt-get install avrdude" in done.stderr
+
+
+ARDUINO_AVR = Path("/usr/share/arduino/hardware/arduino/avr")  # Debian's arduino-core-avr
+
+
+def platform_flags(name: str) -> list[str]:
+    """A flag set of the Arduino AVR platform (platform.txt), as the IDE expands it."""
+    values = dict(row.split("=", 1) for row in (ARDUINO_AVR / "platform.txt").read_text()
+                  .splitlines() if "=" in row and not row.startswith("#"))  # fmt: skip
+    text = values[name].replace("{compiler.warning_flags}", values["compiler.warning_flags"])
+    return [flag for flag in text.split() if flag != "-MMD"]
+
+
+@pytest.mark.slow
+def test_the_arduino_sketch_builds_as_the_ide_builds_it_and_runs_alike(sim, tmp_path):
+    """docs/logger.md's Arduino IDE route: the sketch and gate_logger.c, compiled and
+    linked with the Arduino AVR core's flags and the core's library (whose main() the
+    firmware's replaces), make firmware that sends what the Makefile's sends."""
+    require("gcc-avr", "avr-libc", "arduino-core-avr")
+    core, variant = ARDUINO_AVR / "cores" / "arduino", ARDUINO_AVR / "variants" / "standard"
+    board = ["-mmcu=atmega328p", "-DF_CPU=16000000L", "-DARDUINO=10607", "-DARDUINO_AVR_UNO",
+             "-DARDUINO_ARCH_AVR", f"-I{core}", f"-I{variant}"]  # fmt: skip
+    c, cpp = platform_flags("compiler.c.flags"), platform_flags("compiler.cpp.flags")
+
+    def compile_(source: Path, obj: Path) -> bool:
+        cc = ["avr-gcc", *c] if source.suffix == ".c" else ["avr-g++", *cpp]
+        if source.suffix == ".S":
+            cc = ["avr-gcc", *platform_flags("compiler.S.flags")]
+        done = subprocess.run([*cc, *board, str(source), "-o", str(obj)], capture_output=True)
+        return done.returncode == 0
+
+    # The IDE turns the .ino into C++ that includes Arduino.h, and compiles the .c beside it.
+    sketch = tmp_path / "gate-logger.ino.cpp"
+    ino = (FIRMWARE_DIR / "gate-logger.ino").read_text()
+    sketch.write_text(f'#include <Arduino.h>\n#line 1 "gate-logger.ino"\n{ino}')
+    objects = [tmp_path / "sketch.o", tmp_path / "gate_logger.o"]
+    assert compile_(sketch, objects[0]) and compile_(FIRMWARE_DIR / "gate_logger.c", objects[1])
+    # The core's library; a file Debian's compiler cannot build (WString.cpp) is not
+    # needed by the firmware, and the link below would fail if it were.
+    sources = sorted(s for s in core.iterdir() if s.suffix in (".c", ".cpp", ".S"))
+    built = [tmp_path / f"core-{s.name}.o" for s in sources]
+    built = [o for s, o in zip(sources, built, strict=True) if compile_(s, o)]
+    assert any("main.cpp" in o.name for o in built) and any("wiring.c" in o.name for o in built)
+    subprocess.run(["avr-gcc-ar", "rcs", str(tmp_path / "core.a"), *map(str, built)], check=True)
+    elf = tmp_path / "gate-logger.ino.elf"
+    subprocess.run(["avr-gcc", *platform_flags("compiler.c.elf.flags"), "-mmcu=atmega328p",
+                    "-o", str(elf), *map(str, objects), str(tmp_path / "core.a"), "-lm"],
+                   check=True, capture_output=True)  # fmt: skip
+
+    from simlogger import run_logger
+
+    edges = [(0.01 + 0.013 * k, 1 + k % 8, 1 - (k // 8) % 2) for k in range(40)]
+    runs = [run_logger(sim.harness, firmware, edges, end=0.7, workdir=tmp_path, rx=[(0.3, 63)])
+            for firmware in (elf, sim.firmware())]  # fmt: skip
+    assert runs[0].text == runs[1].text and len(runs[0].lines) == 43
