@@ -17,7 +17,7 @@ sends its start-up header into the capture. When no header has come `HEADER_WAIT
 after the start, `record` sends `messages.HEADER_REQUEST`, which the gate-logger
 firmware 1.1 answers with its header (``requested=1``: not a restart). When none has
 come `REQUEST_WAIT` s later, or when the recording ends first, a note says so in the
-capture (`NO_HEADER`): the reader then takes the gate count from the records, and
+capture (`NO_HEADER`, `NO_HEADER_YET`): the reader then takes the gate count from the records, and
 the counter width from the largest value seen. The first line of such a capture may
 be a fragment of a line; the reader skips and counts it.
 
@@ -46,11 +46,15 @@ RETRY_EVERY = 0.5
 HEADER_WAIT = 2.0
 #: Seconds to wait for the header asked for (its line takes 10 ms at 115200 baud).
 REQUEST_WAIT = 1.0
-#: The note written when no header came.
+#: The note written when no header came, after a request for it or before one.
 NO_HEADER = (
-    "no logger header seen {when}: the board did not reset when its port was opened and "
-    "did not answer a request for the header (firmware before 1.1, or another logger); "
-    "the gate count and the counter width come from the records"
+    "no logger header seen after a request for it: the board did not reset when its port "
+    "was opened, and its firmware does not answer '?' (gate-logger before 1.1, or another "
+    "logger); the gate count and the counter width come from the records"
+)
+NO_HEADER_YET = (
+    "no logger header seen in the {seconds:.1f} s recorded (it is asked for after "
+    "{wait:g} s); the gate count and the counter width come from the records"
 )
 _LINE_END = re.compile(rb"\r\n|\r(?!$)|\n")
 
@@ -146,9 +150,9 @@ class HeaderWatch:
         if self.state != "waiting":
             return None
         self.state = "not seen"
-        when = ("after a request for it" if self.asked_at is not None else
-                f"in the {now - self.start:.1f} s recorded")  # fmt: skip
-        return format_note(NO_HEADER.format(when=when))
+        if self.asked_at is not None:
+            return format_note(NO_HEADER)
+        return format_note(NO_HEADER_YET.format(seconds=now - self.start, wait=HEADER_WAIT))
 
 
 def open_port(port: str, baud: int):
