@@ -2,7 +2,7 @@
  * Run the gate-logger firmware in simavr, drive its gate pins with edges at known
  * cycles, and copy its UART to stdout.
  *
- *   harness FIRMWARE.elf EDGES [--speed S] [--lines FILE]
+ *   harness FIRMWARE.elf EDGES [--speed S] [--lines FILE] [--rx-stdin]
  *
  * EDGES is a text file:
  *   init LLLLLLLL          levels of gates 1..8 before reset (1 = pin high)
@@ -15,6 +15,9 @@
  * --speed S   pace the output: S simulated seconds per wall-clock second (0, the
  *             default: as fast as the simulation runs).
  * --lines F   write to F, for each UART line, the cycle at which its last byte was sent.
+ * --rx-stdin  also pass the bytes that arrive on stdin (e.g. a pty's master end, where
+ *             a program writes to the port) to the UART's input, looking every
+ *             simulated millisecond.
  *
  * On stderr: "timer1-start-cycle N", the cycle at which the firmware started Timer1
  * (the origin of its tick count), and at the end "cycles N".
@@ -22,6 +25,8 @@
 
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
 #include <simavr/avr_extint.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_uart.h>
@@ -54,6 +59,7 @@ static FILE *lines_out;
 static char out_buf[256];
 static size_t out_len;
 static int uart_fd = -1; /* the UART's bytes go here: the process's stdout */
+static int rx_stdin;
 
 static void die(const char *what)
 {
@@ -123,6 +129,20 @@ static avr_cycle_count_t apply_edges(avr_t *avr, avr_cycle_count_t when, void *p
     return next_edge < n_edges ? edges[next_edge].cycle : 0;
 }
 
+static avr_cycle_count_t read_stdin(avr_t *avr, avr_cycle_count_t when, void *param)
+{
+    (void)avr;
+    (void)param;
+    struct pollfd p = {STDIN_FILENO, POLLIN, 0};
+    unsigned char buf[64];
+    if (poll(&p, 1, 0) > 0 && (p.revents & POLLIN)) {
+        ssize_t n = read(STDIN_FILENO, buf, sizeof buf);
+        for (ssize_t k = 0; k < n; k++)
+            avr_raise_irq(uart_in, buf[k]);
+    }
+    return when + F_CPU / 1000;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3)
@@ -134,7 +154,9 @@ int main(int argc, char **argv)
             lines_out = fopen(argv[++i], "w");
             if (!lines_out)
                 die("cannot write --lines file");
-        } else
+        } else if (!strcmp(argv[i], "--rx-stdin"))
+            rx_stdin = 1;
+        else
             die("unknown option");
     }
 
@@ -211,6 +233,10 @@ int main(int argc, char **argv)
     }
     if (n_edges)
         avr_cycle_timer_register(avr, edges[0].cycle, apply_edges, NULL);
+    if (rx_stdin) {
+        fcntl(STDIN_FILENO, F_SETFL, fcntl(STDIN_FILENO, F_GETFL) | O_NONBLOCK);
+        avr_cycle_timer_register(avr, F_CPU / 1000, read_stdin, NULL);
+    }
 
     clock_gettime(CLOCK_MONOTONIC, &wall_start);
     int timer_seen = 0, pins_set = 0;
