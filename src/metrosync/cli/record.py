@@ -16,8 +16,10 @@ def register(subparsers) -> None:
         help="record a light-gate logger's serial stream, with a live r(t)",
         description="Read the gate-logger's lines from a serial port and write them, line "
         "for line, to a capture file that `metrosync analyze` reads (flushed at once, synced "
-        "to disk every second). Shows a live panel: passes and BPM per gate, silent gates, "
-        "and r(t). Ctrl-C ends the recording cleanly.",
+        "to disk every second). A board that did not reset when the port opened is asked "
+        "for its header after 2 s; a note in the capture says when none came. Shows a live "
+        "panel: passes and BPM per gate, silent gates and gates that never changed (left "
+        "out of r), and r(t). Ctrl-C ends the recording cleanly.",
         formatter_class=HelpFormatter,
     )
     parser.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyACM0 or COM3")
