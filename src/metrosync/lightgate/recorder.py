@@ -17,9 +17,9 @@ sends its start-up header into the capture. When no header has come `HEADER_WAIT
 after the start, `record` sends `messages.HEADER_REQUEST`, which the gate-logger
 firmware 1.1 answers with its header (``requested=1``: not a restart). When none has
 come `REQUEST_WAIT` s later, or when the recording ends first, a note says so in the
-capture (`NO_HEADER`, `NO_HEADER_YET`): the reader then takes the gate count from the records, and
-the counter width from the largest value seen. The first line of such a capture may
-be a fragment of a line; the reader skips and counts it.
+capture (`NO_HEADER`, `NO_HEADER_YET`): the reader then takes the gate count from the
+records, and the counter width from the largest value seen. The first line of such a
+capture may be a fragment of a line; the reader skips and counts it.
 
 The capture is written in place, not atomically: it must grow while it is recorded.
 An existing file is refused unless ``overwrite``.
