@@ -42,7 +42,7 @@ SYNC_EVERY = 1.0
 #: Pause between attempts to reopen a vanished port, s.
 RETRY_EVERY = 0.5
 #: Seconds after the start to wait for a start-up header before asking for one: a
-#: board that resets when the port opens runs its bootloader first (up to ~1.5 s).
+#: board that resets when the port opens runs its bootloader first, for a second or so.
 HEADER_WAIT = 2.0
 #: Seconds to wait for the header asked for (its line takes 10 ms at 115200 baud).
 REQUEST_WAIT = 1.0
