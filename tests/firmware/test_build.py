@@ -161,3 +161,14 @@ def test_the_arduino_sketch_builds_as_the_ide_builds_it_and_runs_alike(sim, tmp_
     runs = [run_logger(sim.harness, firmware, edges, end=0.7, workdir=tmp_path, rx=[(0.3, 63)])
             for firmware in (elf, sim.firmware())]  # fmt: skip
     assert runs[0].text == runs[1].text and len(runs[0].lines) == 43
+
+
+def test_without_avr_libc_the_build_says_what_to_install(tmp_path):
+    env = bare_path(tmp_path)
+    fake = tmp_path / "bin" / "avr-gcc"  # a compiler that finds no avr/io.h
+    fake.write_text("#!/bin/sh\necho 'avr/io.h: No such file or directory' >&2\nexit 1\n")
+    fake.chmod(0o755)
+    done = make(f"BUILD={tmp_path / 'build'}", env=env)
+    assert done.returncode != 0
+    assert "avr-gcc has no avr-libc (avr/io.h not found)" in done.stderr
+    assert "apt-get install gcc-avr avr-libc" in done.stderr
