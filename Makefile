@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint bench clean system-deps firmware
+.PHONY: run test lint bench clean system-deps firmware flash
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,9 +26,14 @@ system-deps:
 test: $(STAMP) system-deps
 	$(BIN)/python -m pytest
 
-# The gate-logger firmware (needs gcc-avr and avr-libc): firmware/gate-logger/build/gate-logger.hex
+# The gate-logger firmware (needs gcc-avr and avr-libc): firmware/gate-logger/build/gate-logger.hex.
+# Options pass through and a changed one rebuilds: make firmware CHANNELS=7; make flash
+# CHANNELS=7 PORT=/dev/ttyACM0 (avrdude). Without the toolchain it says what to install.
 firmware:
 	$(MAKE) -C firmware/gate-logger
+
+flash:
+	$(MAKE) -C firmware/gate-logger flash
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

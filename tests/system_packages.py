@@ -19,6 +19,7 @@ PROBES = {
     "simavr": ("program", "simavr"),
     "libsimavr-dev": ("file", "/usr/include/simavr/sim_avr.h"),
     "gcc": ("program", "gcc"),
+    "arduino-core-avr": ("file", "/usr/share/arduino/hardware/arduino/avr/platform.txt"),
 }
 
 

@@ -18,7 +18,7 @@
  *             the hold-off shows as a spell of one hold-off (metrosync drops spells
  *             shorter than 0.5 ms as glitches).
  *   Output    8N1 at BAUD (115200) baud, lines ending CR LF:
- *               "# metrosync gate-logger 1.0 channels=8 tick_us=64 counter_bits=32
+ *               "# metrosync gate-logger 1.1 channels=8 tick_us=64 counter_bits=32
  *                baud=115200 holdoff_ticks=4"        once at start-up (one line), then
  *               "0-0-1-0-0-0-0-0 1450"               the levels at start-up, then one
  *                                                    line per change of any gate: gate 1
@@ -29,6 +29,11 @@
  *                                                    was full, at their place, followed
  *                                                    by a record of the levels as they
  *                                                    were when there was room again.
+ *   Input     a '?' received on the serial line asks for the header again: it is sent
+ *             as the next line, with " requested=1" at its end, so that a program that
+ *             opened the port without resetting the board (and so missed the first
+ *             header) can still learn the gate count, tick and counter width; the
+ *             added key tells it from the header of a restart. Other bytes are ignored.
  *   Buffering changes queue in a ring of RING_EVENTS (128) records drained by the UART,
  *             so a burst waits instead of being lost; only a ring that fills drops
  *             records, and the overflow line then says how many.
@@ -62,7 +67,8 @@
 #define START_TICKS 0UL
 #endif
 
-#define VERSION "1.0"
+#define VERSION "1.1"
+#define HEADER_REQUEST '?'
 #define STR_(x) #x
 #define STR(x) STR_(x)
 
@@ -104,12 +110,19 @@ static uint16_t since[8];           /* low 16 bits of the tick each hold-off beg
 static uint32_t lost;               /* records dropped since the last overflow record */
 
 /* The line being sent, drained byte by byte by the UART interrupt. */
-static char line[96];
+static char line[128];
 static volatile uint8_t line_len, line_pos;
+static volatile uint8_t header_requested; /* a HEADER_REQUEST byte came in */
 
 static inline uint8_t read_gates(void)
 {
-    uint8_t d = PIND, b = PINB; /* read back to back: 1 cycle apart */
+    /* Back to back, 1 cycle apart; again if port D changed in between, so that edges
+       on both ports at one instant are read together (one line), never split. */
+    uint8_t d, b;
+    do {
+        d = PIND;
+        b = PINB;
+    } while (d != PIND);
     return (uint8_t)(((d >> 2) & 0x3Fu) | ((b & 0x03u) << 6)) & GATE_MASK;
 }
 
@@ -155,8 +168,10 @@ static void push(uint8_t levels, uint32_t ticks)
    not in its hold-off, timestamped now. Interrupts must be off. */
 static void sample(void)
 {
-    uint32_t t = now_ticks();
+    /* The pins before the clock: an edge then always gets its own tick or the next,
+       never the tick before it (which a tick boundary between the two reads gave). */
     uint8_t pins = read_gates();
+    uint32_t t = now_ticks();
     uint8_t h = holding;
     if (h) {
         for (uint8_t k = 0; k < CHANNELS; k++) {
@@ -187,6 +202,14 @@ ISR(USART_UDRE_vect)
         UDR0 = (uint8_t)line[line_pos++];
     if (line_pos >= line_len)
         UCSR0B &= (uint8_t)~_BV(UDRIE0); /* line sent: the main loop sets up the next */
+}
+
+ISR(USART_RX_vect)
+{
+    uint8_t status = UCSR0A;
+    uint8_t c = UDR0; /* read in any case: it clears the interrupt */
+    if (c == HEADER_REQUEST && !(status & (_BV(FE0) | _BV(DOR0))))
+        header_requested = 1;
 }
 
 static uint8_t append(uint8_t n, const char *s)
@@ -254,13 +277,16 @@ static void setup(void)
     UBRR0H = UBRRH_VALUE;
     UBRR0L = UBRRL_VALUE;
     UCSR0C = _BV(UCSZ01) | _BV(UCSZ00); /* 8N1 */
-    UCSR0B = _BV(TXEN0);
+    UCSR0B = _BV(TXEN0) | _BV(RXEN0) | _BV(RXCIE0);
 
     PCMSK2 = PORTD_GATES;
     PCMSK0 = PORTB_GATES;
     PCIFR = _BV(PCIF2) | _BV(PCIF0);
     PCICR = (PORTD_GATES ? _BV(PCIE2) : 0) | (PORTB_GATES ? _BV(PCIE0) : 0);
 }
+
+#define HEADER "# metrosync gate-logger " VERSION " channels=" STR(CHANNELS) \
+               " tick_us=64 counter_bits=32 baud=" STR(BAUD) " holdoff_ticks=" STR(HOLDOFF_TICKS)
 
 int main(void)
 {
@@ -269,9 +295,7 @@ int main(void)
     reported = read_gates();
     put(KIND_CHANGE, reported, now_ticks());
     sei();
-    send_line(append(0, "# metrosync gate-logger " VERSION " channels=" STR(CHANNELS)
-                            " tick_us=64 counter_bits=32 baud=" STR(BAUD)
-                            " holdoff_ticks=" STR(HOLDOFF_TICKS)));
+    send_line(append(0, HEADER));
     set_sleep_mode(SLEEP_MODE_IDLE);
     for (;;) {
         cli();
@@ -284,6 +308,14 @@ int main(void)
             put(KIND_CHANGE, reported, now_ticks());
         }
         uint8_t busy = line_pos < line_len;
+        if (!busy && header_requested) {
+            /* Before the queued records: the header carries no time, and the program
+               that asked waits for it to read them. */
+            header_requested = 0;
+            sei();
+            send_line(append(0, HEADER " requested=1"));
+            continue;
+        }
         if (!busy && head != tail) {
             record_t r = ring[tail & (RING_EVENTS - 1)];
             tail++;

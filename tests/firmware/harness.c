@@ -2,18 +2,22 @@
  * Run the gate-logger firmware in simavr, drive its gate pins with edges at known
  * cycles, and copy its UART to stdout.
  *
- *   harness FIRMWARE.elf EDGES [--speed S] [--lines FILE]
+ *   harness FIRMWARE.elf EDGES [--speed S] [--lines FILE] [--rx-stdin]
  *
  * EDGES is a text file:
  *   init LLLLLLLL          levels of gates 1..8 before reset (1 = pin high)
  *   CYCLE GATE LEVEL       at CPU cycle CYCLE (16 per us), gate GATE (1..8) goes to LEVEL
+ *   CYCLE rx BYTE          at CPU cycle CYCLE the UART receives BYTE (0..255, decimal)
  *   end CYCLE              stop the simulation at this cycle
- * with edges in time order. Gate 1..6 is PD2..PD7 and gate 7..8 PB0..PB1, as in
+ * with edges and bytes in time order. Gate 1..6 is PD2..PD7 and gate 7..8 PB0..PB1, as in
  * the firmware.
  *
  * --speed S   pace the output: S simulated seconds per wall-clock second (0, the
  *             default: as fast as the simulation runs).
  * --lines F   write to F, for each UART line, the cycle at which its last byte was sent.
+ * --rx-stdin  also pass the bytes that arrive on stdin (e.g. a pty's master end, where
+ *             a program writes to the port) to the UART's input, looking every
+ *             simulated millisecond.
  *
  * On stderr: "timer1-start-cycle N", the cycle at which the firmware started Timer1
  * (the origin of its tick count), and at the end "cycles N".
@@ -21,6 +25,8 @@
 
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
 #include <simavr/avr_extint.h>
 #include <simavr/avr_ioport.h>
 #include <simavr/avr_uart.h>
@@ -39,19 +45,21 @@
 
 typedef struct {
     avr_cycle_count_t cycle;
-    int gate;
-    int level;
+    int gate;  /* 1..8, or 0: a byte for the UART */
+    int level; /* the gate's level, or the byte */
 } edge_t;
 
 static edge_t *edges;
 static size_t n_edges, next_edge;
 static avr_irq_t *gate_irq[8];
+static avr_irq_t *uart_in;
 static double speed;
 static struct timespec wall_start;
 static FILE *lines_out;
 static char out_buf[256];
 static size_t out_len;
 static int uart_fd = -1; /* the UART's bytes go here: the process's stdout */
+static int rx_stdin;
 
 static void die(const char *what)
 {
@@ -116,9 +124,23 @@ static avr_cycle_count_t apply_edges(avr_t *avr, avr_cycle_count_t when, void *p
     (void)when;
     while (next_edge < n_edges && edges[next_edge].cycle <= avr->cycle) {
         edge_t *e = &edges[next_edge++];
-        avr_raise_irq(gate_irq[e->gate - 1], (uint32_t)e->level);
+        avr_raise_irq(e->gate ? gate_irq[e->gate - 1] : uart_in, (uint32_t)e->level);
     }
     return next_edge < n_edges ? edges[next_edge].cycle : 0;
+}
+
+static avr_cycle_count_t read_stdin(avr_t *avr, avr_cycle_count_t when, void *param)
+{
+    (void)avr;
+    (void)param;
+    struct pollfd p = {STDIN_FILENO, POLLIN, 0};
+    unsigned char buf[64];
+    if (poll(&p, 1, 0) > 0 && (p.revents & POLLIN)) {
+        ssize_t n = read(STDIN_FILENO, buf, sizeof buf);
+        for (ssize_t k = 0; k < n; k++)
+            avr_raise_irq(uart_in, buf[k]);
+    }
+    return when + F_CPU / 1000;
 }
 
 int main(int argc, char **argv)
@@ -132,7 +154,9 @@ int main(int argc, char **argv)
             lines_out = fopen(argv[++i], "w");
             if (!lines_out)
                 die("cannot write --lines file");
-        } else
+        } else if (!strcmp(argv[i], "--rx-stdin"))
+            rx_stdin = 1;
+        else
             die("unknown option");
     }
 
@@ -157,9 +181,13 @@ int main(int argc, char **argv)
             continue;
         if (sscanf(row, "end %llu", &end) == 1)
             continue;
-        if (sscanf(row, "%llu %d %d", &c, &g, &l) != 3)
+        if (sscanf(row, "%llu rx %d", &c, &l) == 2) {
+            if (l < 0 || l > 255)
+                die("bad rx line");
+            g = 0;
+        } else if (sscanf(row, "%llu %d %d", &c, &g, &l) != 3)
             continue;
-        if (g < 1 || g > 8 || (l != 0 && l != 1))
+        else if (g < 1 || g > 8 || (l != 0 && l != 1))
             die("bad edge line");
         if (n_edges && c < edges[n_edges - 1].cycle)
             die("edges out of time order");
@@ -195,6 +223,7 @@ int main(int argc, char **argv)
     avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
                             uart_out, avr);
+    uart_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
 
     for (int g = 0; g < 8; g++) {
         char port = g < 6 ? 'D' : 'B';
@@ -204,6 +233,10 @@ int main(int argc, char **argv)
     }
     if (n_edges)
         avr_cycle_timer_register(avr, edges[0].cycle, apply_edges, NULL);
+    if (rx_stdin) {
+        fcntl(STDIN_FILENO, F_SETFL, fcntl(STDIN_FILENO, F_GETFL) | O_NONBLOCK);
+        avr_cycle_timer_register(avr, F_CPU / 1000, read_stdin, NULL);
+    }
 
     clock_gettime(CLOCK_MONOTONIC, &wall_start);
     int timer_seen = 0, pins_set = 0;

@@ -2,9 +2,9 @@
 
 `build_firmware` builds the firmware with `make` (test-only defines such as
 ``START_TICKS`` allowed), `build_harness` compiles ``harness.c`` against libsimavr,
-and `run_logger` runs the firmware on a list of gate edges and returns what its UART
-sent, with the cycle at which each line left it and the cycle at which Timer1 (the
-origin of the firmware's ticks) started.
+and `run_logger` runs the firmware on a list of gate edges (and bytes for its serial
+input) and returns what its UART sent, with the cycle at which each line left it and
+the cycle at which Timer1 (the origin of the firmware's ticks) started.
 """
 
 from __future__ import annotations
@@ -66,32 +66,40 @@ class LoggerRun:
         return self.text.splitlines()
 
 
-def edge_file(path: Path, edges, *, end: float, init: str = "00000000") -> Path:
-    """Write the harness's input: ``edges`` are (time s, gate 1..8, level) in time order."""
+def edge_file(path: Path, edges, *, end: float, init: str = "00000000", rx=()) -> Path:
+    """Write the harness's input: ``edges`` are (time s, gate 1..8, level) in time order,
+    ``rx`` (time s, byte) what the UART receives."""
+    timed = sorted([(round(t * F_CPU), f"{g} {lv}") for t, g, lv in edges]
+                   + [(round(t * F_CPU), f"rx {byte}") for t, byte in rx],
+                   key=lambda row: row[0])  # fmt: skip
     rows = [f"init {init}"]
-    rows += [f"{round(t * F_CPU)} {g} {lv}" for t, g, lv in edges]
+    rows += [f"{cycle} {what}" for cycle, what in timed]
     rows.append(f"end {round(end * F_CPU)}")
     Path(path).write_text("\n".join(rows) + "\n")
     return Path(path)
 
 
 def run_logger(harness: Path, elf: Path, edges, *, end: float, workdir: Path,
-               init: str = "00000000", speed: float = 0.0, stdout=None,
-               timeout: float = 120) -> LoggerRun | subprocess.Popen:  # fmt: skip
-    """Run the firmware on ``edges`` until ``end`` s (simulated).
+               init: str = "00000000", speed: float = 0.0, stdout=None, stdin=None,
+               timeout: float = 120, rx=()) -> LoggerRun | subprocess.Popen:  # fmt: skip
+    """Run the firmware on ``edges`` until ``end`` s (simulated), sending it the bytes
+    ``rx`` [(time s, byte)] on its serial input, and with ``stdin`` (a file descriptor,
+    e.g. the pty's master end) what arrives there too.
 
     With ``stdout`` (a file descriptor, e.g. a pty's master end) the harness writes the
     UART there, paced at ``speed`` simulated seconds per second, and the started
     process is returned; otherwise the run is waited for and returned as `LoggerRun`.
     """
     workdir = Path(workdir)
-    edges_path = edge_file(workdir / "edges.txt", edges, end=end, init=init)
+    edges_path = edge_file(workdir / "edges.txt", edges, end=end, init=init, rx=rx)
     lines_path = workdir / "line_cycles.txt"
     argv = [str(harness), str(elf), str(edges_path), "--lines", str(lines_path)]
     if speed:
         argv += ["--speed", repr(float(speed))]
+    if stdin is not None:
+        argv.append("--rx-stdin")
     if stdout is not None:
-        return subprocess.Popen(argv, stdout=stdout, stderr=subprocess.PIPE)
+        return subprocess.Popen(argv, stdin=stdin, stdout=stdout, stderr=subprocess.PIPE)
     done = subprocess.run(argv, capture_output=True, timeout=timeout, check=True)
     return LoggerRun(
         text=done.stdout.decode("ascii"),

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from simlogger import simulation_edges, timer_start
@@ -55,3 +57,37 @@ def test_simulation_through_the_firmware_and_a_pty_analyses_like_the_simulation(
     print(f"\nfirmware chain: max |r_capture - r_simulation| = {delta:.4f} "
           f"over {res.sizes['time']} points")  # fmt: skip
     assert delta < 0.006
+
+
+def test_a_board_that_did_not_reset_answers_record_s_request_for_its_header(sim, tmp_path):
+    from simlogger import run_logger
+
+    # The board runs before the port is opened, as one that does not reset on opening:
+    # its start-up header waits in the port, and opening the port discards it.
+    edges = sorted((0.05 * g + 0.25 * k + d, g, lv) for g in range(1, 5) for k in range(240)
+                   for d, lv in ((0.0, 1), (0.01, 0)))  # fmt: skip
+    pty, out = Pty(), tmp_path / "run.log"
+    # Real time, for as long as the test needs it (it stops the board when done).
+    logger = run_logger(sim.harness, sim.firmware(), edges, end=60.0, workdir=tmp_path,
+                        speed=1.0, stdout=pty.master, stdin=pty.master)  # fmt: skip
+    time.sleep(0.3)  # the header (10 ms) and a few records are out, unread
+    record = Command("record", pty.path, "--out", out)
+    try:
+        wait_until(out.exists)
+        wait_until(lambda: "requested=1" in out.read_text(), timeout=20)
+        time.sleep(0.5)  # a few records after it
+        code, err = record.interrupt()
+    finally:
+        record.kill()
+        logger.kill()
+        logger.wait(10)
+        logger.stderr.close()
+        pty.unplug()
+    assert code == 0, err
+    text = out.read_text()
+    # Only the header asked for: the start-up one was discarded with the port's input.
+    assert text.count("# metrosync gate-logger 1.1 channels=8 ") == 1
+    assert "no logger header" not in text + record.text
+    log = read_log(out)
+    assert log.header.requested and log.header.channels == 8 and log.restarts == ()
+    assert log.records_lost == 0 and len(log.ticks) > 30

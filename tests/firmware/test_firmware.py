@@ -79,7 +79,7 @@ def metronome_run(sim, tmp_path_factory):
 
 def test_reader_parses_every_line(metronome_run):
     edges, run = metronome_run
-    assert run.lines[0].startswith("# metrosync gate-logger 1.0 channels=8 tick_us=64 ")
+    assert run.lines[0].startswith("# metrosync gate-logger 1.1 channels=8 tick_us=64 ")
     log = parse_log(run.text, strict=True)  # strict: any line not understood is an error
     assert len(log.ticks) == len(run.lines) - 1
     assert [s.reason for s in log.skipped] == ["logger header"]
@@ -192,3 +192,27 @@ def test_fewer_channels_print_fewer_gates(sim, tmp_path):
                      workdir=tmp_path)  # fmt: skip
     assert " channels=3 " in run.lines[0]
     assert [line.split()[0] for line in run.lines[1:]] == ["0-0-0", "0-0-1", "0-0-0"]
+
+
+def test_a_question_mark_brings_the_header_again_between_records(sim, tmp_path):
+    # Gate 1 passes every 20 ms; '?' arrives once while idle and once inside a burst
+    # of all gates; another byte does nothing.
+    edges = [(0.01 + 0.02 * k + d, 1, lv) for k in range(20) for d, lv in ((0, 1), (0.005, 0))]
+    edges = sorted(edges + staggered_burst(6, start=0.2043))
+    rx = [(0.1037, ord("?")), (0.15, ord("x")), (0.2050, ord("?"))]
+    run = run_logger(sim.harness, sim.firmware(), edges, end=0.6, workdir=tmp_path, rx=rx)
+    headers = [i for i, line in enumerate(run.lines) if line.startswith("#")]
+    assert len(headers) == 3, run.lines
+    first = run.lines[0]
+    assert all(run.lines[i] == first + " requested=1" for i in headers[1:])
+    # Each requested header goes out as soon as the line under way is: its last byte
+    # leaves within its own time (108 bytes, 10.3 ms) plus a record's (3.1 ms) and the
+    # time of the '?' itself (87 us) after the '?' began.
+    took = run.line_cycles[headers[1:]] / F_CPU - [0.1037, 0.2050]
+    assert np.all((took > 0.0100) & (took < 0.0137)), took
+    # Nothing else moved: every record is there, each within a tick of its edge, and
+    # the reader takes a requested header for what it is, not for a restart.
+    assert_within_one_tick(run, edges)
+    log = parse_log(run.text, strict=True)
+    assert log.restarts == () and log.header.channels == 8 and log.records_lost == 0
+    assert len(log.ticks) == len(run.lines) - 3

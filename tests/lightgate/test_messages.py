@@ -37,6 +37,20 @@ def test_header_is_used_and_accounted_for():
     assert "gate-logger 1.0, 3 gates, 64 us tick, 32-bit counter" in log.report()
 
 
+def test_a_requested_header_is_not_a_restart_and_may_come_first_after_records():
+    requested = parse_message(HEADER + " requested=1")
+    assert requested.requested and not parse_message(HEADER).requested
+    assert requested.extra == {"holdoff_ticks": "4"}
+    # The port opened without a reset: a fragment, records, then the header asked for.
+    text = f"0 7\n{BODY}{HEADER} requested=1\n0-0-1 900\n"
+    log = parse_log(text)
+    assert log.restarts == () and log.header == requested and log.counter_bits == 32
+    assert log.ticks.tolist() == [0, 10, 20, 800, 810, 900]
+    # The same header without the key is a restart, which needs a marked gap.
+    with pytest.raises(TimestampError, match="restarted"):
+        parse_log(text.replace(" requested=1", ""))
+
+
 def test_a_wrap_of_the_32_bit_counter_is_unwrapped():
     text = f"{HEADER}\n0-0-0 4294967000\n1-0-0 4294967290\n0-0-0 4\n"
     log = parse_log(text)

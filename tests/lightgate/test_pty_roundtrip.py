@@ -29,7 +29,10 @@ def virtual_run():
                   trajectories=True, progress=False)  # fmt: skip
     gate = LightGate(offset=0.1, width=0.05, tick=64e-6, counter_bits=16, start_tick=50000)
     text = format_log(ds.time.values, ds.theta.values[:, 0, :], ds.theta_dot.values[:, 0, :], gate)
-    return ds, text
+    # A logger that resets when the port opens sends its header first (so `record`
+    # neither asks for it nor notes its absence: the capture is what was sent).
+    header = "# metrosync gate-logger 1.1 channels=7 tick_us=64 counter_bits=16 baud=115200\n"
+    return ds, header + text
 
 
 class FileWatcher(threading.Thread):

@@ -73,5 +73,7 @@ def test_refusals(tmp_path):
     two.write_text("0-0 1\n1-0 5\n0-0 9\n")
     with pytest.raises(ChannelCountError):
         analyze([DATA / "clean.log", two])
-    with pytest.raises(AnalysisError, match="gate 0"):
-        analyze([two])
+    # Gate 1 never changes: it is left out, with a warning; gate 0 has too few passes.
+    with pytest.warns(UserWarning, match="gate 1 never changed"):
+        with pytest.raises(AnalysisError, match="gate 0"):
+            analyze([two])

@@ -31,8 +31,9 @@ def follow(args, analyze_options: dict) -> int:
     reading = {k: analyze_options.pop(k) for k in ("tick", "counter_bits", "polarity", "strict")}
     follower = LogFollower(path, **reading)
     last = time.monotonic()
-    with LivePanel(follower, f"following {path} (Ctrl-C: analyse and stop)",
-                   channels=analyze_options.get("channels")) as panel:  # fmt: skip
+    title = f"following {path} (Ctrl-C: analyse and stop)"
+    with LivePanel(follower, title, channels=analyze_options.get("channels"),
+                   logger=str(path)) as panel:  # fmt: skip
         try:
             while True:
                 if follower.poll():

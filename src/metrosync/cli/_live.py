@@ -5,7 +5,10 @@ second it asks the `LogFollower` for the capture so far (its recent part, for a
 bounded cost), computes `live_status`, and shows it: on a terminal a `rich` panel
 redrawn in place, otherwise one plain line. An error of the analysis (a capture that
 is not readable yet, a gate count that changed) is shown in the panel and never
-stops the recording.
+stops the recording; but chosen ``channels`` that the logger does not have are
+refused (`ParameterError`, from `tick`) as soon as its header or its first records
+tell its gate count, with the check `analyze` makes. A gate that never changed is
+shown as such and named in a warning line: it is left out of r.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import sys
 import time
 
 from ..errors import EmptyLogError, MetrosyncError
+from ..lightgate.channels import check_channels, never_changed_text
 from ..lightgate.follow import LogFollower
 from ..lightgate.live import LiveStatus, live_status
 
@@ -31,13 +35,16 @@ class LivePanel:
     title : what is shown (e.g. ``"recording /dev/ttyACM0 -> run.log"``).
     channels : gates to show and use for r (0-based), or None for all.
     plain : plain lines even on a terminal.
+    logger : what sends the lines, for a refusal of ``channels`` ("the logger on COM3").
     """
 
     def __init__(self, follower: LogFollower, title: str, *, channels=None, plain=None,
-                 interval: float = 1.0, stream=None):  # fmt: skip
+                 interval: float = 1.0, stream=None, logger: str = "the logger"):  # fmt: skip
         self.follower = follower
         self.title = title
         self.channels = channels
+        self.logger = logger
+        self._checked = channels is None
         self.interval = interval
         self.stream = stream or sys.stdout
         self.plain = not self.stream.isatty() if plain is None else plain
@@ -63,7 +70,14 @@ class LivePanel:
         return False
 
     def tick(self, idle: float = 0.0, *, force: bool = False) -> None:
-        """Refresh when due (or ``force``); ``idle``: seconds since the last line arrived."""
+        """Refresh when due (or ``force``); ``idle``: seconds since the last line arrived.
+
+        Raises `ParameterError` when the chosen channels do not fit the logger's gates.
+        """
+        if not self._checked and (k := self.follower.gates) is not None:
+            check_channels(self.channels, k,
+                           where=f" ({self.logger}: {k} gates per line)")  # fmt: skip
+            self._checked = True
         now = time.monotonic()
         if not force and now < self._next:
             return
@@ -71,7 +85,8 @@ class LivePanel:
         status, note = None, ""
         try:
             status = live_status(self.follower.log(last=LIVE_LINES), channels=self.channels,
-                                 passes=self.follower.interruptions, idle=idle)  # fmt: skip
+                                 passes=self.follower.interruptions,
+                                 changes=self.follower.changes, idle=idle)  # fmt: skip
         except EmptyLogError:
             note = "waiting for the first record"
         except MetrosyncError as error:
@@ -87,9 +102,10 @@ class LivePanel:
         if status is None:
             return f"{head} {note}"
         gates = " ".join(
+            f"{g.gate}:never-changed" if g.never_changed else
             f"{g.gate}:{g.passes}p/{_num(g.bpm, '.1f')}bpm{'/SILENT' if g.silent else ''}"
             for g in status.gates
-        )
+        )  # fmt: skip
         lost = f" LOST={status.records_lost}" if status.records_lost else ""
         return (f"{head} r={_num(status.r_last, '.3f')} lag={_num(status.r_lag, '.1f')}s "
                 f"gates {gates}{lost}")  # fmt: skip
@@ -109,8 +125,12 @@ class LivePanel:
                            ("", "left")):  # fmt: skip
             table.add_column(name, justify=just)
         for g in status.gates:
-            state = (Text(f"SILENT for {_num(g.silent_for, '.0f')} s", style="bold red")
-                     if g.silent else Text("ok", style="green"))  # fmt: skip
+            if g.never_changed:
+                state = Text("never changed", style="yellow")
+            elif g.silent:
+                state = Text(f"SILENT for {_num(g.silent_for, '.0f')} s", style="bold red")
+            else:
+                state = Text("ok", style="green")
             table.add_row(str(g.gate), str(g.passes), _num(g.bpm, ".2f"), state)
         shown = status.r_time > status.r_time[-1] - R_SHOWN if status.r.size else []
         if status.r.size:
@@ -122,6 +142,10 @@ class LivePanel:
         else:
             r_line = Text("r(t): needs two gates with two passes each", style="dim")
         parts = [table, r_line]
+        if status.never_changed and len(status.never_changed) < len(status.gates):
+            # Only once another gate has changed: at the start every gate is unchanged.
+            parts.append(Text(f"{never_changed_text(status.never_changed)}: left out of r",
+                              style="yellow"))  # fmt: skip
         if status.records_lost:
             parts.append(Text(f"the logger LOST {status.records_lost} records (buffer full)",
                               style="bold red"))  # fmt: skip

@@ -46,7 +46,8 @@ def register(subparsers) -> None:
     g.add_argument("--strict", action="store_true", help="refuse any line that is not a record")
     c = parser.add_argument_group("cleaning and measuring")
     c.add_argument("--channels", type=int_list, default=None, metavar="I,J,...",
-                   help="gates to analyse, comma-separated, 0-based (default: all)")  # fmt: skip
+                   help="gates to analyse, comma-separated, 0-based (default: all; a gate "
+                   "that never changed is left out, with a warning)")  # fmt: skip
     c.add_argument("--glitch", type=float, default=DEFAULT_GLITCH, help="shortest real spell, s")
     c.add_argument("--min-asymmetry", type=float, default=DEFAULT_MIN_ASYMMETRY,
                    help="smallest (l-s)/(l+s) that tells the pass directions apart")  # fmt: skip
@@ -66,7 +67,7 @@ def register(subparsers) -> None:
                      help="follow a LOG that is still being written (by `metrosync record` or "
                      "a terminal program), with a live panel; at Ctrl-C analyse it and write "
                      "--out/--plot")  # fmt: skip
-    add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt")
+    add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt", channels="--channels")
     add_audio_options(parser)
     parser.set_defaults(func=run)
 

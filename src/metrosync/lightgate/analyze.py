@@ -26,6 +26,10 @@ and attrs ``r_eq`` (mean r over the final ``equilibrium_window``, default the la
 quarter of the grid), ``sigma_bpm`` (σ of ``frequency_bpm``, ddof=1),
 ``sigma_beats_per_tick`` (the same in the unit of the paper's tables), the
 options used, and the reading and cleaning reports.
+
+A gate whose level never changes in a log (an unwired gate of the 8-gate firmware, or
+a metronome that does not swing through its beam) is left out, with a warning that
+names it, and listed in attrs ``gates_never_changed`` (text, e.g. ``"7"``).
 """
 
 from __future__ import annotations
@@ -39,8 +43,9 @@ import xarray as xr
 
 from .._version import __version__
 from ..errors import AnalysisError, ChannelCountError, ParameterError
-from ..observables.order import equilibrium_order
 from ..observables import crossings as ph
+from ..observables.order import equilibrium_order
+from .channels import check_channels, never_changed, never_changed_text
 from .cleaning import (
     DEFAULT_GLITCH,
     DEFAULT_MAX_INTERRUPTION,
@@ -131,7 +136,8 @@ def analyze_logs(
                 f"{log.source} has {log.channels} gates but {logs[0].source} has {k}; "
                 f"repeated runs must use the same gates."
             )
-    chosen = _channels(channels, k)
+    asked = check_channels(channels, k)
+    chosen = _skip_never_changed(logs, asked)
     per_log = [[c[j] for j in chosen] for c in cleaned]
 
     spans = []
@@ -213,6 +219,7 @@ def analyze_logs(
         "path": (("log",), np.array([log.source for log in logs]), {"long_name": "log file"}),
     }  # fmt: skip
     attrs = {
+        "gates_never_changed": ",".join(str(g) for g in asked if g not in chosen),
         "r_eq": r_eq,
         "equilibrium_window": window,
         "sigma_bpm": sigma,
@@ -264,13 +271,24 @@ def _warn_missed_passes(sources, chosen, bridged, extra, irregular, kept) -> Non
             )
 
 
-def _channels(channels, k: int) -> list[int]:
-    if channels is None:
-        return list(range(k))
-    chosen = [int(c) for c in channels]
-    bad = [c for c in chosen if not 0 <= c < k]
-    if bad or not chosen or len(set(chosen)) != len(chosen):
-        raise ParameterError(
-            f"`channels` must be distinct gate indices in [0, {k - 1}], got {list(channels)!r}."
+def _skip_never_changed(logs: Sequence[GateLog], chosen: list[int]) -> list[int]:
+    """The chosen gates less those that never changed in some log, with a warning."""
+    dead = {g: [log.source for log in logs if g in never_changed(log.levels)] for g in chosen}
+    dead = {g: sources for g, sources in dead.items() if sources}
+    if not dead:
+        return chosen
+    kept = [g for g in chosen if g not in dead]
+    every = len(logs) > 1 and all(len(s) == len(logs) for s in dead.values())
+    where = "every log" if every else ", ".join(sorted({s for v in dead.values() for s in v}))
+    if not kept:
+        raise AnalysisError(
+            f"every gate chosen ({', '.join(map(str, chosen))}) never changed in {where}: no "
+            f"pendulum passed a beam. Check the wiring and the gates' places (docs/logger.md)."
         )
-    return chosen
+    warnings.warn(
+        f"{where}: {never_changed_text(list(dead))}: left out; the analysis uses gates "
+        f"{', '.join(map(str, kept))}. Give `channels` to choose the gates yourself.",
+        UserWarning,
+        stacklevel=3,
+    )
+    return kept

@@ -54,6 +54,7 @@ class LogFollower:
         self.records = 0
         self._changes = [0] * 8  # level changes per gate, over the whole capture
         self._last_gates: str | None = None
+        self._widths: list[int] = []  # gates per record of the last three records
         self._header: tuple[int, Line] | None = None  # the first header, and its index
         self._pending = ""  # text after the last complete line
         self._offset = 0
@@ -108,12 +109,28 @@ class LogFollower:
                 for k, (a, b) in enumerate(zip(last, line.gates, strict=True)):
                     self._changes[k] += a != b
             self._last_gates = line.gates
+            self._widths = [*self._widths[-2:], len(line.gates)]
         self.n_lines += len(new)
         if self.keep is not None and len(self.lines) > 2 * self.keep:
             del self.lines[: len(self.lines) - self.keep]
             if self._header is not None:
                 self._header = (-1, self._header[1])  # now before every kept line
         return len(new)
+
+    @property
+    def gates(self) -> int | None:
+        """Gates per record: the logger header's, or else that of the last three records
+        when they agree (the first line of a stream may be a fragment); None before."""
+        if self._header is not None:
+            return self._header[1].message.channels
+        if len(self._widths) == 3 and len(set(self._widths)) == 1:
+            return self._widths[0]
+        return None
+
+    @property
+    def changes(self) -> list[int]:
+        """Per gate, level changes over the whole capture."""
+        return list(self._changes)
 
     @property
     def interruptions(self) -> list[int]:

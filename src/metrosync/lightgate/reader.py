@@ -23,9 +23,10 @@ a terminal program are messy, so the reader
   the logger's start-up header (its tick must agree with ``tick``, and its counter
   width is used when ``counter_bits="auto"``), its overflow lines (``records_lost``),
   and a restart of the logger (a header after the first record, where its counter
-  began again): the records after it continue the time line after the wall-clock
-  gap that `record` marked before it. These lines are listed in ``skipped`` too (with
-  their reason), but ``strict`` does not refuse them.
+  began again; a header sent on request is not one): the records after it continue
+  the time line after the wall-clock gap that `record` marked before it. These lines
+  are listed in ``skipped`` too (with their reason), but ``strict`` does not refuse
+  them.
 
 It refuses, with a `LogFormatError` subclass, an empty capture (`EmptyLogError`), a
 number of gates that changes mid-file or differs from the header's
@@ -54,7 +55,7 @@ from ..errors import (
 )
 from .counter import check_bits, unwrap_segments
 from .gatelog import GateLog, SkippedLine
-from .messages import Gap, LoggerHeader, Overflow, parse_message
+from .messages import Gap, LoggerHeader, Note, Overflow, parse_message
 
 #: The logger follows at most this many gates.
 MAX_GATES = 8
@@ -128,10 +129,11 @@ class Line:
     gates: str | None = None
     value: int | None = None
     reason: str | None = None
-    message: LoggerHeader | Overflow | Gap | None = None
+    message: LoggerHeader | Overflow | Gap | Note | None = None
 
 
-_REASONS = {LoggerHeader: "logger header", Overflow: "logger overflow", Gap: "recording gap"}
+_REASONS = {LoggerHeader: "logger header", Overflow: "logger overflow", Gap: "recording gap",
+            Note: "note of metrosync record"}  # fmt: skip
 
 
 def split_lines(text: str) -> tuple[list[str], bool]:
@@ -182,7 +184,8 @@ def assemble(
             _skip(skipped, number, line.reason, line.text, strict and message is None, source)
             if isinstance(message, LoggerHeader):
                 header = header or message
-                restart = restart or bool(records)  # a header after a record: a restart
+                # A header after a record is a restart, unless `record` asked for it.
+                restart = restart or (bool(records) and not message.requested)
             elif isinstance(message, Overflow):
                 lost += message.count
             elif isinstance(message, Gap):
