@@ -22,7 +22,10 @@ a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
   the case differently) and is ``tock_gain`` (< 1) times as loud as the tick, so the
   tick is the louder, as `metrosync.audio.metronome` names them;
 - the first sample is the onset of the main impact (it is 0 there and rises within
-  0.3 ms), and the peak of the tick is ``level`` (≤ 1).
+  0.3 ms);
+- loudness is energy: the RMS of the tick over its first `LOUDNESS_WINDOW` (50 ms:
+  the impacts) is ``level · REFERENCE_RMS``. Peaks then differ between voices with
+  their crest factor (3 to 11 for drawn voices, so a drawn tick's peak stays below 1).
 
 The waveform is a pure function of the voice and the sample rate. The noise of the
 transient comes from the voice's own ``seed``, so a voice sounds the same every time.
@@ -49,6 +52,10 @@ LEVEL_RANGE = (0.85, 1.0)  # ±0.7 dB: makes differ in spectrum, hardly in loudn
 TRANSIENT_DECAY = 0.0004
 #: Rise time of an impact, s: the waveform starts at 0.
 ATTACK = 0.00008
+#: The tick's loudness is its RMS over this first part, s, ...
+LOUDNESS_WINDOW = 0.05
+#: ... which is ``level`` times this.
+REFERENCE_RMS = 0.09
 #: Highest resonance drawn, Hz.
 MAX_RESONANCE = 9000.0
 
@@ -66,7 +73,8 @@ class Voice:
     sub_gains : (J,) their amplitudes relative to the main impact.
     tock_shift : factor on the resonances for the tock (≠ 1).
     tock_gain : loudness of the tock relative to the tick (< 1).
-    level : peak of the tick, in (0, 1].
+    level : loudness of the tick (its RMS over `LOUDNESS_WINDOW` is
+        ``level · REFERENCE_RMS``), in (0, 1].
     transient : weight of the broadband transient of each impact, relative to the
         resonances.
     seed : seed of the transient's noise.
@@ -183,8 +191,9 @@ class Voice:
 
     def waveform(self, sample_rate: int, *, tock: bool = False) -> np.ndarray:
         """(L,) a tick (or, with ``tock``, a tock): the main impact at sample 0, the
-        secondary impacts after it; peak ``level`` for the tick, ``level · tock_gain``
-        for the tock. L = round(duration · sample_rate)."""
+        secondary impacts after it; RMS over `LOUDNESS_WINDOW` ``level · REFERENCE_RMS``
+        for the tick, ``tock_gain`` times that for the tock.
+        L = round(duration · sample_rate) + 1."""
         one = self.impact(sample_rate, tock=tock)
         out = np.zeros(int(round(self.duration * sample_rate)) + 1)
         out[: one.size] += one
@@ -192,8 +201,9 @@ class Voice:
             k = int(round(delay * sample_rate))
             n = min(one.size, out.size - k)
             out[k : k + n] += gain * one[:n]
-        peak = self.level * (self.tock_gain if tock else 1.0)
-        return out * (peak / np.abs(out).max())
+        rms = np.sqrt(np.mean(out[: int(round(LOUDNESS_WINDOW * sample_rate))] ** 2))
+        loudness = REFERENCE_RMS * self.level * (self.tock_gain if tock else 1.0)
+        return out * (loudness / rms)
 
 
 def voices(n: int, seed: int = 0) -> list[Voice]:
