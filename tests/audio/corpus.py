@@ -546,9 +546,9 @@ def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> n
 
 
 def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
-    """The direct sound (1) and a noise tail that falls 60 dB in rt60."""
+    """The direct sound (1) and a noise tail that falls 60 dB in rt60 (cut at −90 dB)."""
     rt60 = imp.reverb_rt60
-    t = np.arange(int(rt60 * rate)) / rate
+    t = np.arange(int(1.5 * rt60 * rate)) / rate
     tail = rng.normal(0.0, 1.0, t.size) * 10 ** (-3 * t / rt60)
     tail[: int(0.002 * rate)] = 0.0
     tail *= np.sqrt(10 ** (-imp.reverb_drr_db / 10) / np.sum(tail**2))
