@@ -56,6 +56,8 @@ ATTACK = 0.00008
 LOUDNESS_WINDOW = 0.05
 #: ... which is ``level`` times this.
 REFERENCE_RMS = 0.09
+#: Most voices `voices` draws at once.
+MAX_VOICES = 10000
 #: Highest resonance drawn, Hz.
 MAX_RESONANCE = 9000.0
 
@@ -209,9 +211,10 @@ class Voice:
 def voices(n: int, seed: int = 0) -> list[Voice]:
     """``n`` voices that differ from each other: their main resonances are drawn in
     ``n`` separate bands spanning `RESONANCE_RANGE` (log-spaced, in shuffled order),
-    so no two sound alike. The same (n, seed) gives the same voices."""
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 16:
-        raise ParameterError(f"`n` must be an integer in [1, 16], got {n!r}.")
+    so no two sound alike (the more voices, the closer their bands). The same
+    (n, seed) gives the same voices."""
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= MAX_VOICES:
+        raise ParameterError(f"`n` must be an integer in [1, {MAX_VOICES}], got {n!r}.")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
     rng = np.random.default_rng([26, int(seed), int(n)])
@@ -223,7 +226,7 @@ def voices(n: int, seed: int = 0) -> list[Voice]:
         # The middle 60 % of each band: neighbours stay apart.
         f0 = float(np.exp(rng.uniform(np.log(lo) * 0.8 + np.log(hi) * 0.2,
                                       np.log(lo) * 0.2 + np.log(hi) * 0.8)))  # fmt: skip
-        out.append(Voice.draw(int(seed) * 16 + i, main_resonance=f0))
+        out.append(Voice.draw(int(seed) * MAX_VOICES + i, main_resonance=f0))
     return out
 
 
