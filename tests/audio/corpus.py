@@ -87,7 +87,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy import fft as sp_fft
 from scipy import signal
 
 from metrosync.errors import ParameterError
@@ -408,7 +407,7 @@ def make_recording(
     n = int(round(duration * rate))
     gains = np.array([m.gains for m in mics]).T  # (N, C)
     shifts = np.round(np.array([m.delays for m in mics]).T * rate).astype(np.int64)
-    x = np.zeros((n, len(mics)))
+    x = np.zeros((n, len(mics)), dtype=np.float32)
     for i, train in enumerate(trains):
         dry = _render_train(train, rate, n)
         for c in range(len(mics)):
@@ -418,13 +417,13 @@ def make_recording(
     x = _impair(x, rate, impairments, rng, applied)
     if rate != sample_rate:
         g = math.gcd(rate, sample_rate)
-        x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0)
+        x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0).astype(np.float32)
         size = int(round(duration * sample_rate))
         x = np.pad(x[:size], ((0, max(0, size - x.shape[0])), (0, 0)))
     if impairments.quantize_bits:
         full = 2 ** (impairments.quantize_bits - 1)
-        x = np.clip(np.round(x * full), -full, full - 1) / full
-    x = np.clip(x, -1.0, 1.0).astype(np.float32)
+        x = np.clip(np.round(x * full), -full, full - 1) * np.float32(1 / full)
+    x = np.clip(x, -1.0, 1.0).astype(np.float32, copy=False)
     truth = [
         TrainTruth(
             t.times + shifts[i, 0] / rate,
@@ -477,7 +476,7 @@ def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
 def _render_train(train: TickTrain, rate: int, n: int) -> np.ndarray:
     """(n,) the train's ticks and tocks at the metronome, each placed at its nearest
     sample."""
-    out = np.zeros(n)
+    out = np.zeros(n, dtype=np.float32)
     onsets = np.round(train.times * rate).astype(np.int64)
     levels = train.gain * (np.ones(onsets.size) if train.levels is None else train.levels)
     for tock in (False, True):
@@ -488,8 +487,10 @@ def _render_train(train: TickTrain, rate: int, n: int) -> np.ndarray:
         index = onsets[which, None] + np.arange(wave.size)[None, :]
         values = levels[which, None] * wave[None, :]
         inside = index < n
-        # np.add.at: the ticks of a fast train may overlap.
-        np.add.at(out, index[inside], values[inside])
+        if np.all(np.diff(onsets[which]) >= wave.size):
+            out[index[inside]] += values[inside]  # no two overlap: each index once
+        else:
+            np.add.at(out, index[inside], values[inside])
     return out
 
 
@@ -498,11 +499,12 @@ def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> n
     if imp.reverb_rt60 is not None:
         applied["reverb_rt60"] = imp.reverb_rt60
         for c in range(channels):
-            x[:, c] = signal.oaconvolve(x[:, c], _room_response(imp, rate, rng))[:n]
+            room = _room_response(imp, rate, rng).astype(np.float32)
+            x[:, c] = signal.oaconvolve(x[:, c], room)[:n]
     if imp.snr_db is not None:
-        power = np.mean(x**2, axis=0)
+        power = np.mean(x.astype(float) ** 2, axis=0)
         noise = _noise(n, channels, imp.noise, rng)
-        x = x + noise * np.sqrt(power / 10 ** (imp.snr_db / 10))[None, :]
+        x += noise * np.sqrt(power / 10 ** (imp.snr_db / 10)).astype(np.float32)[None, :]
         applied["snr_db"] = imp.snr_db
     if imp.bumps:
         peak = np.abs(x).max()
@@ -531,17 +533,18 @@ def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> n
                 signal.butter(4, high, "lowpass", fs=rate, output="sos"),
             ]
         )
-        x = signal.sosfilt(sos, x, axis=0)
+        x = signal.sosfilt(sos.astype(np.float32), x, axis=0)
         applied["phone_band"] = (low, high)
     if imp.compression:
         x = _compress(x, rate, imp)
         applied["compression"] = (imp.compression_threshold_db, imp.compression_ratio)
-    peak = max(np.abs(x).max(), 1e-12)
+    peak = max(float(np.abs(x).max()), 1e-12)
     if imp.clipping is not None:
-        x = np.clip(x / (peak * imp.clipping), -1.0, 1.0)
+        x *= np.float32(1 / (peak * imp.clipping))
+        np.clip(x, -1.0, 1.0, out=x)
         applied["clipping"] = imp.clipping
     else:
-        x = x * (OUTPUT_PEAK / peak)
+        x *= np.float32(OUTPUT_PEAK / peak)
     return x
 
 
@@ -557,15 +560,17 @@ def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
 
 
 def _noise(n: int, channels: int, color: str, rng) -> np.ndarray:
-    """(n, channels) unit-power Gaussian noise, white or pink (1/f power above 20 Hz)."""
+    """(n, channels) unit-power Gaussian noise, white or pink: 1/f power (−3 dB per
+    octave) from 20 Hz up, through poles two per decade with a zero a quarter decade
+    above each (within 0.5 dB of 1/f from 50 Hz to 20 kHz)."""
     white = rng.standard_normal((n, channels), dtype=np.float32)
     if color == "white":
         return white
-    size = sp_fft.next_fast_len(n, real=True)
-    spectrum = sp_fft.rfft(white, size, axis=0)
-    f = sp_fft.rfftfreq(size)
-    spectrum /= np.sqrt(np.maximum(f, 20.0 / 44100)).astype(np.float32)[:, None]
-    pink = sp_fft.irfft(spectrum, size, axis=0)[:n]
+    rate = 48000  # the shape is set in Hz at this rate; the noise is scaled after
+    poles = 10.0 * 10 ** (np.arange(0, 8) / 2)
+    poles = poles[poles * 10**0.25 < 0.45 * rate]
+    z, p, k = signal.bilinear_zpk(-2 * np.pi * poles * 10**0.25, -2 * np.pi * poles, 1.0, rate)
+    pink = signal.sosfilt(signal.zpk2sos(z, p, k).astype(np.float32), white, axis=0)
     return pink / pink.std(axis=0)
 
 
@@ -573,12 +578,12 @@ def _compress(x: np.ndarray, rate: int, imp: Impairments) -> np.ndarray:
     """Feed-forward compression, each channel: level (dB) = the peak envelope (instant
     attack, exponential release) smoothed by the attack time constant; computed on
     blocks of `COMPRESSOR_BLOCK` samples (0.36 ms at 44.1 kHz, ten times shorter than
-    the attack) and interpolated."""
+    the attack)."""
     n = x.shape[0]
     blocks = -(-n // COMPRESSOR_BLOCK)
-    padded = np.zeros((blocks * COMPRESSOR_BLOCK, x.shape[1]))
+    padded = np.zeros((blocks * COMPRESSOR_BLOCK, x.shape[1]), dtype=np.float32)
     padded[:n] = np.abs(x)
-    block_peak = padded.reshape(blocks, COMPRESSOR_BLOCK, -1).max(axis=1)
+    block_peak = padded.reshape(blocks, COMPRESSOR_BLOCK, -1).max(axis=1).astype(float)
     level_db = 20 * np.log10(block_peak / max(block_peak.max(), 1e-12) + 1e-9)
     # Peak hold with exponential release, vectorised: the decaying maximum
     # max_m (L[m] − (k − m)·r) is the running maximum of L[m] + m·r, minus k·r.
@@ -592,7 +597,7 @@ def _compress(x: np.ndarray, rate: int, imp: Impairments) -> np.ndarray:
     smooth = signal.lfilter(b, den, held, axis=0, zi=zi)[0]
     over = np.maximum(smooth - imp.compression_threshold_db, 0.0)
     gain_db = -(1 - 1 / imp.compression_ratio) * over
-    centres = (np.arange(blocks) + 0.5) * COMPRESSOR_BLOCK
-    samples = np.arange(n)
-    gain = np.column_stack([np.interp(samples, centres, gain_db[:, c]) for c in range(x.shape[1])])
-    return x * 10 ** (gain / 20)
+    # Each block's gain for its samples: the level is smoothed over the attack (ten
+    # blocks and more), so the steps between blocks are small.
+    gain = np.repeat((10 ** (gain_db / 20)).astype(np.float32), COMPRESSOR_BLOCK, axis=0)[:n]
+    return x * gain
