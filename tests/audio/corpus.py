@@ -25,6 +25,12 @@ trains : sequence of `TickTrain`, one per metronome (1 to 8):
       of a run of `metrosync.simulate(..., trajectories=True)`: every crossing of θ_i
       through its escapement angle, upward a tick, downward a tock (audio time 0 at
       ``start``);
+    - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
+      phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
+      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5)``: n metronomes
+      drawn from the seed, free-running (tempos at least ``min_bpm_gap`` apart) or
+      ``locked`` (one tempo, phases within ``phase_spread`` beats), distinct voices
+      unless ``same_voice``: for tests over many recordings;
     - ``metrosync.show.ticks.voices(n, seed)``: n voices that differ from each other.
       A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
       ``voice=`` from `voices` to metronomes that should sound different, the same
@@ -77,6 +83,8 @@ Returns `Recording`:
         onsets at microphone c.
     applied : what the impairments drew (band corners, bump times and microphones, …).
     ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
+    ``Recording.files(starts)`` splits several microphones into one mono recording
+    each, as from phones started ``starts`` s late, with the truth of each.
 """
 
 from __future__ import annotations
@@ -275,6 +283,31 @@ class Recording:
     def channels(self) -> int:
         return 1 if self.samples.ndim == 1 else self.samples.shape[1]
 
+    def files(self, starts: Sequence[float] | None = None) -> list[Recording]:
+        """One mono recording per microphone, as if each were a phone of its own
+        started ``starts[c]`` s (≥ 0, default 0) after the first: its samples from
+        there on, its truth the onsets at that microphone minus its start (ticks
+        before the start left out; ``gains``, ``delays`` of that microphone)."""
+        starts = [0.0] * self.channels if starts is None else [float(s) for s in starts]
+        if len(starts) != self.channels or not all(0 <= s < self.duration for s in starts):
+            raise ParameterError(
+                f"`starts` must hold {self.channels} times in [0, {self.duration:g}) s, got "
+                f"{starts!r}."
+            )
+        samples = self.samples.reshape(self.samples.shape[0], -1)
+        out = []
+        for c, start in enumerate(starts):
+            k = int(round(start * self.sample_rate))
+            truth = []
+            for t in self.truth:
+                times = t.arrivals(c) - k / self.sample_rate
+                keep = times >= 0
+                truth.append(TrainTruth(times[keep], t.is_tock[keep], t.voice,
+                                        t.gains[c : c + 1], t.delays[c : c + 1]))  # fmt: skip
+            applied = dict(self.applied, start=k / self.sample_rate)
+            out.append(Recording(samples[k:, c].copy(), self.sample_rate, truth, applied))
+        return out
+
     def write(self, path: Path | str, subtype: str = "PCM_16") -> Path:
         import soundfile as sf
 
@@ -340,6 +373,75 @@ def steady_train(
     if level_jitter_db:
         levels = 10 ** (rng.normal(0.0, level_jitter_db, t.size) / 20)
     return TickTrain(t, is_tock, Voice.draw(seed) if voice is None else voice, gain, levels)
+
+
+def random_trains(
+    n: int,
+    duration: float,
+    *,
+    seed: int = 0,
+    bpm_range: tuple[float, float] = (90.0, 200.0),
+    locked: bool = False,
+    phase_spread: float = 0.1,
+    min_bpm_gap: float = 2.0,
+    same_voice: bool = False,
+    limp_max: float = 0.04,
+    drift_max_bpm_per_min: float = 1.0,
+    jitter_s: float = 0.0002,
+    level_jitter_db: float = 0.5,
+) -> list[TickTrain]:
+    """``n`` metronomes drawn from ``seed``, for tests over many recordings.
+
+    Free-running (default): tempos uniform in ``bpm_range``, at least ``min_bpm_gap``
+    apart; phases uniform. ``locked``: one tempo for all, phases within
+    ``phase_spread`` beats of each other (in step, as on the disk), the same drift.
+    Each has a limp uniform in [0, ``limp_max``], a drift uniform in
+    [0, ``drift_max_bpm_per_min``], and the given timing and level jitter. Voices
+    are ``voices(n, seed)`` (all different), or with ``same_voice`` one voice for all
+    (metronomes of one make).
+    """
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_TRAINS:
+        raise ParameterError(f"`n` must be an integer in [1, {MAX_TRAINS}], got {n!r}.")
+    low, high = bpm_range
+    if not (10 <= low <= high <= 600):
+        raise ParameterError(f"`bpm_range` must be (low, high) in [10, 600], got {bpm_range!r}.")
+    if not locked and (high - low) < (n - 1) * min_bpm_gap:
+        raise ParameterError(
+            f"`bpm_range` {bpm_range!r} cannot hold {n} tempos `min_bpm_gap` = "
+            f"{min_bpm_gap!r} apart; widen it or lower `min_bpm_gap`."
+        )
+    if not 0 <= phase_spread < 1:
+        raise ParameterError(f"`phase_spread` must be in [0, 1) beats, got {phase_spread!r}.")
+    from metrosync.show.ticks import voices as draw_voices
+
+    rng = np.random.default_rng([29, int(seed)])
+    if locked:
+        bpms = np.full(n, rng.uniform(low, high))
+        base = rng.uniform(0, 1 - phase_spread)
+        phases = base + rng.uniform(0, phase_spread, n)
+        drifts = np.full(n, rng.uniform(0, drift_max_bpm_per_min))
+    else:
+        while True:
+            bpms = rng.uniform(low, high, n)
+            if n == 1 or np.diff(np.sort(bpms)).min() >= min_bpm_gap:
+                break
+        phases = rng.uniform(0, 1, n)
+        drifts = rng.uniform(0, drift_max_bpm_per_min, n)
+    sounds = [Voice.draw(int(seed))] * n if same_voice else draw_voices(n, int(seed))
+    return [
+        steady_train(
+            float(bpms[i]),
+            duration,
+            phase=float(phases[i]),
+            limp=float(rng.uniform(0, limp_max)),
+            drift_bpm_per_min=float(drifts[i]),
+            jitter_s=jitter_s,
+            level_jitter_db=level_jitter_db,
+            voice=sounds[i],
+            seed=int(seed) * MAX_TRAINS + i,
+        )  # fmt: skip
+        for i in range(n)
+    ]
 
 
 def simulated_trains(

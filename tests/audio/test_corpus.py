@@ -10,6 +10,7 @@ from corpus import (
     Microphone,
     TickTrain,
     make_recording,
+    random_trains,
     simulated_trains,
     steady_train,
 )
@@ -93,6 +94,25 @@ def test_given_microphones_set_gains_and_delays():
     np.testing.assert_allclose(rec.truth[0].arrivals(1), rec.truth[0].times + 0.01)
 
 
+def test_microphones_split_into_phones_started_at_different_times(four):
+    rec = make_recording(four, microphones=2, seed=5)
+    files = rec.files([0.0, 1.25])
+    assert [f.channels for f in files] == [1, 1]
+    assert files[1].samples.size == rec.samples.shape[0] - round(1.25 * 44100)
+    np.testing.assert_array_equal(files[1].samples, rec.samples[round(1.25 * 44100) :, 1])
+    for i, truth in enumerate(files[1].truth):
+        want = rec.truth[i].arrivals(1) - 1.25
+        np.testing.assert_allclose(truth.times, want[want >= 0])
+        assert truth.gains[0] == rec.truth[i].gains[1]
+    # (The file may open in the ring of a tick struck before it started: from 0.2 s.)
+    late = [(i, k) for i, k in isolated(files[1].truth) if files[1].truth[i].times[k] > 0.2]
+    errors = [first_rise(files[1].samples, files[1].truth[i].times[k], 44100)
+              - files[1].truth[i].times[k] for i, k in late]  # fmt: skip
+    assert len(errors) > 20 and np.max(np.abs(errors)) <= 1e-4
+    with pytest.raises(ParameterError, match="`starts`"):
+        rec.files([0.0])
+
+
 def test_the_same_seed_gives_the_same_recording(four):
     a = make_recording(four, impairments=Impairments.phone(), seed=2)
     b = make_recording(four, impairments=Impairments.phone(), seed=2)
@@ -173,6 +193,30 @@ def test_jitter_and_level_jitter_are_seeded_and_of_the_size_asked():
     displacement = a.times - steady_train(120, 120.0).times[: a.times.size]
     assert displacement.std() == pytest.approx(0.001, rel=0.15)
     assert np.std(20 * np.log10(a.levels)) == pytest.approx(1.0, rel=0.15)
+
+
+def test_random_free_running_trains_keep_their_tempos_apart_and_voices_distinct():
+    for seed in range(20):
+        trains = random_trains(4, 30.0, seed=seed, min_bpm_gap=4.0)
+        bpm = [120 / (t.times[2] - t.times[0]) for t in trains]  # one full swing
+        assert np.diff(np.sort(bpm)).min() > 3.5
+        assert all(85 < b < 205 for b in bpm)
+        assert len({t.voice for t in trains}) == 4
+    assert [t.times.size for t in random_trains(3, 30.0, seed=5)] == [
+        t.times.size for t in random_trains(3, 30.0, seed=5)
+    ]
+
+
+def test_random_locked_trains_share_a_tempo_and_stay_in_step():
+    trains = random_trains(3, 60.0, seed=2, locked=True, phase_spread=0.05, same_voice=True)
+    assert len({t.voice for t in trains}) == 1
+    counts = {t.times.size for t in trains}
+    assert max(counts) - min(counts) <= 1
+    k = min(counts)
+    spread = np.ptp([t.times[:k] for t in trains], axis=0)
+    period = np.median(np.diff(trains[0].times))
+    # In step: within the phase spread plus the limp's half and the jitter.
+    assert spread.max() < (0.05 + 0.02) * period + 0.002
 
 
 # --- impairments ---------------------------------------------------------------------
