@@ -52,9 +52,10 @@ impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
     2. background noise at ``snr_db``: ``noise`` ("pink" or "white") Gaussian noise
        whose power is ``snr_db`` dB below the mean power of the signal so far (whole
        recording, each microphone);
-    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 25–90 Hz
-       sinusoid, 40–120 ms, peak 0.5–2 times the signal's peak) at uniform random
-       times, each on one random microphone;
+    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
+       sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
+       height; peak 0.5–2 times the signal's peak) at uniform random times, each on
+       one random microphone;
     4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
        and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
        high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay
@@ -609,19 +610,15 @@ def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> n
         x += noise * np.sqrt(power / 10 ** (imp.snr_db / 10)).astype(np.float32)[None, :]
         applied["snr_db"] = imp.snr_db
     if imp.bumps:
-        peak = np.abs(x).max()
+        peak = float(np.abs(x).max())
         bumps = []
         for _ in range(imp.bumps):
             t0, c = rng.uniform(0, n / rate), int(rng.integers(channels))
-            length = rng.uniform(0.04, 0.12)
-            t = np.arange(int(length * rate)) / rate
-            f = rng.uniform(25, 90)
-            thump = np.sin(2 * np.pi * f * t) * np.exp(-t / (length / 4)) * (1 - np.exp(-t / 0.002))
-            thump *= rng.uniform(0.5, 2.0) * peak / np.abs(thump).max()
+            bumps.append((int(t0 * rate) / rate, c))
             k = int(t0 * rate)
+            thump = _thump(rate, rng) * peak
             m = min(thump.size, n - k)
             x[k : k + m, c] += thump[:m]
-            bumps.append((float(k / rate), c))
         applied["bumps"] = sorted(bumps)
     if imp.phone_band is not False:
         if imp.phone_band is True:
@@ -648,6 +645,19 @@ def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> n
     else:
         x *= np.float32(OUTPUT_PEAK / peak)
     return x
+
+
+def _thump(rate: int, rng) -> np.ndarray:
+    """A hand bumping the phone, peak 0.5–2: a damped 40–150 Hz sinusoid lasting
+    50–150 ms (decay time a quarter of that), opened by the contact's broadband
+    crack (1 ms decaying noise, 0.2–0.5 of the thump's peak)."""
+    length = rng.uniform(0.05, 0.15)
+    t = np.arange(int(length * rate)) / rate
+    body = np.sin(2 * np.pi * rng.uniform(40, 150) * t) * np.exp(-t / (length / 4))
+    body *= (1 - np.exp(-t / 0.002)) / np.abs(body).max()
+    crack = rng.normal(0.0, 1.0, t.size) * np.exp(-t / 0.001)
+    crack *= rng.uniform(0.2, 0.5) / np.abs(crack).max()
+    return ((body + crack) * rng.uniform(0.5, 2.0)).astype(np.float32)
 
 
 def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
