@@ -17,7 +17,9 @@ a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
   amplitudes ``weights``; the slowest decays 60 dB in ``ring`` seconds, the others
   faster (``decays``, fractions of it);
 - impact j ≥ 1 is the same sound, ``sub_gains[j-1]`` times as loud, starting
-  ``sub_delays[j-1]`` s after the main impact;
+  ``sub_delays[j-1]`` s after the main impact. As heard, the ring of the earlier
+  impacts adds in or out of phase: the waveform's peak at a secondary impact is
+  0.39–0.78 of the main one's for 90 % of drawn voices (median 0.57);
 - the tock rings at the resonances times ``tock_shift`` (a different pallet excites
   the case differently) and is ``tock_gain`` (< 1) times as loud as the tick, so the
   tick is the louder, as `metrosync.audio.metronome` names them;
@@ -47,7 +49,7 @@ RING_RANGE = (0.07, 0.09)  # s for the slowest resonance to fall by 60 dB
 RESONANCE_RANGE = (800.0, 4500.0)  # Hz, the main resonance
 TOCK_GAIN_RANGE = (0.6, 0.85)
 TOCK_SHIFT_RANGE = (0.06, 0.15)  # |tock_shift − 1|
-LEVEL_RANGE = (0.85, 1.0)  # ±0.7 dB: makes differ in spectrum, hardly in loudness
+LEVEL_RANGE = (0.85, 1.0)  # 1.4 dB: makes differ in spectrum, hardly in loudness
 #: Length of the broadband transient of an impact (decay time), s.
 TRANSIENT_DECAY = 0.0004
 #: Rise time of an impact, s: the waveform starts at 0.
