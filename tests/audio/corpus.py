@@ -351,7 +351,7 @@ def steady_train(
             f"`jitter_s` must be in [0, a tenth of a beat) and `level_jitter_db` in [0, 12], "
             f"got {jitter_s!r} and {level_jitter_db!r}."
         )
-    rng = np.random.default_rng([27, int(seed)])
+    rng = np.random.default_rng([27, _seed(seed)])
     # Beats counted since t = 0: n(t) = b t + c t² with b = bpm/60 and c = drift/7200
     # (the tempo bpm + drift·t/60); tick k (unlimped) falls where n = k + phase.
     b, c = bpm / 60.0, drift_bpm_per_min / 7200.0
@@ -415,7 +415,7 @@ def random_trains(
         raise ParameterError(f"`phase_spread` must be in [0, 1) beats, got {phase_spread!r}.")
     from metrosync.show.ticks import voices as draw_voices
 
-    rng = np.random.default_rng([29, int(seed)])
+    rng = np.random.default_rng([29, _seed(seed)])
     if locked:
         bpms = np.full(n, rng.uniform(low, high))
         base = rng.uniform(0, 1 - phase_spread)
@@ -496,7 +496,11 @@ def make_recording(
         raise ParameterError(
             f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
         )
-    rng = np.random.default_rng([28, int(seed)])
+    if not isinstance(impairments, Impairments):
+        raise ParameterError(
+            f"`impairments` must be an Impairments (e.g. Impairments.phone()), got {impairments!r}."
+        )
+    rng = np.random.default_rng([28, _seed(seed)])
     mics = _microphones(microphones, len(trains), rng)
     last = max((float(t.times[-1]) for t in trains if t.times.size), default=0.0)
     if duration is None:
@@ -538,6 +542,12 @@ def make_recording(
         for i, t in enumerate(trains)
     ]
     return Recording(x[:, 0] if len(mics) == 1 else x, sample_rate, truth, applied)
+
+
+def _seed(seed) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
+    return int(seed)
 
 
 def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:

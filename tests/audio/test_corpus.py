@@ -156,6 +156,11 @@ def test_simulated_trains_tick_at_the_crossings_upward_and_tock_downward():
         (lambda: make_recording([steady_train(100, 2)], microphones=0), "`microphones`"),
         (lambda: make_recording([steady_train(100, 2)], duration=1.0), "`duration`"),
         (lambda: make_recording([steady_train(100, 2)], sample_rate=100), "`sample_rate`"),
+        (lambda: make_recording([steady_train(100, 2)], seed=-1), "`seed`"),
+        (lambda: make_recording([steady_train(100, 2)], impairments=True), "`impairments`"),
+        (lambda: steady_train(100, 2, seed=1.5), "`seed`"),
+        (lambda: random_trains(3, 10, bpm_range=(100, 101), min_bpm_gap=2), "`bpm_range`"),
+        (lambda: random_trains(9, 10), "`n`"),
     ],
 )
 def test_bad_arguments_are_named(call, name):
