@@ -7,13 +7,15 @@ Entry point::
                    impairments=Impairments(), duration=None, seed=0) -> Recording
 
 trains : sequence of `TickTrain`, one per metronome (1 to 8):
-    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None)`` — the onsets (s, at the
-    metronome) of each tick's FIRST impact, which ticks are tocks, the metronome's
-    sound (`metrosync.show.ticks.Voice`), its loudness, and optional per-tick level
-    factors (K,). Build them with
+    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)`` —
+    the onsets (s, at the metronome) of each tick's FIRST impact, which ticks are
+    tocks, the metronome's sound (`metrosync.show.ticks.Voice`), its loudness,
+    optional per-tick level factors (K,), and how much (s, std) the secondary impacts
+    of each tick wander about the voice's delays. Build them with
 
     - ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
-      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0)``:
+      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
+      bounce_jitter_s=0)``:
       a free-running metronome; ``bpm`` ticks per minute (tick and tock each count),
       the first tick at ``phase`` beats (0 ≤ phase < 1), beats alternating
       (1 ± limp/2)·T (limp = (long − short)/mean beat, a fraction, as
@@ -27,7 +29,8 @@ trains : sequence of `TickTrain`, one per metronome (1 to 8):
       ``start``);
     - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
       phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
-      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5)``: n metronomes
+      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
+      bounce_jitter_s=0)``: n metronomes
       drawn from the seed, free-running (tempos at least ``min_bpm_gap`` apart) or
       ``locked`` (one tempo, phases within ``phase_spread`` beats), distinct voices
       unless ``same_voice``: for tests over many recordings;
@@ -90,6 +93,7 @@ Returns `Recording`:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -106,6 +110,8 @@ DISK_RADIUS = 0.27  # m, as in the experiment
 OUTPUT_PEAK = 0.9
 MAX_TRAINS = 8
 MAX_MICROPHONES = 8
+#: Variants of a tick (and of a tock) rendered for a train with bounce jitter.
+BOUNCE_VARIANTS = 16
 #: Samples per level measurement of the compressor.
 COMPRESSOR_BLOCK = 16
 
@@ -119,6 +125,9 @@ class TickTrain:
     voice : the metronome's sound.
     gain : its loudness (the tick's peak is ``gain · voice.level`` before impairments).
     levels : (K,) optional factor on each tick's loudness.
+    bounce_jitter_s : standard deviation of each tick's secondary-impact delays about
+        the voice's, s (the pallet bounces a little differently each time; rendered
+        from `BOUNCE_VARIANTS` variants of the tick and of the tock).
     """
 
     times: np.ndarray
@@ -126,8 +135,13 @@ class TickTrain:
     voice: Voice
     gain: float = 1.0
     levels: np.ndarray | None = None
+    bounce_jitter_s: float = 0.0
 
     def __post_init__(self) -> None:
+        if not (0 <= self.bounce_jitter_s <= 0.005):
+            raise ParameterError(
+                f"`bounce_jitter_s` must be in [0, 0.005] s, got {self.bounce_jitter_s!r}."
+            )
         times = np.asarray(self.times, dtype=float)
         is_tock = np.asarray(self.is_tock, dtype=bool)
         if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(times < 0):
@@ -332,6 +346,7 @@ def steady_train(
     voice: Voice | None = None,
     gain: float = 1.0,
     seed: int = 0,
+    bounce_jitter_s: float = 0.0,
 ) -> TickTrain:
     """A free-running metronome (see the module docstring); ticks in [0, duration)."""
     if not (math.isfinite(bpm) and 10 <= bpm <= 600):
@@ -373,7 +388,8 @@ def steady_train(
     levels = None
     if level_jitter_db:
         levels = 10 ** (rng.normal(0.0, level_jitter_db, t.size) / 20)
-    return TickTrain(t, is_tock, Voice.draw(seed) if voice is None else voice, gain, levels)
+    voice = Voice.draw(seed) if voice is None else voice
+    return TickTrain(t, is_tock, voice, gain, levels, bounce_jitter_s)
 
 
 def random_trains(
@@ -390,6 +406,7 @@ def random_trains(
     drift_max_bpm_per_min: float = 1.0,
     jitter_s: float = 0.0002,
     level_jitter_db: float = 0.5,
+    bounce_jitter_s: float = 0.0,
 ) -> list[TickTrain]:
     """``n`` metronomes drawn from ``seed``, for tests over many recordings.
 
@@ -440,7 +457,8 @@ def random_trains(
             level_jitter_db=level_jitter_db,
             voice=sounds[i],
             seed=int(seed) * MAX_TRAINS + i,
-        )  # fmt: skip
+            bounce_jitter_s=bounce_jitter_s,
+        )
         for i in range(n)
     ]
 
@@ -516,7 +534,7 @@ def make_recording(
     shifts = np.round(np.array([m.delays for m in mics]).T * rate).astype(np.int64)
     x = np.zeros((n, len(mics)), dtype=np.float32)
     for i, train in enumerate(trains):
-        dry = _render_train(train, rate, n)
+        dry = _render_train(train, rate, n, np.random.default_rng([30, seed, i]))
         for c in range(len(mics)):
             s = shifts[i, c]
             x[s:, c] += gains[i, c] * dry[: n - s]
@@ -586,25 +604,42 @@ def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
     return mics
 
 
-def _render_train(train: TickTrain, rate: int, n: int) -> np.ndarray:
+def _render_train(train: TickTrain, rate: int, n: int, rng) -> np.ndarray:
     """(n,) the train's ticks and tocks at the metronome, each placed at its nearest
-    sample."""
+    sample; with bounce jitter, each tick one of `BOUNCE_VARIANTS` variants drawn
+    from ``rng``."""
     out = np.zeros(n, dtype=np.float32)
     onsets = np.round(train.times * rate).astype(np.int64)
     levels = train.gain * (np.ones(onsets.size) if train.levels is None else train.levels)
+    variants = 1 if train.bounce_jitter_s == 0 or not train.voice.sub_delays else BOUNCE_VARIANTS
+    pick = rng.integers(variants, size=onsets.size)
     for tock in (False, True):
-        which = train.is_tock == tock
-        if not which.any():
-            continue
-        wave = train.voice.waveform(rate, tock=tock)
-        index = onsets[which, None] + np.arange(wave.size)[None, :]
-        values = levels[which, None] * wave[None, :]
-        inside = index < n
-        if np.all(np.diff(onsets[which]) >= wave.size):
-            out[index[inside]] += values[inside]  # no two overlap: each index once
-        else:
-            np.add.at(out, index[inside], values[inside])
+        for v in range(variants):
+            which = (train.is_tock == tock) & (pick == v)
+            if not which.any():
+                continue
+            voice = (
+                train.voice if variants == 1 else _bounced(train.voice, train.bounce_jitter_s, rng)
+            )
+            wave = voice.waveform(rate, tock=tock)
+            index = onsets[which, None] + np.arange(wave.size)[None, :]
+            values = levels[which, None] * wave[None, :]
+            inside = index < n
+            if np.all(np.diff(onsets[which]) >= wave.size):
+                out[index[inside]] += values[inside]  # no two overlap: each index once
+            else:
+                np.add.at(out, index[inside], values[inside])
     return out
+
+
+def _bounced(voice: Voice, jitter: float, rng) -> Voice:
+    """The voice with its secondary-impact delays moved by Gaussian ``jitter`` (s),
+    kept at least 5 ms after the main impact and 2 ms after each other."""
+    moved = np.sort(np.asarray(voice.sub_delays) + rng.normal(0.0, jitter, len(voice.sub_delays)))
+    delays = []
+    for d in moved:
+        delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
+    return dataclasses.replace(voice, sub_delays=tuple(delays))
 
 
 def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> np.ndarray:

@@ -161,6 +161,7 @@ def test_simulated_trains_tick_at_the_crossings_upward_and_tock_downward():
         (lambda: steady_train(100, 2, seed=1.5), "`seed`"),
         (lambda: random_trains(3, 10, bpm_range=(100, 101), min_bpm_gap=2), "`bpm_range`"),
         (lambda: random_trains(9, 10), "`n`"),
+        (lambda: steady_train(100, 2, bounce_jitter_s=0.1), "`bounce_jitter_s`"),
     ],
 )
 def test_bad_arguments_are_named(call, name):
@@ -222,6 +223,29 @@ def test_random_locked_trains_share_a_tempo_and_stay_in_step():
     period = np.median(np.diff(trains[0].times))
     # In step: within the phase spread plus the limp's half and the jitter.
     assert spread.max() < (0.05 + 0.02) * period + 0.002
+
+
+def test_bounce_jitter_moves_the_secondary_impacts_not_the_first():
+    voice = Voice.draw(0)  # one secondary impact
+    assert len(voice.sub_delays) == 1
+    train = steady_train(60, 40.0, voice=voice, bounce_jitter_s=0.001)
+    rec = make_recording([train], seed=3)
+    x = rec.samples.astype(float)
+    sos = signal.butter(8, 12000, "highpass", fs=44100, output="sos")
+    high = np.abs(signal.sosfiltfilt(sos, x))
+    bounces, starts = [], []
+    for t in rec.truth[0].times:
+        k = int(round(t * 44100))
+        starts.append(first_rise(rec.samples, t, 44100) - t)
+        main = np.argmax(high[k : k + int(0.002 * 44100)])
+        window = high[k + int(0.005 * 44100) : k + int(0.05 * 44100)]
+        bounces.append((np.argmax(window) + int(0.005 * 44100) - main) / 44100)
+    assert np.max(np.abs(starts)) <= 1e-4
+    assert np.std(bounces) == pytest.approx(0.001, rel=0.35)
+    # The mean of 16 variants: within three of its standard errors (0.25 ms).
+    assert np.mean(bounces) == pytest.approx(voice.sub_delays[0], abs=0.00075)
+    plain = make_recording([steady_train(60, 40.0, voice=voice)], seed=3).samples
+    assert not np.array_equal(plain, rec.samples)
 
 
 # --- impairments ---------------------------------------------------------------------
