@@ -87,8 +87,9 @@ Returns `Recording`:
         onsets at microphone c.
     applied : what the impairments drew (band corners, bump times and microphones, …).
     ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
-    ``Recording.files(starts)`` splits several microphones into one mono recording
-    each, as from phones started ``starts`` s late, with the truth of each.
+    ``Recording.files(starts, clock_ppm)`` splits several microphones into one mono
+    recording each, as from phones started ``starts`` s late whose clocks run fast by
+    ``clock_ppm``, with the truth of each.
 """
 
 from __future__ import annotations
@@ -298,29 +299,49 @@ class Recording:
     def channels(self) -> int:
         return 1 if self.samples.ndim == 1 else self.samples.shape[1]
 
-    def files(self, starts: Sequence[float] | None = None) -> list[Recording]:
+    def files(
+        self, starts: Sequence[float] | None = None, clock_ppm: Sequence[float] | None = None
+    ) -> list[Recording]:
         """One mono recording per microphone, as if each were a phone of its own
         started ``starts[c]`` s (≥ 0, default 0) after the first: its samples from
         there on, its truth the onsets at that microphone minus its start (ticks
-        before the start left out; ``gains``, ``delays`` of that microphone)."""
+        before the start left out; ``gains``, ``delays`` of that microphone).
+
+        clock_ppm : (C,) how fast each phone's clock runs, parts per million (default
+            0; phones differ by tens): a phone whose clock is fast by ε·10⁶ ppm takes
+            (1 + ε) times as many samples per second as it says, so its file is
+            resampled (FFT) to (1 + ε) times as many samples and its truth times
+            are (t − start)·(1 + ε). Over a minute, 20 ppm moves the ticks by 1.2 ms.
+        """
         starts = [0.0] * self.channels if starts is None else [float(s) for s in starts]
         if len(starts) != self.channels or not all(0 <= s < self.duration for s in starts):
             raise ParameterError(
                 f"`starts` must hold {self.channels} times in [0, {self.duration:g}) s, got "
                 f"{starts!r}."
             )
+        ppm = [0.0] * self.channels if clock_ppm is None else [float(p) for p in clock_ppm]
+        if len(ppm) != self.channels or not all(abs(p) <= 1000 for p in ppm):
+            raise ParameterError(
+                f"`clock_ppm` must hold {self.channels} values in [-1000, 1000] ppm, got "
+                f"{clock_ppm!r}."
+            )
         samples = self.samples.reshape(self.samples.shape[0], -1)
         out = []
         for c, start in enumerate(starts):
             k = int(round(start * self.sample_rate))
+            stretch = 1.0 + ppm[c] * 1e-6
+            x = samples[k:, c]
+            if stretch != 1.0:
+                x = signal.resample(x, int(round(x.size * stretch))).astype(np.float32)
+                x = np.clip(x, -1.0, 1.0)
             truth = []
             for t in self.truth:
                 times = t.arrivals(c) - k / self.sample_rate
                 keep = times >= 0
-                truth.append(TrainTruth(times[keep], t.is_tock[keep], t.voice,
+                truth.append(TrainTruth(times[keep] * stretch, t.is_tock[keep], t.voice,
                                         t.gains[c : c + 1], t.delays[c : c + 1]))  # fmt: skip
-            applied = dict(self.applied, start=k / self.sample_rate)
-            out.append(Recording(samples[k:, c].copy(), self.sample_rate, truth, applied))
+            applied = dict(self.applied, start=k / self.sample_rate, clock_ppm=ppm[c])
+            out.append(Recording(x.copy(), self.sample_rate, truth, applied))
         return out
 
     def write(self, path: Path | str, subtype: str = "PCM_16") -> Path:

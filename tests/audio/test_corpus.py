@@ -113,6 +113,23 @@ def test_microphones_split_into_phones_started_at_different_times(four):
         rec.files([0.0])
 
 
+def test_phones_whose_clocks_run_fast_stretch_their_files_and_truth():
+    trains = random_trains(2, 40.0, seed=3)
+    rec = make_recording(trains, microphones=2, seed=4)
+    same = rec.files([0.5, 0.5])[1]
+    fast = rec.files([0.5, 0.5], clock_ppm=[0.0, 50.0])[1]
+    assert fast.samples.size == round(same.samples.size * (1 + 50e-6))
+    for a, b in zip(same.truth, fast.truth, strict=True):
+        np.testing.assert_allclose(b.times, a.times * (1 + 50e-6))
+    assert fast.truth[0].times[-1] - same.truth[0].times[-1] > 0.0018  # 2 ms at the end
+    late = [(i, k) for i, k in isolated(fast.truth) if fast.truth[i].times[k] > 0.2]
+    errors = [first_rise(fast.samples, fast.truth[i].times[k], 44100)
+              - fast.truth[i].times[k] for i, k in late]  # fmt: skip
+    assert len(errors) > 20 and np.max(np.abs(errors)) <= 1e-4
+    with pytest.raises(ParameterError, match="`clock_ppm`"):
+        rec.files(clock_ppm=[0.0])
+
+
 def test_the_same_seed_gives_the_same_recording(four):
     a = make_recording(four, impairments=Impairments.phone(), seed=2)
     b = make_recording(four, impairments=Impairments.phone(), seed=2)
