@@ -77,7 +77,7 @@ class ClickTrack:
     tock_waveforms : N arrays, the tock of each metronome, or None when tick and tock
         sound alike (then ``waveforms`` sounds at every crossing).
     is_tock : N (K_i,) bool arrays, which clicks are tocks (downward crossings), or
-        None with ``tock_waveforms``.
+        None when ``tock_waveforms`` is.
     """
 
     sample_rate: int
