@@ -406,7 +406,9 @@ def test_the_phone_set_keeps_the_onsets_within_half_a_millisecond(four):
 
 
 @pytest.mark.slow
-def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_two_seconds():
+def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_a_second():
+    """CPU time of this process (all its threads), so that other jobs on the machine
+    do not count; about 0.2 s on the 2-core development machine."""
     import time
 
     group = voices(4, seed=2)
@@ -415,7 +417,7 @@ def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_two_secon
     make_recording([steady_train(100, 2.0)])  # warm the imports
     best = np.inf
     for _ in range(2):
-        start = time.perf_counter()
+        start = time.process_time()
         make_recording(trains, impairments=Impairments.phone(clipping=0.8), seed=1)
-        best = min(best, time.perf_counter() - start)
-    assert best < 2.0
+        best = min(best, time.process_time() - start)
+    assert best < 1.0
