@@ -30,10 +30,11 @@ trains : sequence of `TickTrain`, one per metronome (1 to 8):
     - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
       phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
       drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
-      bounce_jitter_s=0)``: n metronomes
-      drawn from the seed, free-running (tempos at least ``min_bpm_gap`` apart) or
-      ``locked`` (one tempo, phases within ``phase_spread`` beats), distinct voices
-      unless ``same_voice``: for tests over many recordings;
+      bounce_jitter_s=0, same_make=False)``: n metronomes drawn from the seed,
+      free-running (tempos at least ``min_bpm_gap`` apart) or ``locked`` (one tempo,
+      phases within ``phase_spread`` beats), distinct voices unless ``same_make``
+      (siblings of one voice, `Voice.sibling`) or ``same_voice`` (one voice): for
+      tests over many recordings;
     - ``metrosync.show.ticks.voices(n, seed)``: n voices that differ from each other.
       A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
       ``voice=`` from `voices` to metronomes that should sound different, the same
@@ -428,6 +429,7 @@ def random_trains(
     jitter_s: float = 0.0002,
     level_jitter_db: float = 0.5,
     bounce_jitter_s: float = 0.0,
+    same_make: bool = False,
 ) -> list[TickTrain]:
     """``n`` metronomes drawn from ``seed``, for tests over many recordings.
 
@@ -436,8 +438,9 @@ def random_trains(
     ``phase_spread`` beats of each other (in step, as on the disk), the same drift.
     Each has a limp uniform in [0, ``limp_max``], a drift uniform in
     [0, ``drift_max_bpm_per_min``], and the given timing and level jitter. Voices
-    are ``voices(n, seed)`` (all different), or with ``same_voice`` one voice for all
-    (metronomes of one make).
+    are ``voices(n, seed)`` (all different), with ``same_make`` siblings of one drawn
+    voice (`Voice.sibling`: metronomes of one make, alike but not identical), or with
+    ``same_voice`` one voice for all (indistinguishable by sound).
     """
     if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_TRAINS:
         raise ParameterError(f"`n` must be an integer in [1, {MAX_TRAINS}], got {n!r}.")
@@ -466,7 +469,12 @@ def random_trains(
                 break
         phases = rng.uniform(0, 1, n)
         drifts = rng.uniform(0, drift_max_bpm_per_min, n)
-    sounds = [Voice.draw(int(seed))] * n if same_voice else draw_voices(n, int(seed))
+    if same_voice:
+        sounds = [Voice.draw(int(seed))] * n
+    elif same_make:
+        sounds = [Voice.draw(int(seed)).sibling(i) for i in range(n)]
+    else:
+        sounds = draw_voices(n, int(seed))
     return [
         steady_train(
             float(bpms[i]),
@@ -529,7 +537,7 @@ def make_recording(
         )
     if (
         isinstance(sample_rate, bool)
-        or not isinstance(sample_rate, int)
+        or not isinstance(sample_rate, int | np.integer)
         or not (8000 <= sample_rate <= 192000)
     ):
         raise ParameterError(
@@ -580,7 +588,7 @@ def make_recording(
         )  # fmt: skip
         for i, t in enumerate(trains)
     ]
-    return Recording(x[:, 0] if len(mics) == 1 else x, sample_rate, truth, applied)
+    return Recording(x[:, 0] if len(mics) == 1 else x, int(sample_rate), truth, applied)
 
 
 def _seed(seed) -> int:

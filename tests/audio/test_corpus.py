@@ -230,6 +230,13 @@ def test_random_free_running_trains_keep_their_tempos_apart_and_voices_distinct(
     ]
 
 
+def test_random_trains_of_one_make_sound_alike():
+    trains = random_trains(3, 10.0, seed=4, same_make=True)
+    base = Voice.draw(4)
+    assert [t.voice for t in trains] == [base.sibling(i) for i in range(3)]
+    assert len({t.voice for t in trains}) == 3
+
+
 def test_random_locked_trains_share_a_tempo_and_stay_in_step():
     trains = random_trains(3, 60.0, seed=2, locked=True, phase_spread=0.05, same_voice=True)
     assert len({t.voice for t in trains}) == 1

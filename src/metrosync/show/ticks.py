@@ -35,6 +35,7 @@ transient comes from the voice's own ``seed``, so a voice sounds the same every 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -168,6 +169,32 @@ class Voice:
             tock_gain=float(rng.uniform(*TOCK_GAIN_RANGE)),
             level=float(rng.uniform(*LEVEL_RANGE)),
             seed=int(seed),
+        )
+
+    def sibling(self, seed: int, *, spread: float = 0.02) -> Voice:
+        """Another metronome of the same make: resonances moved by a relative
+        Gaussian ``spread`` (default 2 %), secondary impacts by ``spread`` × 50 ms
+        (1 ms) and their heights by ``spread`` × 2.5 (5 %), loudness within ``spread``
+        × 25 (0.5 dB); the same tock traits. Drawn from ``seed``.
+        """
+        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+            raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
+        if not (0 <= spread <= 0.1):
+            raise ParameterError(f"`spread` must be in [0, 0.1], got {spread!r}.")
+        rng = np.random.default_rng([31, self.seed, int(seed)])
+        m, j = len(self.resonances), len(self.sub_delays)
+        resonances = np.asarray(self.resonances) * (1 + rng.normal(0.0, spread, m))
+        delays = np.asarray(self.sub_delays) + rng.normal(0.0, 50 * spread * 1e-3, j)
+        delays = np.maximum.accumulate(np.maximum(np.sort(delays), 0.005))
+        gains = np.clip(np.asarray(self.sub_gains) + rng.normal(0.0, 2.5 * spread, j), 0.05, 1)
+        level_db = rng.normal(0.0, 25 * spread)
+        return dataclasses.replace(
+            self,
+            resonances=tuple(float(f) for f in np.clip(resonances, 50.0, MAX_RESONANCE * 1.4)),
+            sub_delays=tuple(float(d) for d in delays + 1e-4 * np.arange(j)),
+            sub_gains=tuple(float(g) for g in gains),
+            level=float(np.clip(self.level * 10 ** (level_db / 20), 0.05, 1.0)),
+            seed=int(self.seed) * MAX_VOICES + int(seed) + 1,
         )
 
     @property
