@@ -9,7 +9,8 @@ pallets, so they differ in sound and in loudness; two metronomes of different ma
 differ in spectrum more than in loudness.
 
 A `Voice` holds those traits of one metronome, frozen, and is drawn reproducibly from
-a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
+a seed (`Voice.draw`, or `voices` for several that differ from each other;
+`Voice.sibling` for another metronome of the same make, alike but not identical). Its
 `Voice.waveform` renders one tick or one tock:
 
 - each impact is a broadband transient (exponentially decaying noise, 0.4 ms) plus
