@@ -78,6 +78,9 @@ impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
 duration : length, s (default: the last tick + 1 s). A tick at or after the end is
     refused.
 
+Layout: the trains are in `corpus_trains`, the impairments in `corpus_impairments`,
+the recording here; import everything from here (``from corpus import ...``).
+
 Returns `Recording`:
     samples : float32, (S,) for one microphone, (S, C) for several, in [−1, 1].
     sample_rate : Hz.
@@ -102,73 +105,30 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from corpus_impairments import COMPRESSOR_BLOCK, OUTPUT_PEAK, Impairments, impair
+from corpus_trains import (
+    BOUNCE_VARIANTS,
+    MAX_TRAINS,
+    TickTrain,
+    check_seed,
+    random_trains,
+    simulated_trains,
+    steady_train,
+)
 from scipy import signal
 
 from metrosync.errors import ParameterError
 from metrosync.show.ticks import Voice
 
+__all__ = [
+    "BOUNCE_VARIANTS", "COMPRESSOR_BLOCK", "MAX_MICROPHONES", "MAX_TRAINS", "OUTPUT_PEAK",
+    "Impairments", "Microphone", "Recording", "TickTrain", "TrainTruth", "make_recording",
+    "random_trains", "simulated_trains", "steady_train",
+]  # fmt: skip
+
 SPEED_OF_SOUND = 343.0  # m/s
 DISK_RADIUS = 0.27  # m, as in the experiment
-OUTPUT_PEAK = 0.9
-MAX_TRAINS = 8
 MAX_MICROPHONES = 8
-#: Variants of a tick (and of a tock) rendered for a train with bounce jitter.
-BOUNCE_VARIANTS = 16
-#: Samples per level measurement of the compressor.
-COMPRESSOR_BLOCK = 16
-
-
-@dataclass(frozen=True, eq=False)
-class TickTrain:
-    """The ticks of one metronome.
-
-    times : (K,) increasing onsets of each tick's first impact at the metronome, s, ≥ 0.
-    is_tock : (K,) True where the tick is a tock.
-    voice : the metronome's sound.
-    gain : its loudness (the tick's peak is ``gain · voice.level`` before impairments).
-    levels : (K,) optional factor on each tick's loudness.
-    bounce_jitter_s : standard deviation of each tick's secondary-impact delays about
-        the voice's, s (the pallet bounces a little differently each time; rendered
-        from `BOUNCE_VARIANTS` variants of the tick and of the tock).
-    """
-
-    times: np.ndarray
-    is_tock: np.ndarray
-    voice: Voice
-    gain: float = 1.0
-    levels: np.ndarray | None = None
-    bounce_jitter_s: float = 0.0
-
-    def __post_init__(self) -> None:
-        if not (0 <= self.bounce_jitter_s <= 0.005):
-            raise ParameterError(
-                f"`bounce_jitter_s` must be in [0, 0.005] s, got {self.bounce_jitter_s!r}."
-            )
-        times = np.asarray(self.times, dtype=float)
-        is_tock = np.asarray(self.is_tock, dtype=bool)
-        if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(times < 0):
-            raise ParameterError(
-                f"`times` must be a 1-D array of finite times ≥ 0 s, got {times!r}."
-            )
-        if np.any(np.diff(times) <= 0):
-            raise ParameterError("`times` must be strictly increasing.")
-        if is_tock.shape != times.shape:
-            raise ParameterError(
-                f"`is_tock` must have the shape of `times` {times.shape}, got {is_tock.shape}."
-            )
-        if not isinstance(self.voice, Voice):
-            raise ParameterError(f"`voice` must be a Voice, got {self.voice!r}.")
-        if not (math.isfinite(self.gain) and self.gain > 0):
-            raise ParameterError(f"`gain` must be a number > 0, got {self.gain!r}.")
-        object.__setattr__(self, "times", times)
-        object.__setattr__(self, "is_tock", is_tock)
-        if self.levels is not None:
-            levels = np.asarray(self.levels, dtype=float)
-            if levels.shape != times.shape or np.any(levels <= 0):
-                raise ParameterError(
-                    f"`levels` must be {times.shape} positive factors, got {levels!r}."
-                )
-            object.__setattr__(self, "levels", levels)
 
 
 @dataclass(frozen=True)
@@ -188,78 +148,6 @@ class Microphone:
             raise ParameterError(f"`gains` must be ≥ 0, got {self.gains!r}.")
         if not all(math.isfinite(d) and 0 <= d <= 0.1 for d in self.delays):
             raise ParameterError(f"`delays` must be in [0, 0.1] s, got {self.delays!r}.")
-
-
-@dataclass(frozen=True)
-class Impairments:
-    """What the room, the phone and the hand do to the sound; all off by default.
-
-    See the module docstring for each step and its order.
-    """
-
-    reverb_rt60: float | None = None
-    reverb_drr_db: float = 6.0
-    snr_db: float | None = None
-    noise: str = "pink"
-    bumps: int = 0
-    phone_band: bool | tuple[float, float] = False
-    compression: bool = False
-    compression_threshold_db: float = -24.0
-    compression_ratio: float = 4.0
-    compression_attack_s: float = 0.003
-    compression_release_s: float = 0.1
-    clipping: float | None = None
-    resample_from: int | None = None
-    quantize_bits: int | None = None
-
-    def __post_init__(self) -> None:
-        if self.reverb_rt60 is not None and not (0.05 <= self.reverb_rt60 <= 3.0):
-            raise ParameterError(
-                f"`reverb_rt60` must be in [0.05, 3] s or None, got {self.reverb_rt60!r}."
-            )
-        if self.snr_db is not None and not (-20 <= self.snr_db <= 120):
-            raise ParameterError(f"`snr_db` must be in [-20, 120] dB or None, got {self.snr_db!r}.")
-        if self.noise not in ("pink", "white"):
-            raise ParameterError(f"`noise` must be 'pink' or 'white', got {self.noise!r}.")
-        if isinstance(self.bumps, bool) or not isinstance(self.bumps, int) or self.bumps < 0:
-            raise ParameterError(f"`bumps` must be an integer ≥ 0, got {self.bumps!r}.")
-        if not isinstance(self.phone_band, bool):
-            low, high = self.phone_band
-            if not (10 <= low < high):
-                raise ParameterError(
-                    f"`phone_band` must be True, False or (low, high) Hz with "
-                    f"10 ≤ low < high, got {self.phone_band!r}."
-                )
-        if not self.compression_ratio >= 1:
-            raise ParameterError(
-                f"`compression_ratio` must be ≥ 1, got {self.compression_ratio!r}."
-            )
-        if not (self.compression_attack_s > 0 and self.compression_release_s > 0):
-            raise ParameterError("`compression_attack_s` and `compression_release_s` must be > 0.")
-        if self.clipping is not None and not (0 < self.clipping < 1):
-            raise ParameterError(
-                f"`clipping` must be in (0, 1) (the fraction of the peak that reaches full "
-                f"scale) or None, got {self.clipping!r}."
-            )
-        if self.resample_from is not None and not (8000 <= self.resample_from <= 192000):
-            raise ParameterError(
-                f"`resample_from` must be a rate in [8000, 192000] Hz or None, got "
-                f"{self.resample_from!r}."
-            )
-        if self.quantize_bits is not None and self.quantize_bits not in (8, 16, 24):
-            raise ParameterError(
-                f"`quantize_bits` must be 8, 16, 24 or None, got {self.quantize_bits!r}."
-            )
-
-    @classmethod
-    def phone(cls, **changes) -> Impairments:
-        """A phone on a table in a room, everything on: RT60 0.4 s, noise at 30 dB,
-        two bumps, the phone's band, compression, 48 kHz resampled, 16 bits (no
-        clipping: add ``clipping=0.8`` for a recording made too loud)."""
-        base = dict(reverb_rt60=0.4, snr_db=30.0, bumps=2, phone_band=True,
-                    compression=True, resample_from=48000, quantize_bits=16)  # fmt: skip
-        base.update(changes)
-        return cls(**base)
 
 
 @dataclass(frozen=True, eq=False)
@@ -352,171 +240,6 @@ class Recording:
         return Path(path)
 
 
-# --- tick trains ---------------------------------------------------------------------
-
-
-def steady_train(
-    bpm: float,
-    duration: float,
-    *,
-    phase: float = 0.0,
-    limp: float = 0.0,
-    drift_bpm_per_min: float = 0.0,
-    jitter_s: float = 0.0,
-    level_jitter_db: float = 0.0,
-    tock_first: bool = False,
-    voice: Voice | None = None,
-    gain: float = 1.0,
-    seed: int = 0,
-    bounce_jitter_s: float = 0.0,
-) -> TickTrain:
-    """A free-running metronome (see the module docstring); ticks in [0, duration)."""
-    if not (math.isfinite(bpm) and 10 <= bpm <= 600):
-        raise ParameterError(f"`bpm` must be in [10, 600] ticks per minute, got {bpm!r}.")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"`duration` must be > 0 s, got {duration!r}.")
-    if not (0 <= phase < 1):
-        raise ParameterError(f"`phase` must be in [0, 1) beats, got {phase!r}.")
-    if not (0 <= limp < 0.5):
-        raise ParameterError(f"`limp` must be in [0, 0.5) of a beat, got {limp!r}.")
-    if not (math.isfinite(drift_bpm_per_min) and abs(drift_bpm_per_min) <= 0.5 * bpm):
-        raise ParameterError(
-            f"`drift_bpm_per_min` must be within ±bpm/2, got {drift_bpm_per_min!r}."
-        )
-    if not (0 <= jitter_s < 0.1 * 60 / bpm) or not (0 <= level_jitter_db <= 12):
-        raise ParameterError(
-            f"`jitter_s` must be in [0, a tenth of a beat) and `level_jitter_db` in [0, 12], "
-            f"got {jitter_s!r} and {level_jitter_db!r}."
-        )
-    rng = np.random.default_rng([27, _seed(seed)])
-    # Beats counted since t = 0: n(t) = b t + c t² with b = bpm/60 and c = drift/7200
-    # (the tempo bpm + drift·t/60); tick k (unlimped) falls where n = k + phase.
-    b, c = bpm / 60.0, drift_bpm_per_min / 7200.0
-    last = b * duration + c * duration**2
-    beats = np.arange(0, math.ceil(max(last, 0.0)) + 2) + phase
-    if c == 0:
-        t = beats / b
-    else:
-        disc = np.maximum(b * b + 4 * c * beats, 0.0)
-        t = 2 * beats / (b + np.sqrt(disc))  # the root that tends to n/b as c → 0
-    period = 1.0 / (b + 2 * c * t)
-    k = np.arange(t.size)
-    t = t + np.where(k % 2 == 1, limp / 2, 0.0) * period  # long beat first
-    if jitter_s:
-        t = t + rng.normal(0.0, jitter_s, t.size)
-    is_tock = (k % 2 == 1) != tock_first
-    keep = (t >= 0) & (t < duration)
-    t, is_tock = t[keep], is_tock[keep]
-    levels = None
-    if level_jitter_db:
-        levels = 10 ** (rng.normal(0.0, level_jitter_db, t.size) / 20)
-    voice = Voice.draw(seed) if voice is None else voice
-    return TickTrain(t, is_tock, voice, gain, levels, bounce_jitter_s)
-
-
-def random_trains(
-    n: int,
-    duration: float,
-    *,
-    seed: int = 0,
-    bpm_range: tuple[float, float] = (90.0, 200.0),
-    locked: bool = False,
-    phase_spread: float = 0.1,
-    min_bpm_gap: float = 2.0,
-    same_voice: bool = False,
-    limp_max: float = 0.04,
-    drift_max_bpm_per_min: float = 1.0,
-    jitter_s: float = 0.0002,
-    level_jitter_db: float = 0.5,
-    bounce_jitter_s: float = 0.0,
-    same_make: bool = False,
-) -> list[TickTrain]:
-    """``n`` metronomes drawn from ``seed``, for tests over many recordings.
-
-    Free-running (default): tempos uniform in ``bpm_range``, at least ``min_bpm_gap``
-    apart; phases uniform. ``locked``: one tempo for all, phases within
-    ``phase_spread`` beats of each other (in step, as on the disk), the same drift.
-    Each has a limp uniform in [0, ``limp_max``], a drift uniform in
-    [0, ``drift_max_bpm_per_min``], and the given timing and level jitter. Voices
-    are ``voices(n, seed)`` (all different), with ``same_make`` siblings of one drawn
-    voice (`Voice.sibling`: metronomes of one make, alike but not identical), or with
-    ``same_voice`` one voice for all (indistinguishable by sound).
-    """
-    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_TRAINS:
-        raise ParameterError(f"`n` must be an integer in [1, {MAX_TRAINS}], got {n!r}.")
-    low, high = bpm_range
-    if not (10 <= low <= high <= 600):
-        raise ParameterError(f"`bpm_range` must be (low, high) in [10, 600], got {bpm_range!r}.")
-    if not locked and (high - low) < (n - 1) * min_bpm_gap:
-        raise ParameterError(
-            f"`bpm_range` {bpm_range!r} cannot hold {n} tempos `min_bpm_gap` = "
-            f"{min_bpm_gap!r} apart; widen it or lower `min_bpm_gap`."
-        )
-    if not 0 <= phase_spread < 1:
-        raise ParameterError(f"`phase_spread` must be in [0, 1) beats, got {phase_spread!r}.")
-    from metrosync.show.ticks import voices as draw_voices
-
-    rng = np.random.default_rng([29, _seed(seed)])
-    if locked:
-        bpms = np.full(n, rng.uniform(low, high))
-        base = rng.uniform(0, 1 - phase_spread)
-        phases = base + rng.uniform(0, phase_spread, n)
-        drifts = np.full(n, rng.uniform(0, drift_max_bpm_per_min))
-    else:
-        while True:
-            bpms = rng.uniform(low, high, n)
-            if n == 1 or np.diff(np.sort(bpms)).min() >= min_bpm_gap:
-                break
-        phases = rng.uniform(0, 1, n)
-        drifts = rng.uniform(0, drift_max_bpm_per_min, n)
-    if same_voice:
-        sounds = [Voice.draw(int(seed))] * n
-    elif same_make:
-        sounds = [Voice.draw(int(seed)).sibling(i) for i in range(n)]
-    else:
-        sounds = draw_voices(n, int(seed))
-    return [
-        steady_train(
-            float(bpms[i]),
-            duration,
-            phase=float(phases[i]),
-            limp=float(rng.uniform(0, limp_max)),
-            drift_bpm_per_min=float(drifts[i]),
-            jitter_s=jitter_s,
-            level_jitter_db=level_jitter_db,
-            voice=sounds[i],
-            seed=int(seed) * MAX_TRAINS + i,
-            bounce_jitter_s=bounce_jitter_s,
-        )
-        for i in range(n)
-    ]
-
-
-def simulated_trains(
-    ds, *, run: int = 0, voices: Sequence[Voice] | None = None, start=None, end=None
-) -> list[TickTrain]:
-    """The ticks of run ``run`` of a simulated dataset (with trajectories), one train
-    per metronome: upward crossings of the escapement angle are ticks, downward ones
-    tocks; times from ``start`` (default: the first record) to ``end``."""
-    from metrosync.show.recording import RecordedRun
-    from metrosync.show.sound import crossing_times
-    from metrosync.show.ticks import voices as draw_voices
-
-    recorded = RecordedRun.from_dataset(ds, run)
-    start, end = recorded.window(start, end)
-    voices = draw_voices(recorded.n) if voices is None else list(voices)
-    if len(voices) != recorded.n:
-        raise ParameterError(
-            f"`voices` must hold one voice per metronome ({recorded.n}), got {len(voices)}."
-        )
-    trains = []
-    for i, times in enumerate(crossing_times(recorded)):
-        times = times[(times >= start) & (times < end)]
-        downward = recorded.theta_dot_at(times)[:, i] < 0
-        trains.append(TickTrain(times - start, downward, voices[i]))
-    return trains
-
-
 # --- the recording -------------------------------------------------------------------
 
 
@@ -547,7 +270,7 @@ def make_recording(
         raise ParameterError(
             f"`impairments` must be an Impairments (e.g. Impairments.phone()), got {impairments!r}."
         )
-    rng = np.random.default_rng([28, _seed(seed)])
+    rng = np.random.default_rng([28, check_seed(seed)])
     mics = _microphones(microphones, len(trains), rng)
     last = max((float(t.times[-1]) for t in trains if t.times.size), default=0.0)
     if duration is None:
@@ -568,7 +291,7 @@ def make_recording(
             s = shifts[i, c]
             x[s:, c] += gains[i, c] * dry[: n - s]
     applied: dict = {}
-    x = _impair(x, rate, impairments, rng, applied)
+    x = impair(x, rate, impairments, rng, applied)
     if rate != sample_rate:
         g = math.gcd(rate, sample_rate)
         x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0).astype(np.float32)
@@ -589,12 +312,6 @@ def make_recording(
         for i, t in enumerate(trains)
     ]
     return Recording(x[:, 0] if len(mics) == 1 else x, int(sample_rate), truth, applied)
-
-
-def _seed(seed) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
-    return int(seed)
 
 
 def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
@@ -669,121 +386,3 @@ def _bounced(voice: Voice, jitter: float, rng) -> Voice:
     for d in moved:
         delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
     return dataclasses.replace(voice, sub_delays=tuple(delays))
-
-
-def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> np.ndarray:
-    n, channels = x.shape
-    if imp.reverb_rt60 is not None:
-        applied["reverb_rt60"] = imp.reverb_rt60
-        for c in range(channels):
-            room = _room_response(imp, rate, rng).astype(np.float32)
-            x[:, c] = signal.oaconvolve(x[:, c], room)[:n]
-    if imp.snr_db is not None:
-        power = np.mean(x.astype(float) ** 2, axis=0)
-        noise = _noise(n, channels, imp.noise, rng)
-        x += noise * np.sqrt(power / 10 ** (imp.snr_db / 10)).astype(np.float32)[None, :]
-        applied["snr_db"] = imp.snr_db
-    if imp.bumps:
-        peak = float(np.abs(x).max())
-        bumps = []
-        for _ in range(imp.bumps):
-            t0, c = rng.uniform(0, n / rate), int(rng.integers(channels))
-            bumps.append((int(t0 * rate) / rate, c))
-            k = int(t0 * rate)
-            thump = _thump(rate, rng) * peak
-            m = min(thump.size, n - k)
-            x[k : k + m, c] += thump[:m]
-        applied["bumps"] = sorted(bumps)
-    if imp.phone_band is not False:
-        if imp.phone_band is True:
-            low, high = float(rng.uniform(100, 300)), float(rng.uniform(4000, 8000))
-        else:
-            low, high = map(float, imp.phone_band)
-        high = min(high, 0.45 * rate)
-        sos = np.concatenate(
-            [
-                signal.butter(2, low, "highpass", fs=rate, output="sos"),
-                signal.butter(4, high, "lowpass", fs=rate, output="sos"),
-            ]
-        )
-        x = signal.sosfilt(sos.astype(np.float32), x, axis=0)
-        applied["phone_band"] = (low, high)
-    if imp.compression:
-        x = _compress(x, rate, imp)
-        applied["compression"] = (imp.compression_threshold_db, imp.compression_ratio)
-    peak = max(float(np.abs(x).max()), 1e-12)
-    if imp.clipping is not None:
-        x *= np.float32(1 / (peak * imp.clipping))
-        np.clip(x, -1.0, 1.0, out=x)
-        applied["clipping"] = imp.clipping
-    else:
-        x *= np.float32(OUTPUT_PEAK / peak)
-    return x
-
-
-def _thump(rate: int, rng) -> np.ndarray:
-    """A hand bumping the phone, peak 0.5–2: a damped 40–150 Hz sinusoid lasting
-    50–150 ms (decay time a quarter of that), opened by the contact's broadband
-    crack (1 ms decaying noise, 0.2–0.5 of the thump's peak)."""
-    length = rng.uniform(0.05, 0.15)
-    t = np.arange(int(length * rate)) / rate
-    body = np.sin(2 * np.pi * rng.uniform(40, 150) * t) * np.exp(-t / (length / 4))
-    body *= (1 - np.exp(-t / 0.002)) / np.abs(body).max()
-    crack = rng.normal(0.0, 1.0, t.size) * np.exp(-t / 0.001)
-    crack *= rng.uniform(0.2, 0.5) / np.abs(crack).max()
-    return ((body + crack) * rng.uniform(0.5, 2.0)).astype(np.float32)
-
-
-def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
-    """The direct sound (1) and a noise tail that falls 60 dB in rt60 (cut at −90 dB)."""
-    rt60 = imp.reverb_rt60
-    t = np.arange(int(1.5 * rt60 * rate)) / rate
-    tail = rng.normal(0.0, 1.0, t.size) * 10 ** (-3 * t / rt60)
-    tail[: int(0.002 * rate)] = 0.0
-    tail *= np.sqrt(10 ** (-imp.reverb_drr_db / 10) / np.sum(tail**2))
-    tail[0] = 1.0
-    return tail
-
-
-def _noise(n: int, channels: int, color: str, rng) -> np.ndarray:
-    """(n, channels) unit-power Gaussian noise, white or pink: 1/f power (−3 dB per
-    octave) from 20 Hz up, through poles two per decade with a zero a quarter decade
-    above each (within 0.5 dB of 1/f from 50 Hz to 20 kHz)."""
-    white = rng.standard_normal((n, channels), dtype=np.float32)
-    if color == "white":
-        return white
-    rate = 48000  # the shape is set in Hz at this rate; the noise is scaled after
-    poles = 10.0 * 10 ** (np.arange(0, 8) / 2)
-    poles = poles[poles * 10**0.25 < 0.45 * rate]
-    z, p, k = signal.bilinear_zpk(-2 * np.pi * poles * 10**0.25, -2 * np.pi * poles, 1.0, rate)
-    pink = signal.sosfilt(signal.zpk2sos(z, p, k).astype(np.float32), white, axis=0)
-    return pink / pink.std(axis=0)
-
-
-def _compress(x: np.ndarray, rate: int, imp: Impairments) -> np.ndarray:
-    """Feed-forward compression, each channel: level (dB) = the peak envelope (instant
-    attack, exponential release) smoothed by the attack time constant; computed on
-    blocks of `COMPRESSOR_BLOCK` samples (0.36 ms at 44.1 kHz, ten times shorter than
-    the attack)."""
-    n = x.shape[0]
-    blocks = -(-n // COMPRESSOR_BLOCK)
-    padded = np.zeros((blocks * COMPRESSOR_BLOCK, x.shape[1]), dtype=np.float32)
-    padded[:n] = np.abs(x)
-    block_peak = padded.reshape(blocks, COMPRESSOR_BLOCK, -1).max(axis=1).astype(float)
-    level_db = 20 * np.log10(block_peak / max(block_peak.max(), 1e-12) + 1e-9)
-    # Peak hold with exponential release, vectorised: the decaying maximum
-    # max_m (L[m] − (k − m)·r) is the running maximum of L[m] + m·r, minus k·r.
-    step = COMPRESSOR_BLOCK / rate
-    r = 8.685889638 * step / imp.compression_release_s  # dB per block (e-fold per release)
-    ramp = np.arange(blocks)[:, None] * r
-    held = np.maximum.accumulate(level_db + ramp, axis=0) - ramp
-    a = math.exp(-step / imp.compression_attack_s)
-    b, den = [1 - a], [1, -a]
-    zi = signal.lfilter_zi(b, den)[:, None] * held[:1]
-    smooth = signal.lfilter(b, den, held, axis=0, zi=zi)[0]
-    over = np.maximum(smooth - imp.compression_threshold_db, 0.0)
-    gain_db = -(1 - 1 / imp.compression_ratio) * over
-    # Each block's gain for its samples: the level is smoothed over the attack (ten
-    # blocks and more), so the steps between blocks are small.
-    gain = np.repeat((10 ** (gain_db / 20)).astype(np.float32), COMPRESSOR_BLOCK, axis=0)[:n]
-    return x * gain
