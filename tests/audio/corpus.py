@@ -1,0 +1,388 @@
+"""A realistic test corpus: recordings of metronomes as a phone hears them, with the
+ground truth of every tick.
+
+Entry point::
+
+    make_recording(trains, *, sample_rate=44100, microphones=1,
+                   impairments=Impairments(), duration=None, seed=0) -> Recording
+
+trains : sequence of `TickTrain`, one per metronome (1 to 8):
+    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)`` —
+    the onsets (s, at the metronome) of each tick's FIRST impact, which ticks are
+    tocks, the metronome's sound (`metrosync.show.ticks.Voice`), its loudness,
+    optional per-tick level factors (K,), and how much (s, std) the secondary impacts
+    of each tick wander about the voice's delays. Build them with
+
+    - ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
+      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
+      bounce_jitter_s=0)``:
+      a free-running metronome; ``bpm`` ticks per minute (tick and tock each count),
+      the first tick at ``phase`` beats (0 ≤ phase < 1), beats alternating
+      (1 ± limp/2)·T (limp = (long − short)/mean beat, a fraction, as
+      `metrosync.audio.metronome` measures it), the tempo rising by
+      ``drift_bpm_per_min`` BPM per minute as the spring unwinds, each tick displaced
+      by independent Gaussian jitter (s, std), each tick's level by Gaussian dB.
+      Locked metronomes: the same ``bpm`` (and drift) with the phases you want;
+    - ``simulated_trains(ds, *, run=0, voices=None, start=None, end=None)``: the ticks
+      of a run of `metrosync.simulate(..., trajectories=True)`: every crossing of θ_i
+      through its escapement angle, upward a tick, downward a tock (audio time 0 at
+      ``start``);
+    - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
+      phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
+      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
+      bounce_jitter_s=0, same_make=False)``: n metronomes drawn from the seed,
+      free-running (tempos at least ``min_bpm_gap`` apart) or ``locked`` (one tempo,
+      phases within ``phase_spread`` beats), distinct voices unless ``same_make``
+      (siblings of one voice, `Voice.sibling`) or ``same_voice`` (one voice): for
+      tests over many recordings;
+    - ``metrosync.show.ticks.voices(n, seed)``: n voices that differ from each other.
+      A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
+      ``voice=`` from `voices` to metronomes that should sound different, the same
+      voice to metronomes of one make.
+
+sample_rate : 44100 or 48000 (any integer in [8000, 192000]) Hz, of the output.
+microphones : an int C (1 to 8), or a sequence of C `Microphone(gains, delays)`, one
+    gain and one delay (s, ≥ 0) per train. With C = 1 (the default) the microphone
+    hears every train at gain 1 and delay 0. With C ≥ 2 the metronomes stand on a disk
+    of radius 0.27 m (metronome i at angle 2πi/N) and the microphones at drawn places
+    0.35–0.8 m from its centre, 0.1–0.3 m above it: delay = distance / 343 m/s
+    rounded to whole samples, gain = (nearest microphone's distance / distance), so
+    each metronome is loudest (gain 1) at its nearest microphone.
+impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
+    realistic set. Applied in this order, each microphone separately:
+    1. reverberation (``reverb_rt60`` s): convolution with the direct sound plus an
+       exponentially decaying Gaussian-noise tail (−60 dB after rt60, starting 2 ms
+       after the direct sound, ``reverb_drr_db`` dB below it in energy);
+    2. background noise at ``snr_db``: ``noise`` ("pink" or "white") Gaussian noise
+       whose power is ``snr_db`` dB below the mean power of the signal so far (whole
+       recording, each microphone);
+    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
+       sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
+       height; peak 0.5–2 times the signal's peak) at uniform random times, each on
+       one random microphone;
+    4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
+       and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
+       high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay
+       the tick's rise by well under 0.5 ms);
+    5. compression (``compression``): a feed-forward compressor on the signal's level
+       (instant peak detection with exponential release ``compression_release_s``,
+       smoothed by the attack ``compression_attack_s``), gain reduction
+       (1 − 1/ratio)·(level − threshold) above ``compression_threshold_db`` (dB
+       relative to the signal's peak);
+    6. level: the peak is scaled to 0.9 of full scale; with ``clipping`` = c in (0, 1)
+       it is scaled to 1/c instead and clipped at ±1 (full scale);
+    7. format: with ``resample_from`` = R the recording is made at R Hz and resampled
+       (polyphase, linear phase: no delay) to ``sample_rate``; with ``quantize_bits``
+       it is rounded to that many bits.
+    Every draw comes from ``seed``: the same arguments give the same samples.
+duration : length, s (default: the last tick + 1 s). A tick at or after the end is
+    refused.
+
+Layout: the trains are in `corpus_trains`, the impairments in `corpus_impairments`,
+the recording here; import everything from here (``from corpus import ...``).
+
+Returns `Recording`:
+    samples : float32, (S,) for one microphone, (S, C) for several, in [−1, 1].
+    sample_rate : Hz.
+    truth : one `TrainTruth` per train, in order: ``times`` (K,) the onset of each
+        tick's first impact at microphone 0, s (rendered at the nearest sample: within
+        half a sample); ``is_tock`` (K,) bool; ``voice``; ``gains`` (C,) and
+        ``delays`` (C,) of that metronome at each microphone; ``arrivals(c)`` the
+        onsets at microphone c.
+    applied : what the impairments drew (band corners, bump times and microphones, …).
+    ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
+    ``Recording.files(starts, clock_ppm)`` splits several microphones into one mono
+    recording each, as from phones started ``starts`` s late whose clocks run fast by
+    ``clock_ppm``, with the truth of each.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from corpus_impairments import COMPRESSOR_BLOCK, OUTPUT_PEAK, Impairments, impair
+from corpus_trains import (
+    BOUNCE_VARIANTS,
+    MAX_TRAINS,
+    TickTrain,
+    check_seed,
+    random_trains,
+    simulated_trains,
+    steady_train,
+)
+from scipy import signal
+
+from metrosync.errors import ParameterError
+from metrosync.show.ticks import Voice
+
+__all__ = [
+    "BOUNCE_VARIANTS", "COMPRESSOR_BLOCK", "MAX_MICROPHONES", "MAX_TRAINS", "OUTPUT_PEAK",
+    "Impairments", "Microphone", "Recording", "TickTrain", "TrainTruth", "make_recording",
+    "random_trains", "simulated_trains", "steady_train",
+]  # fmt: skip
+
+SPEED_OF_SOUND = 343.0  # m/s
+DISK_RADIUS = 0.27  # m, as in the experiment
+MAX_MICROPHONES = 8
+
+
+@dataclass(frozen=True)
+class Microphone:
+    """One microphone: the gain and the delay (s, ≥ 0) at which it hears each train."""
+
+    gains: tuple[float, ...]
+    delays: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.gains) != len(self.delays):
+            raise ParameterError(
+                f"`gains` and `delays` need one value per train, got {len(self.gains)} "
+                f"and {len(self.delays)}."
+            )
+        if not all(math.isfinite(g) and g >= 0 for g in self.gains):
+            raise ParameterError(f"`gains` must be ≥ 0, got {self.gains!r}.")
+        if not all(math.isfinite(d) and 0 <= d <= 0.1 for d in self.delays):
+            raise ParameterError(f"`delays` must be in [0, 0.1] s, got {self.delays!r}.")
+
+
+@dataclass(frozen=True, eq=False)
+class TrainTruth:
+    """The truth about one train in a recording.
+
+    times : (K,) onset of each tick's first impact at microphone 0, s.
+    is_tock : (K,) True for the tocks.
+    voice : the metronome's sound.
+    gains, delays : (C,) its gain and delay (s) at each microphone.
+    """
+
+    times: np.ndarray
+    is_tock: np.ndarray
+    voice: Voice
+    gains: np.ndarray
+    delays: np.ndarray
+
+    def arrivals(self, channel: int) -> np.ndarray:
+        """(K,) the onsets at microphone ``channel``, s."""
+        return self.times + (self.delays[channel] - self.delays[0])
+
+
+@dataclass(frozen=True, eq=False)
+class Recording:
+    """samples (S,) or (S, C) float32, sample_rate Hz, truth per train, applied draws."""
+
+    samples: np.ndarray
+    sample_rate: int
+    truth: list[TrainTruth]
+    applied: dict = field(default_factory=dict)
+
+    @property
+    def duration(self) -> float:
+        return self.samples.shape[0] / self.sample_rate
+
+    @property
+    def channels(self) -> int:
+        return 1 if self.samples.ndim == 1 else self.samples.shape[1]
+
+    def files(
+        self, starts: Sequence[float] | None = None, clock_ppm: Sequence[float] | None = None
+    ) -> list[Recording]:
+        """One mono recording per microphone, as if each were a phone of its own
+        started ``starts[c]`` s (≥ 0, default 0) after the first: its samples from
+        there on, its truth the onsets at that microphone minus its start (ticks
+        before the start left out; ``gains``, ``delays`` of that microphone).
+
+        clock_ppm : (C,) how fast each phone's clock runs, parts per million (default
+            0; phones differ by tens): a phone whose clock is fast by ε·10⁶ ppm takes
+            (1 + ε) times as many samples per second as it says, so its file is
+            resampled (FFT) to (1 + ε) times as many samples and its truth times
+            are (t − start)·(1 + ε). Over a minute, 20 ppm moves the ticks by 1.2 ms.
+        """
+        starts = [0.0] * self.channels if starts is None else [float(s) for s in starts]
+        if len(starts) != self.channels or not all(0 <= s < self.duration for s in starts):
+            raise ParameterError(
+                f"`starts` must hold {self.channels} times in [0, {self.duration:g}) s, got "
+                f"{starts!r}."
+            )
+        ppm = [0.0] * self.channels if clock_ppm is None else [float(p) for p in clock_ppm]
+        if len(ppm) != self.channels or not all(abs(p) <= 1000 for p in ppm):
+            raise ParameterError(
+                f"`clock_ppm` must hold {self.channels} values in [-1000, 1000] ppm, got "
+                f"{clock_ppm!r}."
+            )
+        samples = self.samples.reshape(self.samples.shape[0], -1)
+        out = []
+        for c, start in enumerate(starts):
+            k = int(round(start * self.sample_rate))
+            stretch = 1.0 + ppm[c] * 1e-6
+            x = samples[k:, c]
+            if stretch != 1.0:
+                x = signal.resample(x, int(round(x.size * stretch))).astype(np.float32)
+                x = np.clip(x, -1.0, 1.0)
+            truth = []
+            for t in self.truth:
+                times = t.arrivals(c) - k / self.sample_rate
+                keep = times >= 0
+                truth.append(TrainTruth(times[keep] * stretch, t.is_tock[keep], t.voice,
+                                        t.gains[c : c + 1], t.delays[c : c + 1]))  # fmt: skip
+            applied = dict(self.applied, start=k / self.sample_rate, clock_ppm=ppm[c])
+            out.append(Recording(x.copy(), self.sample_rate, truth, applied))
+        return out
+
+    def write(self, path: Path | str, subtype: str = "PCM_16") -> Path:
+        import soundfile as sf
+
+        sf.write(str(path), self.samples, self.sample_rate, subtype=subtype)
+        return Path(path)
+
+
+# --- the recording -------------------------------------------------------------------
+
+
+def make_recording(
+    trains: Sequence[TickTrain],
+    *,
+    sample_rate: int = 44100,
+    microphones: int | Sequence[Microphone] = 1,
+    impairments: Impairments = Impairments(),  # noqa: B008 (frozen)
+    duration: float | None = None,
+    seed: int = 0,
+) -> Recording:
+    """A recording of ``trains`` with its ground truth (see the module docstring)."""
+    trains = list(trains)
+    if not 1 <= len(trains) <= MAX_TRAINS or not all(isinstance(t, TickTrain) for t in trains):
+        raise ParameterError(
+            f"`trains` must be 1 to {MAX_TRAINS} TickTrain, got {len(trains)} items."
+        )
+    if (
+        isinstance(sample_rate, bool)
+        or not isinstance(sample_rate, int | np.integer)
+        or not (8000 <= sample_rate <= 192000)
+    ):
+        raise ParameterError(
+            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
+        )
+    if not isinstance(impairments, Impairments):
+        raise ParameterError(
+            f"`impairments` must be an Impairments (e.g. Impairments.phone()), got {impairments!r}."
+        )
+    rng = np.random.default_rng([28, check_seed(seed)])
+    mics = _microphones(microphones, len(trains), rng)
+    last = max((float(t.times[-1]) for t in trains if t.times.size), default=0.0)
+    if duration is None:
+        duration = last + 1.0
+    if not (math.isfinite(duration) and duration > last):
+        raise ParameterError(
+            f"`duration` = {duration!r} s ends before the last tick at {last:.3f} s; "
+            f"give a longer `duration` or None."
+        )
+    rate = impairments.resample_from or sample_rate
+    n = int(round(duration * rate))
+    gains = np.array([m.gains for m in mics]).T  # (N, C)
+    shifts = np.round(np.array([m.delays for m in mics]).T * rate).astype(np.int64)
+    x = np.zeros((n, len(mics)), dtype=np.float32)
+    for i, train in enumerate(trains):
+        dry = _render_train(train, rate, n, np.random.default_rng([30, seed, i]))
+        for c in range(len(mics)):
+            s = shifts[i, c]
+            x[s:, c] += gains[i, c] * dry[: n - s]
+    applied: dict = {}
+    x = impair(x, rate, impairments, rng, applied)
+    if rate != sample_rate:
+        g = math.gcd(rate, sample_rate)
+        x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0).astype(np.float32)
+        size = int(round(duration * sample_rate))
+        x = np.pad(x[:size], ((0, max(0, size - x.shape[0])), (0, 0)))
+    if impairments.quantize_bits:
+        full = 2 ** (impairments.quantize_bits - 1)
+        x = np.clip(np.round(x * full), -full, full - 1) * np.float32(1 / full)
+    x = np.clip(x, -1.0, 1.0).astype(np.float32, copy=False)
+    truth = [
+        TrainTruth(
+            t.times + shifts[i, 0] / rate,
+            t.is_tock.copy(),
+            t.voice,
+            gains[i].copy(),
+            shifts[i] / rate,
+        )  # fmt: skip
+        for i, t in enumerate(trains)
+    ]
+    return Recording(x[:, 0] if len(mics) == 1 else x, int(sample_rate), truth, applied)
+
+
+def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
+    if isinstance(microphones, int) and not isinstance(microphones, bool):
+        if not 1 <= microphones <= MAX_MICROPHONES:
+            raise ParameterError(
+                f"`microphones` must be 1 to {MAX_MICROPHONES}, got {microphones!r}."
+            )
+        if microphones == 1:
+            return [Microphone((1.0,) * n_trains, (0.0,) * n_trains)]
+        angle = 2 * np.pi * np.arange(n_trains) / n_trains
+        sources = np.column_stack([DISK_RADIUS * np.cos(angle), DISK_RADIUS * np.sin(angle),
+                                   np.zeros(n_trains)])  # fmt: skip
+        where = rng.uniform(0, 2 * np.pi, microphones)
+        radius = rng.uniform(0.35, 0.8, microphones)
+        places = np.column_stack([radius * np.cos(where), radius * np.sin(where),
+                                  rng.uniform(0.1, 0.3, microphones)])  # fmt: skip
+        distance = np.linalg.norm(places[:, None, :] - sources[None, :, :], axis=-1)  # (C, N)
+        gains = distance.min(axis=0) / distance
+        return [
+            Microphone(tuple(map(float, gains[c])), tuple(map(float, distance[c] / SPEED_OF_SOUND)))
+            for c in range(microphones)
+        ]
+    mics = list(microphones)
+    if not 1 <= len(mics) <= MAX_MICROPHONES or not all(isinstance(m, Microphone) for m in mics):
+        raise ParameterError(
+            f"`microphones` must be an int or 1 to {MAX_MICROPHONES} Microphone, got "
+            f"{microphones!r}."
+        )
+    for m in mics:
+        if len(m.gains) != n_trains:
+            raise ParameterError(
+                f"each Microphone needs one gain and delay per train ({n_trains}), got "
+                f"{len(m.gains)}."
+            )
+    return mics
+
+
+def _render_train(train: TickTrain, rate: int, n: int, rng) -> np.ndarray:
+    """(n,) the train's ticks and tocks at the metronome, each placed at its nearest
+    sample; with bounce jitter, each tick one of `BOUNCE_VARIANTS` variants drawn
+    from ``rng``."""
+    out = np.zeros(n, dtype=np.float32)
+    onsets = np.round(train.times * rate).astype(np.int64)
+    levels = train.gain * (np.ones(onsets.size) if train.levels is None else train.levels)
+    variants = 1 if train.bounce_jitter_s == 0 or not train.voice.sub_delays else BOUNCE_VARIANTS
+    pick = rng.integers(variants, size=onsets.size)
+    for tock in (False, True):
+        for v in range(variants):
+            which = (train.is_tock == tock) & (pick == v)
+            if not which.any():
+                continue
+            voice = (
+                train.voice if variants == 1 else _bounced(train.voice, train.bounce_jitter_s, rng)
+            )
+            wave = voice.waveform(rate, tock=tock)
+            index = onsets[which, None] + np.arange(wave.size)[None, :]
+            values = levels[which, None] * wave[None, :]
+            inside = index < n
+            if np.all(np.diff(onsets[which]) >= wave.size):
+                out[index[inside]] += values[inside]  # no two overlap: each index once
+            else:
+                np.add.at(out, index[inside], values[inside])
+    return out
+
+
+def _bounced(voice: Voice, jitter: float, rng) -> Voice:
+    """The voice with its secondary-impact delays moved by Gaussian ``jitter`` (s),
+    kept at least 5 ms after the main impact and 2 ms after each other."""
+    moved = np.sort(np.asarray(voice.sub_delays) + rng.normal(0.0, jitter, len(voice.sub_delays)))
+    delays = []
+    for d in moved:
+        delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
+    return dataclasses.replace(voice, sub_delays=tuple(delays))
