@@ -23,7 +23,10 @@ from ._scene_render import (
     Pinhole,
     background,
     body_faces,
+    composite,
     convex_coverage,
+    finish_plane,
+    restore,
     rod_coverage,
     rod_points,
 )
@@ -172,13 +175,22 @@ class Filming:
             self.noise_c = self.rng.normal(0.0, 0.6 * cam.noise, shape).astype(np.float32)
         self.flicker_phase = float(self.rng.uniform(0, 2 * np.pi))
         self.buffer = np.empty((h * 3 // 2, w), np.uint8)
+        self.work = (self.Y.copy(), self.U.copy(), self.V.copy())
+        self.no_flicker = np.ones(h, np.float32)
+        self.no_noise = np.zeros((0, 0), np.float32)
 
     # -- one frame ----------------------------------------------------------------------
     def render(self, t: float) -> np.ndarray:
-        """(H·3/2, W) uint8 yuv420p picture of the frame captured at ``t``."""
+        """(H·3/2, W) uint8 yuv420p picture of the frame captured at ``t``.
+
+        The rods are drawn into working copies of the static planes, inside their
+        boxes only; one pass per plane then applies the light, the noise and the
+        rounding; the boxes are restored for the next frame.
+        """
         cam, pin = self.camera, self.pinhole
         h, w = cam.height, cam.width
-        Y, U, V = self.Y.copy(), self.U.copy(), self.V.copy()
+        Y, U, V = self.work
+        drawn = []
         for i in self.order:
             box = self.boxes[i]
             if box is None:
@@ -194,50 +206,49 @@ class Filming:
             pivot = pin.project(m.pivot)
             rod = np.zeros((y1 - y0, x1 - x0), np.float32)
             bob = np.zeros_like(rod)
-            rod_coverage(rod, bob, x0, y0, pivot[0], pivot[1], tips, bobs, *self.sizes[i])
-            rod *= self.vis[i]
-            bob *= self.vis[i]
+            span = np.empty((y1 - y0, 2), np.int64)
+            rod_coverage(rod, bob, span, x0, y0, pivot[0], pivot[1], tips, bobs, *self.sizes[i])
             rod_yuv, bob_yuv = self.colours[i]
-            region = Y[y0:y1, x0:x1]
-            region += rod * (rod_yuv[0] - region) + bob * (bob_yuv[0] - region)
-            rod2, bob2 = half(rod), half(bob)
-            for plane, c in ((U, 1), (V, 2)):
-                region = plane[y0 // 2 : y1 // 2, x0 // 2 : x1 // 2]
-                region += rod2 * (rod_yuv[c] - region) + bob2 * (bob_yuv[c] - region)
-        if cam.flicker_hz > 0 and cam.flicker_depth > 0:
-            rows = t + self.row_delay * np.arange(h)
-            x = cam.flicker_hz * self.exposure
-            smear = np.sinc(x)  # the light averaged over each row's exposure
-            gain = 1.0 + 0.5 * cam.flicker_depth * smear * np.cos(
-                2 * np.pi * cam.flicker_hz * rows + self.flicker_phase
-            )
-            gain = gain.astype(np.float32)
-            Y -= 16.0
-            Y *= gain[:, None]
-            Y += 16.0
-            g2 = half(np.repeat(gain[:, None], 2, axis=1))[:, :1]
-            for plane in (U, V):
-                plane -= 128.0
-                plane *= g2
-                plane += 128.0
-        if cam.noise > 0:
-            pad = self.noise_pad
-            b, dy, dx = self.rng.integers(2), self.rng.integers(pad), self.rng.integers(pad)
-            Y += self.noise_y[b, dy : dy + h, dx : dx + w]
-            b, dy, dx = self.rng.integers(2), self.rng.integers(pad), self.rng.integers(pad)
-            U += self.noise_c[b, dy : dy + h // 2, dx : dx + w // 2]
-            b, dy, dx = self.rng.integers(2), self.rng.integers(pad), self.rng.integers(pad)
-            V += self.noise_c[b, dy : dy + h // 2, dx : dx + w // 2]
+            composite(Y, U, V, x0, y0, rod, bob, self.vis[i], span, rod_yuv, bob_yuv)
+            drawn.append((x0, y0, span))
+        gain = self._light(t)
+        gain2 = 0.5 * (gain[0::2] + gain[1::2])
         buf = self.buffer
-        for plane, target in (
-            (Y, buf[:h]),
-            (U, buf[h : h + h // 4].reshape(h // 2, w // 2)),
-            (V, buf[h + h // 4 :].reshape(h // 2, w // 2)),
+        targets = (
+            buf[:h],
+            buf[h : h + h // 4].reshape(h // 2, w // 2),
+            buf[h + h // 4 :].reshape(h // 2, w // 2),
+        )
+        for plane, target, offset, g, c in zip(
+            self.work, targets, (16.0, 128.0, 128.0), (gain, gain2, gain2), (0, 1, 1), strict=True
         ):
-            plane += 0.5
-            np.clip(plane, 0.0, 255.0, out=plane)
-            np.copyto(target, plane, casting="unsafe")
+            noise, dy, dx = self._noise(c)
+            finish_plane(target, plane, offset, g, noise, dy, dx)
+        for x0, y0, span in drawn:
+            restore(Y, self.Y, x0, y0, span, 1)
+            restore(U, self.U, x0, y0, span, 2)
+            restore(V, self.V, x0, y0, span, 2)
         return buf
+
+    def _light(self, t: float) -> np.ndarray:
+        """(H,) float32: each row's light, 1 on average, averaged over its exposure."""
+        cam = self.camera
+        if not (cam.flicker_hz > 0 and cam.flicker_depth > 0):
+            return self.no_flicker
+        rows = t + self.row_delay * np.arange(cam.height)
+        smear = np.sinc(cam.flicker_hz * self.exposure)
+        gain = 1.0 + 0.5 * cam.flicker_depth * smear * np.cos(
+            2 * np.pi * cam.flicker_hz * rows + self.flicker_phase
+        )
+        return gain.astype(np.float32)
+
+    def _noise(self, chroma: int) -> tuple[np.ndarray, int, int]:
+        if self.camera.noise <= 0:
+            return self.no_noise, 0, 0
+        bank = self.noise_c if chroma else self.noise_y
+        pad = self.noise_pad
+        b, dy, dx = self.rng.integers(len(bank)), self.rng.integers(pad), self.rng.integers(pad)
+        return bank[b], int(dy), int(dx)
 
     def _samples(self, i: int, t: float) -> int:
         if self.exposure <= 0:
@@ -247,7 +258,7 @@ class Filming:
         a, b = np.interp([t - half_e, t + half_e], self.times, self.theta[:, i])
         length_px = self.pinhole.focal_px * m.rod_length / self.pinhole.depth(m.pivot)
         return int(
-            np.clip(math.ceil(abs(b - a) * length_px / 0.7), 1, self.camera.max_blur_samples)
+            np.clip(math.ceil(abs(b - a) * length_px / 1.2), 1, self.camera.max_blur_samples)
         )
 
     # -- file ---------------------------------------------------------------------------

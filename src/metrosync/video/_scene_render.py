@@ -257,10 +257,12 @@ def _vignette(image: np.ndarray, rng) -> None:
 
 
 @nb.njit(cache=False, nogil=True)
-def rod_coverage(rod, bob, x0, y0, pivot_x, pivot_y, tips, bobs, rod_hw, bob_hl, bob_hw):
+def rod_coverage(rod, bob, span, x0, y0, pivot_x, pivot_y, tips, bobs, rod_hw, bob_hl, bob_hw):
     """Accumulate the mean coverage of the rod and of the bob over one frame's samples.
 
     rod, bob : (h, w) float32, zeroed, the box [y0, y0+h) × [x0, x0+w); filled in place.
+    span : (h, 2) int64, set to each row's first and past-the-last column touched
+        (0, 0 where none).
     tips, bobs : (h, K, 2) projected tip and bob centre for each box row and each of K
         samples in the exposure (a row's samples at that row's times).
     rod_hw : half width of the rod; bob_hl, bob_hw : half length along and half width
@@ -272,6 +274,8 @@ def rod_coverage(rod, bob, x0, y0, pivot_x, pivot_y, tips, bobs, rod_hw, bob_hl,
     reach = max(rod_hw, bob_hl, bob_hw) + 1.5
     for r in range(h):
         y = y0 + r
+        lo = w
+        hi = 0
         for k in range(k_samples):
             tx = tips[r, k, 0]
             ty = tips[r, k, 1]
@@ -284,8 +288,20 @@ def rod_coverage(rod, bob, x0, y0, pivot_x, pivot_y, tips, bobs, rod_hw, bob_hl,
             uy = dy / length
             bx = bobs[r, k, 0]
             by = bobs[r, k, 1]
-            c0 = max(0, int(math.floor(min(pivot_x, tx) - reach - x0)))
-            c1 = min(w, int(math.ceil(max(pivot_x, tx) + reach - x0)) + 1)
+            # Only the columns of this row near the segment: a band of half width
+            # `reach` about a line of slope dx/dy, clamped to the segment's span.
+            c0 = int(math.floor(min(pivot_x, tx) - reach - x0))
+            c1 = int(math.ceil(max(pivot_x, tx) + reach - x0)) + 1
+            if abs(dy) > 1e-3:
+                s = min(max((y - pivot_y) / dy, 0.0), 1.0)
+                xc = pivot_x + s * dx - x0
+                spread = reach * (length + abs(dx)) / abs(dy) + 1.0
+                c0 = max(c0, int(math.floor(xc - spread)))
+                c1 = min(c1, int(math.ceil(xc + spread)) + 1)
+            c0 = max(c0, 0)
+            c1 = min(c1, w)
+            lo = min(lo, c0)
+            hi = max(hi, c1)
             for c in range(c0, c1):
                 px = x0 + c - pivot_x
                 py = y - pivot_y
@@ -301,3 +317,96 @@ def rod_coverage(rod, bob, x0, y0, pivot_x, pivot_y, tips, bobs, rod_hw, bob_hl,
                 cov_bob = min(max(cov_bob, 0.0), 1.0)
                 rod[r, c] += weight * cov_rod * (1.0 - cov_bob)
                 bob[r, c] += weight * cov_bob
+        if hi > lo:
+            span[r, 0] = lo
+            span[r, 1] = hi
+        else:
+            span[r, 0] = 0
+            span[r, 1] = 0
+
+
+@nb.njit(cache=False, nogil=True)
+def composite(y_plane, u_plane, v_plane, x0, y0, rod, bob, vis, span, rod_yuv, bob_yuv):
+    """Lay a rod and its bob of coverages ``rod``, ``bob`` (h, w) seen through ``vis``
+    (h, w) over the planes, in place, on the columns ``span`` (h, 2) of each box row.
+
+    x0, y0 : the box's corner, even.   rod_yuv, bob_yuv : (3,) colours. Chroma, at half
+    resolution, takes the mean of each 2 × 2 block's coverage.
+    """
+    h = rod.shape[0]
+    for r in range(h):
+        for c in range(span[r, 0], span[r, 1]):
+            a = rod[r, c] * vis[r, c]
+            b = bob[r, c] * vis[r, c]
+            old = y_plane[y0 + r, x0 + c]
+            y_plane[y0 + r, x0 + c] = old + a * (rod_yuv[0] - old) + b * (bob_yuv[0] - old)
+    for rr in range(h // 2):
+        r = 2 * rr
+        lo, hi = _pair_span(span, r)
+        for cc in range(lo // 2, (hi + 1) // 2):
+            c = 2 * cc
+            a = 0.0
+            b = 0.0
+            for dr in range(2):
+                for dc in range(2):
+                    a += rod[r + dr, c + dc] * vis[r + dr, c + dc]
+                    b += bob[r + dr, c + dc] * vis[r + dr, c + dc]
+            a *= 0.25
+            b *= 0.25
+            yy = y0 // 2 + rr
+            xx = x0 // 2 + cc
+            old = u_plane[yy, xx]
+            u_plane[yy, xx] = old + a * (rod_yuv[1] - old) + b * (bob_yuv[1] - old)
+            old = v_plane[yy, xx]
+            v_plane[yy, xx] = old + a * (rod_yuv[2] - old) + b * (bob_yuv[2] - old)
+
+
+@nb.njit(cache=False, nogil=True)
+def _pair_span(span, r):
+    """Columns [lo, hi) touched in box rows r and r + 1 (lo ≥ hi: none)."""
+    lo = 1 << 30
+    hi = 0
+    for q in range(r, r + 2):
+        if span[q, 1] > span[q, 0]:
+            lo = min(lo, span[q, 0])
+            hi = max(hi, span[q, 1])
+    return lo, hi
+
+
+@nb.njit(cache=False, nogil=True)
+def restore(work, static, x0, y0, span, scale):
+    """Copy ``static`` back over ``work`` on the columns ``span`` (h, 2) of a box's rows
+    (``scale`` = 2 for a chroma plane: half the rows and columns)."""
+    h = span.shape[0]
+    for r in range(0, h, scale):
+        if scale == 2:
+            lo, hi = _pair_span(span, r)
+        else:
+            lo, hi = span[r, 0], span[r, 1]
+        for c in range(lo // scale, (hi + scale - 1) // scale):
+            work[(y0 + r) // scale, x0 // scale + c] = static[(y0 + r) // scale, x0 // scale + c]
+
+
+@nb.njit(cache=False, nogil=True)
+def finish_plane(out, plane, offset, gain, noise, dy, dx):
+    """Write one plane of a frame: light gain per row, noise, rounding to 8 bits.
+
+    out : (h, w) uint8, written.   plane : (h, w) float32 levels.
+    offset : the level that the light does not scale (16 for luma, 128 for chroma).
+    gain : (h,) the light of each row.   noise : (≥ h + dy, ≥ w + dx) float32, or (0, 0)
+    for none; the frame's noise is its window at (dy, dx).
+    """
+    h, w = plane.shape
+    noisy = noise.shape[0] > 0
+    for r in range(h):
+        g = gain[r]
+        for c in range(w):
+            v = offset + (plane[r, c] - offset) * g + 0.5
+            if noisy:
+                v += noise[r + dy, c + dx]
+            if v <= 0.0:
+                out[r, c] = 0
+            elif v >= 255.0:
+                out[r, c] = 255
+            else:
+                out[r, c] = np.uint8(v)
