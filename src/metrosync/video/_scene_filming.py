@@ -83,7 +83,7 @@ def aim(scene: Scene, camera, sweeps: np.ndarray) -> Pinhole:
 class Filming:
     """One run filmed by one camera: schedule, static layers, per-frame rendering."""
 
-    def __init__(self, scene: Scene, camera, times: np.ndarray, theta: np.ndarray, rng, fmt: str):
+    def __init__(self, scene: Scene, camera, times, theta, rng, fmt: str, *, pictures: bool = True):
         self.scene, self.camera, self.format = scene, camera, fmt
         self.rate = Fraction(camera.fps).limit_denominator(1001)
         self.time_base = TIME_BASES.get(fmt, 1 / self.rate)
@@ -93,7 +93,9 @@ class Filming:
         self.row_delay = camera.readout / camera.height
         self.exposure = camera.exposure
         self._schedule()
-        self._static()
+        self._layout()
+        if pictures:
+            self._static()
 
     # -- time ---------------------------------------------------------------------------
     def _schedule(self) -> None:
@@ -123,15 +125,9 @@ class Filming:
         self.frame_times = self.pts * float(self.time_base)
 
     # -- static layers ------------------------------------------------------------------
-    def _static(self) -> None:
+    def _layout(self) -> None:
+        """Each metronome's swept box, what nearer bodies hide of it, sizes and colours."""
         cam, pin = self.camera, self.pinhole
-        rgb = background(self.scene, pin)
-        yuv = to_yuv(rgb)
-        del rgb
-        self.Y = np.ascontiguousarray(yuv[..., 0])
-        self.U = half(yuv[..., 1])
-        self.V = half(yuv[..., 2])
-        del yuv
         order = sorted(
             range(self.scene.n), key=lambda i: -pin.depth(self.scene.metronomes[i].pivot)
         )
@@ -166,6 +162,16 @@ class Filming:
                     vis *= 1.0 - cov
             self.vis[i] = vis
             self.colours[i] = (to_yuv(m.rod_colour), to_yuv(m.bob_colour))
+
+    def _static(self) -> None:
+        cam = self.camera
+        rgb = background(self.scene, self.pinhole)
+        yuv = to_yuv(rgb)
+        del rgb
+        self.Y = np.ascontiguousarray(yuv[..., 0])
+        self.U = half(yuv[..., 1])
+        self.V = half(yuv[..., 2])
+        del yuv
         h, w = cam.height, cam.width
         self.noise_pad = 16
         if cam.noise > 0:
@@ -294,6 +300,26 @@ class Filming:
 
         return [_all_crossings(self.times, self.theta[:, i]) for i in range(self.scene.n)]
 
+    def visible(self) -> np.ndarray:
+        """(N,) fraction of each rod, over its whole swing, that nearer bodies leave seen."""
+        out = np.ones(self.scene.n)
+        for i, m in enumerate(self.scene.metronomes):
+            if self.boxes[i] is None:
+                out[i] = 0.0
+                continue
+            x0, y0, x1, y1 = self.boxes[i]
+            angles = np.linspace(-1.0, 1.0, 9)[:, None] * min(self.sweeps[i], 0.5)
+            tips = self.pinhole.project(rod_points(m, angles)[0])
+            pivot = self.pinhole.project(m.pivot)
+            along = np.linspace(0.05, 1.0, 24)[None, :, None]
+            xy = pivot + along * (tips - pivot)
+            col = np.clip(np.round(xy[..., 0]).astype(int) - x0, 0, x1 - x0 - 1)
+            row = np.clip(np.round(xy[..., 1]).astype(int) - y0, 0, y1 - y0 - 1)
+            inside = (xy[..., 0] >= 0) & (xy[..., 0] < self.camera.width)
+            inside &= (xy[..., 1] >= 0) & (xy[..., 1] < self.camera.height)
+            out[i] = float(np.mean(self.vis[i][row, col] * inside))
+        return out
+
     def _filmed(self, times: np.ndarray) -> np.ndarray:
         return times[(times >= 0.0) & (times <= self.frame_times[-1])]
 
@@ -321,7 +347,7 @@ class Filming:
             ticks=[self._filmed(t) for t in self.ticks()], start_s=self.origin,
             audio=audio is not None,
             audio_delay_s=0.0 if audio is None else float(audio.delay_s), rotation=cam.rotation,
-            scene=self.scene, camera=cam, pinhole=pin,
+            visible=self.visible(), scene=self.scene, camera=cam, pinhole=pin,
         )  # fmt: skip
 
 

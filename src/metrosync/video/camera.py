@@ -37,6 +37,9 @@ What the camera does (`Camera`, each part can be switched off; `Camera.ideal` ha
 * sound (``audio``): a mono track (AAC by default) with a click at every passage of
   each metronome through the vertical, ``delay_s`` late.
 
+Metronomes standing close together hide one another more or less depending on where
+the camera stands: `visibility` (or `FilmTruth.visible`) says how much of each rod shows.
+
 `FilmTruth` is what the tracker should find: per frame its presentation time and the
 true angles; per metronome the pixel position of the pivot and of the rod's tip at rest,
 and the true upward crossings of the vertical (θ passing 0 from below, interpolated
@@ -59,7 +62,10 @@ from ._scene import Metronome, Scene
 from ._scene_filming import Filming, displayed
 from ._scene_render import Pinhole, rod_points
 
-__all__ = ["Camera", "FilmTruth", "Metronome", "Microphone", "Scene", "film", "upward_crossings"]
+__all__ = [
+    "Camera", "FilmTruth", "Metronome", "Microphone", "Scene", "film", "upward_crossings",
+    "visibility",
+]  # fmt: skip
 
 #: Suffixes (containers) `film` writes.
 CONTAINERS = {".mp4": "mp4", ".mov": "mov", ".mkv": "matroska", ".avi": "avi"}
@@ -226,6 +232,8 @@ class FilmTruth:
     crossings : N arrays, upward crossings (θ passing 0 from below) between the first
         and the last frame, s.
     ticks : N arrays, every passage through the vertical (both ways), same span, s.
+    visible : (N,) fraction of each rod, over its swing (up to ±0.5 rad), that no nearer
+        body hides and that lies inside the picture (1: all of it).
     audio : whether the file has a sound track.   audio_delay_s : its delay, s.
     rotation : the display matrix's counter-clockwise turn, degrees.
     scene, camera : what was filmed and how.
@@ -250,6 +258,7 @@ class FilmTruth:
     audio: bool
     audio_delay_s: float
     rotation: int
+    visible: np.ndarray
     scene: Scene = field(repr=False)
     camera: Camera = field(repr=False)
     pinhole: Pinhole = field(repr=False)
@@ -288,7 +297,7 @@ class FilmTruth:
         ):  # fmt: skip
             out[key] = getattr(self, key)
         out["path"] = str(self.path)
-        for key in ("frame_times", "theta", "pivot_px", "tip_px", "bob_px"):
+        for key in ("frame_times", "theta", "pivot_px", "tip_px", "bob_px", "visible"):
             out[key] = np.asarray(getattr(self, key)).tolist()
         out["crossings"] = [c.tolist() for c in self.crossings]
         out["ticks"] = [c.tolist() for c in self.ticks]
@@ -373,6 +382,20 @@ def film(
     with atomic_path(path, keep_suffix=True) as tmp:
         filming.write(tmp, audio)
     return filming.truth(path, audio)
+
+
+def visibility(
+    scene: Scene, camera: Camera | None = None, *, amplitude: float = 0.45
+) -> np.ndarray:
+    """(N,) the fraction of each rod, swinging ±``amplitude`` rad, that ``camera`` would
+    see (`FilmTruth.visible`), without rendering anything: pick scenes where no
+    metronome hides another before filming them."""
+    camera = Camera() if camera is None else camera
+    _check_range("amplitude", amplitude, 0.0, 1.2)
+    times = np.linspace(0.0, 2.0 + 4.0 / camera.frame_rate, 5)
+    theta = np.tile(amplitude * np.array([0.0, 1.0, 0.0, -1.0, 0.0])[:, None], (1, scene.n))
+    filming = Filming(scene, camera, times, theta, np.random.default_rng(0), "mp4", pictures=False)
+    return filming.visible()
 
 
 def _check_trajectory(times, theta, n: int) -> tuple[np.ndarray, np.ndarray]:
