@@ -446,3 +446,18 @@ def test_visibility_says_when_one_metronome_hides_another():
     # From 40° to the right of the axis the one behind shows beside the one in front.
     aside_view = visibility(scene, Camera.ideal(width=320, height=240, yaw_deg=40.0))
     assert aside_view[1] > 0.8
+
+
+def test_random_cameras_film_within_a_phones_range(tmp_path):
+    cameras = [Camera.random(seed) for seed in range(40)]
+    yaws = np.array([c.yaw_deg for c in cameras])
+    assert np.all((np.abs(yaws) >= 20) & (np.abs(yaws) <= 40))
+    assert (yaws > 0).any() and (yaws < 0).any()
+    assert {c.fps for c in cameras} == {30.0, 60.0, 240.0}
+    assert {c.flicker_hz for c in cameras} == {100.0, 120.0}
+    assert Camera.random(3, fps=60.0, width=320, height=240).fps == 60.0
+    t, theta = swing(1.0, 2)
+    camera = Camera.random(7, width=320, height=240)
+    truth = film(tmp_path / "r.mov", t, theta, scene=Scene.random(2, 7), camera=camera)
+    times, _, _ = luma_frames(truth.path)
+    assert np.abs(times - truth.frame_times).max() < 1e-9

@@ -16,6 +16,7 @@ import av
 import numpy as np
 
 from ..errors import ParameterError
+from ..observables.entrainment import upward_crossings
 from ..show.sound import PITCH_RANGE, click_waveform
 from ._scene import Scene
 from ._scene_render import (
@@ -177,8 +178,6 @@ class Filming:
         if cam.noise > 0:
             shape = (2, h + self.noise_pad, w + self.noise_pad)
             self.noise_y = self.rng.normal(0.0, cam.noise, shape).astype(np.float32)
-            shape = (2, h // 2 + self.noise_pad, w // 2 + self.noise_pad)
-            self.noise_c = self.rng.normal(0.0, 0.6 * cam.noise, shape).astype(np.float32)
         self.flicker_phase = float(self.rng.uniform(0, 2 * np.pi))
         self.buffer = np.empty((h * 3 // 2, w), np.uint8)
         self.work = (self.Y.copy(), self.U.copy(), self.V.copy())
@@ -249,9 +248,11 @@ class Filming:
         return gain.astype(np.float32)
 
     def _noise(self, chroma: int) -> tuple[np.ndarray, int, int]:
-        if self.camera.noise <= 0:
+        # Luma only: a phone's processing removes nearly all chroma noise, which would
+        # otherwise cost the encoder most of its bits.
+        if self.camera.noise <= 0 or chroma:
             return self.no_noise, 0, 0
-        bank = self.noise_c if chroma else self.noise_y
+        bank = self.noise_y
         pad = self.noise_pad
         b, dy, dx = self.rng.integers(len(bank)), self.rng.integers(pad), self.rng.integers(pad)
         return bank[b], int(dy), int(dx)
@@ -296,9 +297,7 @@ class Filming:
 
     # -- truth --------------------------------------------------------------------------
     def ticks(self) -> list[np.ndarray]:
-        from .camera import _all_crossings
-
-        return [_all_crossings(self.times, self.theta[:, i]) for i in range(self.scene.n)]
+        return [all_crossings(self.times, self.theta[:, i]) for i in range(self.scene.n)]
 
     def visible(self) -> np.ndarray:
         """(N,) fraction of each rod, over its whole swing, that nearer bodies leave seen."""
@@ -323,9 +322,8 @@ class Filming:
     def _filmed(self, times: np.ndarray) -> np.ndarray:
         return times[(times >= 0.0) & (times <= self.frame_times[-1])]
 
-    def truth(self, path: Path, audio):
-        from .camera import FilmTruth, upward_crossings
-
+    def truth(self, path: Path, audio) -> dict:
+        """The fields of `FilmTruth`."""
         cam, pin = self.camera, self.pinhole
         rest = [rod_points(m, 0.0) for m in self.scene.metronomes]
         pivot = pin.project(np.array([m.pivot for m in self.scene.metronomes]))
@@ -337,7 +335,7 @@ class Filming:
         width, height = (
             (cam.height, cam.width) if cam.rotation in (90, 270) else (cam.width, cam.height)
         )
-        return FilmTruth(
+        return dict(
             path=path, n=self.scene.n, width=width, height=height, fps=float(cam.fps),
             frame_times=self.frame_times.copy(), theta=theta, row_delay_s=self.row_delay,
             exposure_s=self.exposure, dropped=self.dropped,
@@ -349,6 +347,13 @@ class Filming:
             audio_delay_s=0.0 if audio is None else float(audio.delay_s), rotation=cam.rotation,
             visible=self.visible(), scene=self.scene, camera=cam, pinhole=pin,
         )  # fmt: skip
+
+
+def all_crossings(times: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Times (K,) where θ (T,) passes 0 either way, linear between samples ``times``."""
+    sign = theta >= 0
+    k = np.flatnonzero(sign[:-1] != sign[1:])
+    return times[k] + (times[k + 1] - times[k]) * theta[k] / (theta[k] - theta[k + 1])
 
 
 def displayed(xy: np.ndarray, cam) -> np.ndarray:

@@ -21,7 +21,8 @@ What the camera does (`Camera`, each part can be switched off; `Camera.ideal` ha
 * flicker: the light varies at ``flicker_hz`` (100 or 120 Hz, twice the mains) by
   ``flicker_depth``, averaged over each row's exposure (so it shows as bands, and as
   its alias at the frame rate);
-* sensor noise: Gaussian, ``noise`` digital levels rms in luma;
+* sensor noise: Gaussian, ``noise`` digital levels rms, in luma only (phones remove
+  chroma noise);
 * H.264 (libx264, yuv420p, no B-frames, a key frame a second) at ``bitrate`` (default:
   a phone's, about 0.1 bit per pixel per frame), written with PyAV; the container is
   chosen from the file's suffix: .mp4 and .mov (timestamps in 1/90000 s, as phones
@@ -58,6 +59,7 @@ import numpy as np
 
 from .._files import atomic_path
 from ..errors import ParameterError
+from ..observables.entrainment import upward_crossings
 from ._scene import Metronome, Scene
 from ._scene_filming import Filming, displayed
 from ._scene_render import Pinhole, rod_points
@@ -167,6 +169,41 @@ class Camera:
                 1.0 * base.get("width", 1280) * base.get("height", 720) * base.get("fps", 60.0)
             )
         return cls(**base)
+
+    @classmethod
+    def random(cls, seed: int = 0, **options) -> Camera:
+        """A phone drawn at random: 20–40° to either side, tilted down 0–30°, a field of
+        view of 55–80°, framing, exposure, rolling shutter, noise, 100 or 120 Hz
+        flicker, jitter, drops and bit rate all drawn within what phones do; the frame
+        rate is 30, 60 or 240 fps. ``options`` fix any field (e.g. ``fps=60``)."""
+        rng = np.random.default_rng(seed)
+        fps = float(options.get("fps", rng.choice([30.0, 60.0, 60.0, 240.0])))
+        period = 1.0 / float(options.get("real_fps") or fps)
+        drawn = dict(
+            fps=fps,
+            width=640,
+            height=360,
+            yaw_deg=float(rng.uniform(20.0, 40.0) * rng.choice([-1.0, 1.0])),
+            pitch_deg=float(rng.uniform(0.0, 30.0)),
+            roll_deg=float(rng.normal(0.0, 2.0)),
+            hfov_deg=float(rng.uniform(55.0, 80.0)),
+            framing=float(rng.uniform(0.5, 0.9)),
+            exposure_s=float(period * rng.uniform(0.1, 0.9)),
+            rolling_shutter_s=float(min(period, 0.03) * rng.uniform(0.3, 0.95)),
+            noise=float(rng.uniform(0.5, 4.0)),
+            flicker_hz=float(rng.choice([100.0, 120.0])),
+            flicker_depth=float(rng.uniform(0.0, 0.15)),
+            vfr_jitter_s=float(rng.uniform(0.0, 0.2) * period),
+            drop_fraction=float(rng.uniform(0.0, 0.03)),
+        )
+        drawn["bitrate"] = float(
+            rng.uniform(0.05, 0.2)
+            * options.get("width", drawn["width"])
+            * options.get("height", drawn["height"])
+            * fps
+        )
+        drawn.update(options)
+        return cls(**drawn)
 
     @property
     def frame_rate(self) -> float:
@@ -305,24 +342,6 @@ class FilmTruth:
         return json.dumps(out)
 
 
-def upward_crossings(times: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Times (K,) where θ (T,) passes 0 from below, linear between samples ``times`` (T,)."""
-    below = theta[:-1] < 0
-    up = np.flatnonzero(below & (theta[1:] >= 0))
-    return _interpolate_zero(times, theta, up)
-
-
-def _all_crossings(times: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    sign = theta >= 0
-    idx = np.flatnonzero(sign[:-1] != sign[1:])
-    return _interpolate_zero(times, theta, idx)
-
-
-def _interpolate_zero(times, theta, idx) -> np.ndarray:
-    t0, t1, y0, y1 = times[idx], times[idx + 1], theta[idx], theta[idx + 1]
-    return t0 + (t1 - t0) * (-y0) / (y1 - y0)
-
-
 def film(
     path: str | Path,
     times,
@@ -381,7 +400,7 @@ def film(
     filming = Filming(scene, camera, t_video, theta, rng, CONTAINERS[suffix])
     with atomic_path(path, keep_suffix=True) as tmp:
         filming.write(tmp, audio)
-    return filming.truth(path, audio)
+    return FilmTruth(**filming.truth(path, audio))
 
 
 def visibility(
