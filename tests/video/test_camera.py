@@ -228,6 +228,19 @@ def test_flicker_aliases_at_the_frame_rate_and_vanishes_over_a_full_cycle(tmp_pa
     assert frequencies[np.argmax(spectrum)] == pytest.approx(10.0, abs=0.6)  # |100 − 3·30|
 
 
+def test_light_drifts_slowly_only_when_asked(tmp_path):
+    t, theta = still(4.0)
+    means = {}
+    for drift in (0.0, 0.3):
+        camera = clean(light_drift=drift)
+        truth = film(tmp_path / f"d{drift}.mp4", t, theta, scene=plain_scene(), camera=camera)
+        means[drift] = frame_means(truth.path)
+    assert np.ptp(means[0.0]) < 0.5
+    assert np.ptp(means[0.3]) > 3.0
+    steps = np.abs(np.diff(means[0.3]))
+    assert steps.max() < 0.1 * np.ptp(means[0.3])  # slow: no jumps between frames
+
+
 def test_rolling_shutter_bands_the_flicker(tmp_path):
     t, theta = still(1.0)
     camera = clean(flicker_hz=100.0, flicker_depth=0.3, exposure_s=1e-3, rolling_shutter_s=0.03)

@@ -179,6 +179,7 @@ class Filming:
             shape = (2, h + self.noise_pad, w + self.noise_pad)
             self.noise_y = self.rng.normal(0.0, cam.noise, shape).astype(np.float32)
         self.flicker_phase = float(self.rng.uniform(0, 2 * np.pi))
+        self.drift = (self.rng.uniform(2.0, 15.0, 3), self.rng.uniform(0, 2 * np.pi, 3))
         self.buffer = np.empty((h * 3 // 2, w), np.uint8)
         self.work = (self.Y.copy(), self.U.copy(), self.V.copy())
         self.no_flicker = np.ones(h, np.float32)
@@ -238,14 +239,18 @@ class Filming:
     def _light(self, t: float) -> np.ndarray:
         """(H,) float32: each row's light, 1 on average, averaged over its exposure."""
         cam = self.camera
+        level = 1.0
+        if cam.light_drift > 0:
+            periods, phases = self.drift
+            level += cam.light_drift * float(np.mean(np.sin(2 * np.pi * t / periods + phases)))
         if not (cam.flicker_hz > 0 and cam.flicker_depth > 0):
-            return self.no_flicker
+            return self.no_flicker if level == 1.0 else np.full(cam.height, level, np.float32)
         rows = t + self.row_delay * np.arange(cam.height)
         smear = np.sinc(cam.flicker_hz * self.exposure)
         gain = 1.0 + 0.5 * cam.flicker_depth * smear * np.cos(
             2 * np.pi * cam.flicker_hz * rows + self.flicker_phase
         )
-        return gain.astype(np.float32)
+        return (level * gain).astype(np.float32)
 
     def _noise(self, chroma: int) -> tuple[np.ndarray, int, int]:
         # Luma only: a phone's processing removes nearly all chroma noise, which would
