@@ -474,3 +474,12 @@ def test_random_cameras_film_within_a_phones_range(tmp_path):
     truth = film(tmp_path / "r.mov", t, theta, scene=Scene.random(2, 7), camera=camera)
     times, _, _ = luma_frames(truth.path)
     assert np.abs(times - truth.frame_times).max() < 1e-9
+
+
+def test_an_unwritable_path_is_named(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    t, theta = swing(1.0, 1)
+    with pytest.raises(OSError, match="`path` = .*file/clip.mp4"):
+        film(blocker / "clip.mp4", t, theta, scene=plain_scene(), camera=clean())
+    assert [p.name for p in tmp_path.iterdir()] == ["file"]

@@ -109,8 +109,9 @@ class Filming:
         count = int(math.floor((last - lead) / period)) + 1
         if count < 1:
             raise ParameterError(
-                f"The trajectory ({self.times[-1]:.3g} s) is too short for one frame at "
-                f"{cam.frame_rate:g} fps: pass a longer run."
+                f"`times` spans {self.times[-1]:.3g} s, too short for one frame at "
+                f"{cam.frame_rate:g} fps with its exposure and readout "
+                f"({lead + tail:.3g} s): pass a longer run."
             )
         nominal = lead + period * np.arange(count)
         jitter = np.clip(rng.normal(0.0, cam.vfr_jitter_s, count), -jitter_cap, jitter_cap)

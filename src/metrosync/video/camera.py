@@ -264,9 +264,13 @@ class Microphone:
     noise: float = 0.002
 
     def __post_init__(self) -> None:
-        if self.sample_rate not in (8000, 16000, 22050, 24000, 32000, 44100, 48000):
+        if (
+            isinstance(self.sample_rate, bool)
+            or self.sample_rate not in (8000, 16000, 22050, 24000, 32000, 44100, 48000)
+            or not isinstance(self.sample_rate, int | np.integer)
+        ):
             raise ParameterError(
-                f"`sample_rate` must be a standard rate such as 44100 or 48000 Hz, got "
+                f"`sample_rate` must be an integer standard rate such as 44100 or 48000 Hz, got "
                 f"{self.sample_rate!r}."
             )
         if self.codec not in ("aac", "pcm_s16le"):
@@ -421,8 +425,11 @@ def film(
     rng = np.random.default_rng(seed)
     t_video = times - times[0]
     filming = Filming(scene, camera, t_video, theta, rng, CONTAINERS[suffix])
-    with atomic_path(path, keep_suffix=True) as tmp:
-        filming.write(tmp, audio)
+    try:
+        with atomic_path(path, keep_suffix=True) as tmp:
+            filming.write(tmp, audio)
+    except OSError as error:
+        raise OSError(f"Cannot write the video `path` = {str(path)!r}: {error}") from error
     return FilmTruth(**filming.truth(path, audio))
 
 
