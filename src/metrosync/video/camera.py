@@ -45,8 +45,8 @@ What the camera does (`Camera`, each part can be switched off; `Camera.ideal` ha
 * ``rotation``: the phone held turned (90 = portrait): the picture is stored turned
   and the container's display matrix says how to turn it back (PyAV: the picture as
   shown is ``np.rot90(decoded, frame.rotation // 90)``, the rotation read back in
-  [-180, 180]: 270 reads −90); rows, and so the rolling
-  shutter, run down the stored picture.
+  [-180, 180]: 270 reads −90); rows, and so the rolling shutter, run down the stored
+  picture.
 * sound (``audio``): a mono track (AAC by default) with a click at every passage of
   each metronome through the vertical, ``delay_s`` late.
 
