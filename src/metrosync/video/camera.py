@@ -200,7 +200,10 @@ class Camera:
         flicker, jitter, drops and bit rate all drawn within what phones do; the frame
         rate is 30, 60 or 240 fps. ``options`` fix any field (e.g. ``fps=60``)."""
         rng = np.random.default_rng(seed)
-        fps = float(options.get("fps", rng.choice([30.0, 60.0, 60.0, 240.0])))
+        fps = options.get("fps", float(rng.choice([30.0, 60.0, 60.0, 240.0])))
+        _check_range("fps", fps, 1.0, 1000.0)
+        if options.get("real_fps") is not None:
+            _check_range("real_fps", options["real_fps"], 1.0, 1000.0)
         period = 1.0 / float(options.get("real_fps") or fps)
         drawn = dict(
             fps=fps,
