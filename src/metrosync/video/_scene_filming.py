@@ -17,7 +17,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..observables.entrainment import upward_crossings
-from ..show.sound import PITCH_RANGE, click_waveform
 from ._scene import Scene
 from ._scene_render import (
     MIN_SWEEP,
@@ -31,6 +30,7 @@ from ._scene_render import (
     rod_coverage,
     rod_points,
 )
+from ._scene_sound import Sound
 
 #: Tick of the presentation timestamps in each container: MP4 and MOV take a phone's
 #: 1/90000 s, Matroska counts milliseconds, and AVI counts frame periods.
@@ -40,8 +40,6 @@ RGB_TO_YUV = np.array(
     np.float32,
 )
 YUV_OFFSET = np.array([16.0, 128.0, 128.0], np.float32)
-#: Audio samples per encoded audio frame.
-AUDIO_FRAME = 1024
 
 
 def to_yuv(rgb) -> np.ndarray:
@@ -289,7 +287,7 @@ class Filming:
             stream.options = {"preset": cam.preset}
             if cam.rotation:
                 stream.set_display_rotation(cam.rotation)
-            sound = _Sound(container, audio, self) if audio is not None else None
+            sound = Sound(container, audio, self.ticks(), self.rng) if audio is not None else None
             for t, pts in zip(self.frame_times, self.pts, strict=True):
                 frame = av.VideoFrame.from_ndarray(self.render(float(t)), format="yuv420p")
                 frame.pts = int(pts)
@@ -374,61 +372,3 @@ def displayed(xy: np.ndarray, cam) -> np.ndarray:
     elif cam.rotation == 270:
         x, y = h - 1 - y, x
     return np.column_stack([x, y])
-
-
-class _Sound:
-    """The sound track, rendered and encoded block by block as the picture advances."""
-
-    def __init__(self, container, mic, filming: Filming):
-        self.mic, self.rate = mic, mic.sample_rate
-        self.stream = container.add_stream(mic.codec, rate=self.rate, layout="mono")
-        self.container = container
-        self.rng = filming.rng
-        n = filming.scene.n
-        pitches = np.linspace(*PITCH_RANGE, n) if n > 1 else [PITCH_RANGE[0]]
-        self.waves = [0.9 / n * click_waveform(p, self.rate) for p in pitches]
-        onsets, owners = [], []
-        for i, ticks in enumerate(filming.ticks()):
-            onsets.append(np.round((ticks + mic.delay_s) * self.rate).astype(np.int64))
-            owners.append(np.full(ticks.size, i))
-        onsets, owners = np.concatenate(onsets), np.concatenate(owners)
-        order = np.argsort(onsets, kind="stable")
-        self.onsets, self.owners = onsets[order], owners[order]
-        self.longest = max(w.size for w in self.waves)
-        self.done = 0
-        self.s16 = mic.codec == "pcm_s16le"
-
-    def until(self, t: float) -> None:
-        end = int(math.floor(t * self.rate))
-        while self.done + AUDIO_FRAME <= end:
-            self._frame()
-
-    def _frame(self) -> None:
-        s0, n = self.done, AUDIO_FRAME
-        block = (
-            self.rng.normal(0.0, self.mic.noise, n).astype(np.float32)
-            if self.mic.noise
-            else (np.zeros(n, np.float32))
-        )
-        lo = np.searchsorted(self.onsets, s0 - self.longest, side="left")
-        hi = np.searchsorted(self.onsets, s0 + n, side="left")
-        for onset, owner in zip(self.onsets[lo:hi], self.owners[lo:hi], strict=True):
-            wave = self.waves[owner]
-            a, b = max(s0, onset), min(s0 + n, onset + wave.size)
-            if b > a:
-                block[a - s0 : b - s0] += wave[a - onset : b - onset]
-        np.clip(block, -1.0, 1.0, out=block)
-        if self.s16:
-            frame = av.AudioFrame.from_ndarray(
-                (block * 32767).astype(np.int16)[None, :], format="s16", layout="mono"
-            )
-        else:
-            frame = av.AudioFrame.from_ndarray(block[None, :], format="fltp", layout="mono")
-        frame.sample_rate = self.rate
-        frame.pts = s0
-        frame.time_base = Fraction(1, self.rate)
-        self.container.mux(self.stream.encode(frame))
-        self.done += n
-
-    def close(self) -> None:
-        self.container.mux(self.stream.encode(None))
