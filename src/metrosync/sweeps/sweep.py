@@ -77,7 +77,7 @@ class SweepResult:
             f"{len(ex.computed)} computed, {self.reused} reused from {self.store}",
             f"  {ex.seconds:.2f} s wall, {ex.work:.3g} oscillator-steps, "
             f"{ex.throughput:.3g} oscillator-steps/s",
-            f"  runs flagged (overturned/diverged): {flagged} of {simulated} run(s) simulated"
+            f"  runs flagged (overturned/diverged/stopped): {flagged} of {simulated} run(s) simulated"
             + ("; their r is not meaningful (status bits: metrosync.status)" if flagged else ""),
         ]
         failures = self.failures()
