@@ -54,6 +54,7 @@ import numpy as np
 import xarray as xr
 
 from ._version import __version__
+from ._words import plural
 from .budget import simulation_budget
 from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
 from .errors import EscapementWarning, OverturnWarning, ParameterError
@@ -332,11 +333,12 @@ def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
         if defaulted:  # the user gave no stride: the run is what is too short
             raise ParameterError(
                 f"`duration` = {n_steps * dt:g} s is shorter than the default recording "
-                f"interval ({record_every * dt:g} s, {record_every} steps of {dt!r} s); "
-                f"lengthen `duration`, or give `record_every` <= {n_steps} steps."
+                f"interval ({record_every * dt:g} s, {plural(record_every, 'step')} of {dt!r} s); "
+                f"lengthen `duration`, or give `record_every` <= {plural(n_steps, 'step')}."
             )
         raise ParameterError(
-            f"`record_every` = {record_every} steps exceeds the {n_steps} steps of the run; "
+            f"`record_every` = {plural(record_every, 'step')} exceeds the "
+            f"{plural(n_steps, 'step')} of the run; "
             f"lower it or lengthen `duration`."
         )
     return int(record_every), reason

@@ -14,6 +14,7 @@ import math
 import sys
 import time
 
+from .._words import plural
 from ..errors import EmptyLogError, MetrosyncError
 from ..lightgate.follow import LogFollower
 from ..lightgate.live import LiveStatus, live_status
@@ -101,7 +102,7 @@ class LivePanel:
         from rich.text import Text
 
         elapsed = time.monotonic() - self._start
-        foot = Text(f"{elapsed:.0f} s, {self.follower.n_lines} lines", style="dim")
+        foot = Text(f"{elapsed:.0f} s, {plural(self.follower.n_lines, 'line')}", style="dim")
         if status is None:
             return Panel(Group(Text(note), foot), title=self.title)
         table = Table(box=None, pad_edge=False)
@@ -123,10 +124,11 @@ class LivePanel:
             r_line = Text("r(t): needs two gates with two passes each", style="dim")
         parts = [table, r_line]
         if status.records_lost:
-            parts.append(Text(f"the logger LOST {status.records_lost} records (buffer full)",
-                              style="bold red"))  # fmt: skip
+            lost = plural(status.records_lost, "record")
+            parts.append(Text(f"the logger LOST {lost} (buffer full)", style="bold red"))
         if status.restarts:
-            parts.append(Text(f"the logger restarted {status.restarts} times", style="yellow"))
+            restarts = plural(status.restarts, "time")
+            parts.append(Text(f"the logger restarted {restarts}", style="yellow"))
         return Panel(Group(*parts, foot), title=self.title)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._words import plural
 from ._io import check_output
 from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
@@ -58,6 +59,6 @@ def run(args) -> int:
         ds, args.out, run=args.run, fps=args.fps, speedup=speedup,
         start=args.start, end=args.end, dpi=args.dpi,
     )  # fmt: skip
-    print(f"wrote {args.out} ({frames} frames at {args.fps:g} fps, speed-up {speedup:g}, "
+    print(f"wrote {args.out} ({plural(frames, 'frame')} at {args.fps:g} fps, speed-up {speedup:g}, "
           f"{frames / args.fps:.0f} s)")  # fmt: skip
     return 0

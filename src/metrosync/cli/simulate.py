@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..errors import ParameterError
 from ..observables.death import SILENT_PERIODS
 from ..plots import plot_order
@@ -129,11 +130,6 @@ def _simulate_with_gate(args):
     return ds
 
 
-def plural(count: int, noun: str) -> str:
-    """``plural(1, "run") == "1 run"``, ``plural(2, "run") == "2 runs"``."""
-    return f"{count} {noun}" + ("" if count == 1 else "s")
-
-
 def _no_phase(ds) -> str:
     """Why no run has r_eq: too short for every metronome's crossing phase in the
     final window, with the duration that would do."""
@@ -238,8 +234,8 @@ def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
         )
     if str(a.get("record_every_reason", "")).startswith("raised"):
         lines.append(
-            f"  r(t) recorded every {a['record_interval']:g} s ({a['record_every']} steps), "
-            f"{a['record_every_reason']}"
+            f"  r(t) recorded every {a['record_interval']:g} s "
+            f"({plural(a['record_every'], 'step')}), {a['record_every_reason']}"
         )
     lines.append(f"  {elapsed:.2f} s wall, {steps / max(elapsed, 1e-9):.3g} oscillator-steps/s")
     return "\n".join(lines)

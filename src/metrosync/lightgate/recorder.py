@@ -24,6 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .._words import plural
 from ..errors import ParameterError
 from .messages import format_gap
 
@@ -46,9 +47,9 @@ class RecordSummary:
     ended: str
 
     def __str__(self) -> str:
-        gaps = f", {self.gaps} gaps marked" if self.gaps else ""
-        return (f"recorded {self.lines} lines in {self.seconds:.1f} s to {self.out}{gaps} "
-                f"({self.ended})")  # fmt: skip
+        gaps = f", {plural(self.gaps, 'gap')} marked" if self.gaps else ""
+        return (f"recorded {plural(self.lines, 'line')} in {self.seconds:.1f} s to "
+                f"{self.out}{gaps} ({self.ended})")  # fmt: skip
 
 
 class CaptureFile:
