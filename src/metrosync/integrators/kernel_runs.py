@@ -102,7 +102,7 @@ def advance(st, c, settings, rec):
         for w in range(LANES):
             block_forced |= forced(c, (blk, w))
         ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
-        kicks = np.empty(LANES, dtype=np.int64)
+        lk = load_last_kick(last_kick, b0, lanes)
         dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
             dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])  # fmt: skip  # noqa: E501
@@ -117,17 +117,15 @@ def advance(st, c, settings, rec):
                 if alive[w] > 0.0:
                     _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, kicks, overs, sincos)  # fmt: skip  # noqa: E501
-            if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, kicks, overs, libm_sincos)  # fmt: skip  # noqa: E501
             t_old = s * dt
             t_new = (s + 1) * dt
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, sincos)  # fmt: skip  # noqa: E501
+            if n_far > 0:  # rare: redo the pass with libm trig
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, libm_sincos)  # fmt: skip  # noqa: E501
             for w in range(lanes):
-                if ups[w] > 0 or overs[w] > 0 or kicks[w] > 0:
+                if ups[w] > 0 or overs[w] > 0:
                     if alive[w] == 0.0:
                         continue
-                    if kicks[w] > 0:
-                        _book_kicks(c, blk, w, th, tn_s, kicks[w], last_kick, b0 + w, t_new)
                     if overs[w] > 0:
                         status[b0 + w] |= STATUS_OVERTURNED
                     for i in range(n):
@@ -179,18 +177,31 @@ def advance(st, c, settings, rec):
                     if alive[w] > 0.0:
                         _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         store_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, b0, lanes, th, thd, acc, ph, phd, aph, pp, fph)  # fmt: skip  # noqa: E501
+        for w in range(lanes):
+            for i in range(n):
+                last_kick[b0 + w, i] = lk[i, w]
 
 
 @nb.njit(cache=True, inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, kicks, overs, trig):  # fmt: skip  # noqa: E501
+def load_last_kick(last_kick, b0, lanes):
+    """Block-local copy (n, LANES) of the runs' last impulse times (as `load_block`)."""
+    n = last_kick.shape[1]
+    lk = np.empty((n, LANES))
+    for i in range(n):
+        for w in range(LANES):
+            lk[i, w] = last_kick[b0 + min(w, lanes - 1), i]
+    return lk
+
+
+@nb.njit(cache=True, inline="always")
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, trig):  # fmt: skip  # noqa: E501
     """New angles, kicks and the per-lane sums of eqs. (eqm1)–(eqm2) for block ``blk``,
-    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's. Fills
-    the per-lane counts of upward crossings, escapements that fire and overturns;
-    returns the number of far-wound angles."""
+    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's; ``t_new``
+    into ``lk`` where a live lane's escapement fires. Fills the per-lane counts of upward
+    crossings and overturns; returns the number of far-wound angles."""
     n_far = 0
     for w in range(th.shape[1]):
         ups[w] = 0
-        kicks[w] = 0
         overs[w] = 0
         s_num[w] = 0.0
         s_den[w] = 0.0
@@ -201,7 +212,8 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
             tn, vp = drift(t0, thd[i, w], acc[i, w], dt, dt2)
             kick = escapement(c, (blk, i, w), t0, tn)
             ups[w] += 1 if upward(t0, tn) else 0
-            kicks[w] += 1 if kick != 0.0 else 0
+            fired = (kick != 0.0) & (alive[w] > 0.0)
+            lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
             overs[w] += 1 if abs(tn) > overturn_angle else 0
             n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
             sn, cs = trig(tn)
@@ -213,19 +225,6 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
             rest[i, w] = res
             q[i, w] = qi
     return n_far
-
-
-@nb.njit(cache=True, inline="always")
-def _book_kicks(c, blk, w, th, tn_s, count, last_kick, b, t_new):
-    """``t_new`` into ``last_kick[b]`` for each of lane ``w``'s ``count`` escapements that
-    fired in the step (found again by `escapement`: counted per lane in the vectorized
-    pass, they are rare enough to look up here)."""
-    for i in range(th.shape[0]):
-        if escapement(c, (blk, i, w), th[i, w], tn_s[i, w]) != 0.0:
-            last_kick[b, i] = t_new
-            count -= 1
-            if count == 0:
-                break
 
 
 @nb.njit(cache=True)

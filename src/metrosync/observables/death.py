@@ -8,8 +8,9 @@ the oscillation by the platform, in real metronomes (Chaos 32, 043119 (2022)). I
 model it happens when δ lies beyond the swing (a start below δ, or a swing worn down
 by friction, dry friction on the disk, a strong applied torque or a small drive).
 
-Decaying pendulums soon swing in step, so their order parameter r goes to 1: a run
-with a dead metronome would look perfectly synchronized. Every integrator therefore
+Decaying pendulums can swing in step (with the escapement beyond every swing, seven
+of them on the default disk end at r = 1.0000): a run with a dead metronome can look
+synchronized when it is not. Every integrator therefore
 keeps the time of each metronome's last impulse (``last_kick``), and a run in which
 some metronome's last impulse is older than `SILENT_PERIODS` of its periods at the
 end is flagged `metrosync.status.STATUS_STOPPED`. A live metronome gives two
