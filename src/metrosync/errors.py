@@ -22,6 +22,10 @@ class OverturnWarning(UserWarning):
     """The chosen parameters make the pendulums swing past the horizontal."""
 
 
+class EscapementWarning(UserWarning):
+    """Some escapement cannot fire: its angle lies beyond the pendulum's swing."""
+
+
 def require_finite(name: str, value: float) -> float:
     value = float(value)
     if not math.isfinite(value):

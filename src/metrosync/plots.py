@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ._files import save_figure
+from ._words import plural
 from .errors import ParameterError
 
 
@@ -75,7 +76,7 @@ def plot_order(ds, path: Path | str | None = None, *, ax=None):
         ensemble = f"N = {a['n']} in groups {' '.join(labels)} (N@BPM:σ)"
     else:
         ensemble = f"N = {a['n']}, {a['bpm']} BPM, σ = {a['sigma_bpm']} BPM"
-    ax.set_title(f"{ensemble}, mean of {a['runs']} runs")
+    ax.set_title(f"{ensemble}, mean of {plural(a['runs'], 'run')}")
     order_axes(ax, t[-1], a.get("equilibrium_window"), xlabel="t (s)")
     return finish_figure(fig, path)
 

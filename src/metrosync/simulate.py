@@ -17,6 +17,12 @@ was recorded in an `xarray.Dataset`:
                                           run (see `metrosync.observables.ticks`)
     escapement_offset (run, metronome)    where each escapement acts, rad, only when
                                           some metronome is out of beat
+    escapement_stopped (run, metronome)   True for a metronome whose escapement stopped
+                                          firing ("metronome death", `status` bit
+                                          ``stopped``), only when some run has one
+    disk_at_rest (run)                    fraction of the final window with the disk
+                                          held at rest by dry friction, only when
+                                          ``disk_dry_friction`` is on
     theta, theta_dot (time, run, metronome), phi, phi_dot (time, run)
                                           trajectories, only when asked for
 
@@ -48,18 +54,20 @@ import numpy as np
 import xarray as xr
 
 from ._version import __version__
+from ._words import plural
 from .budget import simulation_budget
 from .ensemble import MIN_STEPS_PER_PERIOD, Ensemble, build_ensemble, check_time_step
-from .errors import OverturnWarning, ParameterError
+from .errors import EscapementWarning, OverturnWarning, ParameterError
 from .groups import Group, describe_groups
 from .integrators import BACKENDS, get_integrator
 from .integrators._state import Records, StepState, records_of
 from .model import Metronome, ModelParameters, get_preset
+from .observables.death import flag_stopped, stopped_metronomes
 from .observables.order import ensemble_statistics, equilibrium_order
 from .observables.ticks import CrossingTally, tail_span, tick_rate
 from .pacing import Pacer
 from .progress import progress_bar
-from .status import STATUS_MEANINGS
+from .status import STATUS_MEANINGS, STATUS_STOPPED
 
 #: Time between records of r(t) when `record_every` is not given, s.
 RECORD_SECONDS = 0.1
@@ -203,14 +211,16 @@ def simulate(
         )
     show = _sys.stderr.isatty() if progress is None else progress
     _warn_overturned_start(ensemble, amplitude, overturn_angle)
+    _warn_silent_escapement(ensemble, amplitude)
     longest_period = float(2 * np.pi / np.min(ensemble.system.omega))
     tail_steps = min(n_steps, math.ceil(tail_span(window, longest_period) / dt))
 
     if scheme.fixed_step:
         kernel = scheme.stepper(backend, trajectories=trajectories)
+        window_steps = min(n_steps, int(round(window / dt)))
         records, rates = _run_fixed_step(
             ensemble, kernel, backend, dt, n_steps, record_every, n_records, trajectories,
-            overturn_angle, show, tail_steps,
+            overturn_angle, show, tail_steps, window_steps,
         )  # fmt: skip
     else:
         with progress_bar(total=ensemble.runs, unit="run", enabled=show) as bar:
@@ -219,10 +229,15 @@ def simulate(
                 duration=n_steps * dt, grid_dt=record_every * dt, n_records=n_records,
                 trajectories=trajectories, overturn_angle=overturn_angle,
                 on_run_done=lambda: bar.update(1), group_start=ensemble.group_start,
+                rest_since=n_steps * dt - window,
             )  # fmt: skip
         since = (n_steps - tail_steps) * dt
         rates = np.stack([tick_rate(run, since) for run in records.crossings])
-    # A run that overturned or diverged has no steady tick.
+    # A metronome whose escapement stopped firing is dead: its run is flagged too.
+    records.status = flag_stopped(
+        records.status, records.last_kick, n_steps * dt, ensemble.system.omega
+    )
+    # A run that overturned, diverged or stopped has no steady tick.
     rates[records.status != 0] = np.nan
     settings = {
         "n": ensemble.n,
@@ -271,6 +286,28 @@ def _warn_overturned_start(ensemble: Ensemble, amplitude, overturn_angle: float)
     )
 
 
+def _warn_silent_escapement(ensemble: Ensemble, amplitude) -> None:
+    """Warn when some escapement's angle lies beyond its pendulum's start swing: it
+    cannot fire, the pendulum decays ("metronome death", `observables.death`), and the
+    run will be flagged `stopped`."""
+    swing = np.hypot(ensemble.theta0, ensemble.theta_dot0 / ensemble.system.omega)
+    offset = np.abs(ensemble.system.escapement_offset)
+    beyond = offset > swing
+    if not np.any(beyond):
+        return
+    runs = int(np.any(beyond, axis=1).sum())
+    start = f"`amplitude` = {amplitude!r} rad" if amplitude is not None else "the start swing"
+    warnings.warn(
+        f"`escapement_offset` = {float(offset[beyond].max()):.4g} rad lies beyond "
+        f"{start} ({float(swing[beyond].min()):.3g} rad) of {int(beyond.sum())} "
+        f"metronome(s) in {runs} of {ensemble.runs} run(s): their escapement never fires, "
+        f'the pendulum decays ("metronome death"), and the run is flagged `stopped` in '
+        f"`status`. Give an `escapement_offset` below the swing, or start wider (`amplitude`).",
+        EscapementWarning,
+        stacklevel=3,
+    )
+
+
 def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
     """The record stride (steps) of a run of ``n_steps`` steps of ``dt`` s, and why it
     is what it is (stored in ``attrs``): ``record_every`` when given, else 0.1 s or
@@ -296,11 +333,12 @@ def record_stride(record_every, n_steps: int, dt: float) -> tuple[int, str]:
         if defaulted:  # the user gave no stride: the run is what is too short
             raise ParameterError(
                 f"`duration` = {n_steps * dt:g} s is shorter than the default recording "
-                f"interval ({record_every * dt:g} s, {record_every} steps of {dt!r} s); "
-                f"lengthen `duration`, or give `record_every` <= {n_steps} steps."
+                f"interval ({record_every * dt:g} s, {plural(record_every, 'step')} of {dt!r} s); "
+                f"lengthen `duration`, or give `record_every` <= {plural(n_steps, 'step')}."
             )
         raise ParameterError(
-            f"`record_every` = {record_every} steps exceeds the {n_steps} steps of the run; "
+            f"`record_every` = {plural(record_every, 'step')} exceeds the "
+            f"{plural(n_steps, 'step')} of the run; "
             f"lower it or lengthen `duration`."
         )
     return int(record_every), reason
@@ -326,10 +364,11 @@ def _request_size(n, runs, frequencies_bpm, metronomes, theta0, groups) -> tuple
 
 
 def _run_fixed_step(ensemble, kernel, backend, dt, n_steps, record_every, n_records, trajectories,
-                    overturn_angle, show, tail_steps) -> tuple[Records, np.ndarray]:  # fmt: skip
+                    overturn_angle, show, tail_steps, window_steps) -> tuple[Records, np.ndarray]:  # fmt: skip  # noqa: E501
     """Advance in paced chunks; the last ``tail_steps`` go in segments shorter than half
-    the shortest period, to count ticks (`CrossingTally`). Returns the records and the
-    (B, N) tick rates."""
+    the shortest period, to count ticks (`CrossingTally`), and the steps with the disk
+    at rest are counted over the last ``window_steps`` (``rest_time``). Returns the
+    records and the (B, N) tick rates."""
     state = StepState.start(
         ensemble.system, ensemble.theta0, ensemble.theta_dot0, ensemble.phi0, ensemble.phi_dot0,
         n_records=n_records, trajectories=trajectories, group_start=ensemble.group_start,
@@ -351,14 +390,21 @@ def _run_fixed_step(ensemble, kernel, backend, dt, n_steps, record_every, n_reco
             )  # fmt: skip
             bar.update(round(count * dt, 6))
 
-        for step, count in Pacer(head, estimate):
-            advance(step, count)
+        # The tail is within the window: the head is cut where the window starts.
+        window_start = min(n_steps - window_steps, head)
+        for first, stop in ((0, window_start), (window_start, head)):
+            if first == window_start:
+                rest_before = state.rest_steps.copy()
+            for step, count in Pacer(stop - first, estimate):
+                advance(first + step, count)
         tally = CrossingTally(state.last_up)
         for step, count in Pacer(tail_steps, estimate):
             for part in range(0, count, per_segment):
                 advance(head + step + part, min(per_segment, count - part))
                 tally.see(state.last_up)
-    return records_of(state), tally.rate()
+    records = records_of(state)
+    records.rest_time = (state.rest_steps - rest_before) * dt
+    return records, tally.rate()
 
 
 def _to_dataset(
@@ -413,7 +459,23 @@ def _to_dataset(
             },
         ),
     }
-    offset = ensemble.system.escapement_offset
+    system = ensemble.system
+    if np.any(rec.status & STATUS_STOPPED):  # say which metronomes died
+        stopped = stopped_metronomes(rec.last_kick, settings["duration"], system.omega)
+        data["escapement_stopped"] = (
+            ("run", "metronome"),
+            stopped & ((rec.status & STATUS_STOPPED) != 0)[:, None],
+            {"long_name": "the escapement gave no impulse in the metronome's last "
+             "two periods (metronome death; see metrosync.observables.death)"},
+        )  # fmt: skip
+    if np.any((system.dry_friction > 0) & ~np.isinf(system.total_inertia)):
+        data["disk_at_rest"] = (
+            ("run",),
+            np.minimum(rec.rest_time / window, 1.0),
+            {"units": "1", "long_name": "fraction of the final window with the disk held at "
+             "rest by its dry friction"},
+        )  # fmt: skip
+    offset = system.escapement_offset
     if np.any(offset != 0):  # some metronome is out of beat: say which, and by how much
         data["escapement_offset"] = (
             ("run", "metronome"),

@@ -60,7 +60,7 @@ def test_an_overturning_start_warns_and_prints_no_equilibrium_r(capsys):
     assert "3 of 3 run(s) start overturned" in captured.err
     out = captured.out
     assert "crossing phases): not meaningful, every run is flagged" in out
-    assert "runs flagged: 3 of 3 (3 overturned, 0 diverged)" in out
+    assert "runs flagged: 3 of 3 (3 overturned, 0 diverged, 0 stopped)" in out
     assert "not meaningful" in out.split("runs flagged")[1]
     assert "final r" not in out
 

@@ -210,3 +210,42 @@ def test_gpu_backend_refuses_dry_friction_clearly():
     with pytest.raises(ParameterError, match="`disk_dry_friction`.*backend='numba'"):
         kernel_cuda.advance_state(state, ens.system, dt=DT, step0=0, n_steps=1,
                                   record_every=1, overturn_angle=1.5)  # fmt: skip
+
+
+@pytest.mark.parametrize("integrator, backend", [("verlet", "numba"), ("verlet", "numpy"),
+                                                 ("exact", "scipy")])  # fmt: skip
+def test_disk_at_rest_is_the_fraction_of_the_final_window_the_disk_is_held(integrator, backend):
+    """``disk_at_rest`` against the records of φ̇ (0 exactly while held) over the window,
+    in the stick-slip case (at rest about 40 % of the time): the fixed-step count of
+    held steps equals the records', ``exact`` sums its stuck intervals."""
+    theta0, threshold, drive = CASES["stick-slip"]
+    options = {} if integrator == "exact" else {"backend": backend}
+    ds = simulate(1, 192, duration=3.0, dt=1e-3, record_every=1, trajectories=True,
+                  equilibrium_window=1.5, theta0=theta0, theta_dot0=[0.0], integrator=integrator,
+                  changes={"disk_dry_friction": threshold, "drive": drive}, **options)  # fmt: skip
+    at_rest = float(ds.disk_at_rest[0])
+    # Records in (1.5, 3] s: each the end of a step of the window.
+    window = ds.phi_dot.sel(time=slice(1.5 + 1e-9, None)).values[:, 0]
+    held = float(np.mean(np.abs(window) < 1e-12))
+    assert 0.2 < held < 0.8, held
+    if integrator == "exact":  # stuck intervals against the records that fall in them
+        assert abs(at_rest - held) < 0.01, (at_rest, held)
+    else:
+        assert at_rest == pytest.approx(held, abs=1e-12)
+
+
+@pytest.mark.slow
+def test_the_readme_table_of_dry_friction_is_what_its_command_gives():
+    """The README's row for T = 0.03 N m, re-run with its command's settings (seconds)."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    row = re.search(r"^\| 0\.03 \| (\d+) % \| (0\.\d\d) ± (0\.\d\d) \|$", readme, re.MULTILINE)
+    assert row, "the README's dry-friction table has no row for T = 0.03"
+    command = "--runs 10 --duration 300 \\\n    --window 100 --seed 0 --set disk_dry_friction="
+    assert command in readme
+    ds = simulate(7, 184, sigma_bpm=0.75, runs=10, duration=300, equilibrium_window=100,
+                  seed=0, changes={"disk_dry_friction": 0.03})  # fmt: skip
+    assert round(100 * float(ds.disk_at_rest.mean())) == int(row[1])
+    assert f"{ds.attrs['r_eq_mean']:.2f}" == row[2] and f"{ds.attrs['r_eq_std']:.2f}" == row[3]

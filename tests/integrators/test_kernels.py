@@ -39,6 +39,14 @@ ESCAPEMENT = {"escapement_offset": 0.07, "escapement_reaction": False}
 DRY = {"disk_dry_friction": 5e-3}
 
 
+DEATH_OFFSET = 0.45
+
+
+def death_start(n):
+    """Start swings from 0.2 to 0.8 rad at rest, θ̇ = 0: below and above `DEATH_OFFSET`."""
+    return {"theta0": np.linspace(0.2, 0.8, n), "theta_dot0": np.zeros(n)}
+
+
 def with_changes(**changes):
     return {"params": get_preset("default").with_changes(**changes)}
 
@@ -54,6 +62,9 @@ FEATURES = {
     "dry-friction": lambda n: with_changes(**DRY),
     # ... and near the kick's torque: held, jolted at kicks, held again.
     "dry-friction-held": lambda n: with_changes(disk_dry_friction=2e-2),
+    # Escapements beyond the start swing of the first metronomes: those never fire and
+    # decay ("metronome death"), the others keep going.
+    "death": lambda n: {**with_changes(escapement_offset=DEATH_OFFSET), **death_start(n)},
 }
 FEATURES["all"] = lambda n: {
     **FEATURES["groups"](n),
@@ -73,8 +84,18 @@ def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs, fea
         np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
     for name in ("crossing_order", "group_crossing_order", "group_order"):
         np.testing.assert_allclose(getattr(got, name)(), getattr(ref, name)(), atol=1e-10)
-    np.testing.assert_array_equal(got.status, ref.status)
-    np.testing.assert_array_equal(got.cross_count, ref.cross_count)
+    for name in ("status", "cross_count", "last_kick", "rest_steps"):
+        np.testing.assert_array_equal(getattr(got, name), getattr(ref, name), err_msg=name)
+    fired = ref.last_kick >= 0
+    if feature == "death":  # the escapements below the start swing never fired
+        expected = np.broadcast_to(ens.theta0 > DEATH_OFFSET, fired.shape)
+        np.testing.assert_array_equal(fired, expected)
+    else:
+        assert fired.all() and ref.last_kick.max() > 9.0, "some escapement stopped"
+    if feature.startswith("dry"):
+        assert ref.rest_steps.max() > 0, "the disk was never held"
+    elif feature != "all":
+        assert not ref.rest_steps.any()
     assert np.count_nonzero(ref.cross_count) > 0, "no crossing phase was booked"
     shape = (runs, 101, len(ens.group_start) - 1)
     assert ref.group_order().shape == got.group_order().shape == shape

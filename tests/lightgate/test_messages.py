@@ -72,6 +72,8 @@ def test_overflow_is_counted_and_reported():
     log = parse_log(f"{HEADER}\n{BODY}{lost}")
     assert log.records_lost == 9
     assert "LOST 9 records" in log.report()
+    one = parse_log(f"{HEADER}\n{BODY}# overflow: 1 records lost\n")
+    assert "LOST 1 record: " in one.report()
 
 
 def test_restart_after_a_marked_gap_continues_the_time_line():
@@ -81,7 +83,7 @@ def test_restart_after_a_marked_gap_continues_the_time_line():
     assert log.restarts == (9,)
     expected_after = 810 + round(2.0 / 64e-6)
     assert log.ticks.tolist() == [0, 10, 20, 800, 810, expected_after, expected_after + 100]
-    assert "restarted 1 times" in log.report()
+    assert "restarted 1 time (records resume at lines 9)" in log.report()
     assert np.all(np.diff(log.ticks) >= 0)
 
 

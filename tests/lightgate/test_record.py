@@ -116,7 +116,7 @@ def test_reconnect_waits_and_marks_the_gap(tmp_path):
     assert log.restarts == (9,)
     # The records after the restart continue the time line after the gap.
     assert abs(log.times[5] - (810 * 64e-6 + gap)) < 64e-6 * 4
-    assert "1 gaps marked" in record.lines[-1][1]
+    assert "1 gap marked" in record.lines[-1][1]
     pty.unplug()
 
 

@@ -11,7 +11,7 @@ import xarray as xr
 from metrosync import ParameterError
 from metrosync.paper.claims import Verdict
 from metrosync.paper.claims_map import rank
-from metrosync.paper.map_report import which_reading
+from metrosync.paper.map_report import theory_half_note, which_reading
 from metrosync.paper.readings import (
     BEST,
     CLAIMS_MAP,
@@ -118,6 +118,16 @@ def test_sigma_at_interpolates_and_propagates_the_errors():
     assert all(math.isnan(v) for v in sigma_at(sigmas, [150.0, 160.0, 170.0], [1, 1, 1], 185.0))
 
 
+def test_the_theory_half_column_is_explained_only_when_empty():
+    import xarray as xr
+
+    empty = xr.Dataset({"theory_omega_half": (("tuning", "sigma"), np.full((2, 3), np.nan))})
+    assert "quick mode leaves that simulation out" in theory_half_note(empty)
+    filled = empty.copy(deep=True)
+    filled.theory_omega_half[0, 1] = 183.2
+    assert theory_half_note(filled) is None
+
+
 def test_which_reading_names_the_reading_or_neither():
     assert which_reading(0.76, 0.05) == "beats per tick"
     assert which_reading(1.45, 0.05) == "periods per tick"
@@ -209,6 +219,10 @@ def test_quick_maps_produce_their_tables_and_the_report_ends_with_a_conclusion(t
     assert "σ* from ω_c(∞), peak" in section and "Agreement of theory and simulation" in section
     assert set(smap.estimator.values) == {"peak", "rise", "rise, largest N", "theory"}
     assert np.isfinite(smap.theory_omega_c).all()
+    # Quick mode does not simulate the phase model: its column is empty, and says why.
+    assert np.isnan(smap.theory_omega_half).all()
+    assert "quick mode leaves that simulation out" in section
+    assert "`metrosync reproduce --full` runs it" in section
     assert {"omega_c_rise", "omega_inf_peak", "sigma_at_target"} <= set(smap.data_vars)
     cmap = tiny.datasets["claims_map"]
     table = text[text.index("## The claims map") : text.index("## Parameter consistency")]

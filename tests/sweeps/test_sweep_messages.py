@@ -69,7 +69,7 @@ def test_failed_points_are_counted_apart_from_flagged_runs(tmp_path):
     assert np.all(ds.status.sel(bpm=236) == STATUS_FAILED)
     assert int(ds.n_flagged.sel(bpm=190)) == 3 and int(ds.n_flagged.sel(bpm=236)) == 0
     text = result.summary()
-    assert "runs flagged (overturned/diverged): 3 of 3 run(s) simulated" in text
+    assert "runs flagged (overturned/diverged/stopped): 3 of 3 runs simulated" in text
     assert "1 point(s) without a result: 1 failed (the simulation raised" in text
     assert "metrosync.status" in text
 

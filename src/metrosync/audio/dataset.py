@@ -35,6 +35,7 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
+from .._words import plural
 from ..errors import ParameterError
 from . import detection as det
 from .attribution import attribute_pair
@@ -148,8 +149,8 @@ def analyze_audio(
     wanted = WINDOW_BEATS * period if order_window is None else order_window
     if span < wanted:
         warnings.warn(
-            f"the recording holds only {k} ticks over {span:.1f} s, less than one window of "
-            f"the acoustic order parameter ({wanted:.1f} s): too short for steady "
+            f"the recording holds only {plural(k, 'tick')} over {span:.1f} s, less than one "
+            f"window of the acoustic order parameter ({wanted:.1f} s): too short for steady "
             f"figures; record a minute or more.",
             UserWarning,
             stacklevel=2,

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import fft, ndimage, signal
 
+from .._words import plural
 from .reader import AudioFileError, Recording
 from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY
 
@@ -176,8 +177,8 @@ def _check_levels(recording: Recording, peak: float, clipped: int) -> None:
     if clipped:
         share = clipped / (recording.frames * recording.channels)
         warnings.warn(
-            f"recording {name!r} clipped: {clipped} samples ({100 * share:.2g} %) at full "
-            f"scale. Tick times stay usable, but loudness (tick strengths, and telling "
+            f"recording {name!r} clipped: {plural(clipped, 'sample')} ({100 * share:.2g} %) "
+            f"at full scale. Tick times stay usable, but loudness (tick strengths, and telling "
             f"metronomes apart by it) is capped: record with a lower input gain.",
             UserWarning,
             stacklevel=3,

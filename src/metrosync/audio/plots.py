@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..plots import finish_figure, new_figure
 
 TICK_COLOURS = ("C0", "C3")
@@ -40,7 +41,7 @@ def plot_audio(ds, path: Path | str | None = None):
     ax = axes[0]
     ax.fill_between(*_columns(ds, MAX_COLUMNS), color="0.35", lw=0)
     height = 10 ** (ds.tick_strength.values / 20)
-    ax.plot(t, height, "|", color="C2", ms=6, label=f"{t.size} ticks detected")
+    ax.plot(t, height, "|", color="C2", ms=6, label=f"{plural(t.size, 'tick')} detected")
     ax.set_ylabel("waveform")
     ax.legend(loc="upper right", fontsize="small")
     ax.set_title(

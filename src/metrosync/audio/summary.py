@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._words import plural
+
 
 def _quarter_mean(values: np.ndarray, last: bool) -> float:
     values = np.asarray(values, dtype=float)
@@ -31,8 +33,12 @@ def summary_text(ds) -> str:
         for m in range(ds.sizes["metronome"]):
             lines.append(
                 f"  metronome {m}: {float(ds.bpm[m]):.3f} ± {float(ds.bpm_error[m]):.3f} BPM, "
-                f"jitter {1e3 * float(ds.jitter[m]):.2f} ms, {int(ds.ticks[m])} ticks"
-                + (f" ({int(ds.missed_beats[m])} beats missed)" if int(ds.missed_beats[m]) else "")
+                f"jitter {1e3 * float(ds.jitter[m]):.2f} ms, {plural(int(ds.ticks[m]), 'tick')}"
+                + (
+                    f" ({plural(int(ds.missed_beats[m]), 'beat')} missed)"
+                    if int(ds.missed_beats[m])
+                    else ""
+                )
             )
             lines.append(f"    {str(ds.beat_verdict.values[m])}")
     phase = ds.phase_difference.values

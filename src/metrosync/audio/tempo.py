@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._words import plural
 from ..errors import AnalysisError
 
 #: Tempi searched without a hint, BPM.
@@ -43,8 +44,8 @@ def beat_period(times: np.ndarray, bpm: float | None = None) -> float:
     times = np.asarray(times, dtype=float)
     if times.size < MIN_TICKS:
         raise AnalysisError(
-            f"found only {times.size} ticks; at least {MIN_TICKS} are needed for a tempo. "
-            f"Is this a metronome recording? Try a lower `sensitivity` or another `band`."
+            f"found only {plural(times.size, 'tick')}; at least {MIN_TICKS} are needed for a "
+            f"tempo. Is this a metronome recording? Try a lower `sensitivity` or another `band`."
         )
     if bpm is None:
         lo, hi = 60.0 / BPM_RANGE[1], 60.0 / BPM_RANGE[0]
@@ -83,7 +84,8 @@ def _coarse_lag(times: np.ndarray, lo: float, hi: float, *, pick_shortest: bool)
     best = float(excess.max())
     if best <= 0:
         raise AnalysisError(
-            f"the {k} ticks show no steady beat between {60 / hi:.0f} and {60 / lo:.0f} BPM; "
+            f"the {plural(k, 'tick')} show no steady beat between {60 / hi:.0f} and "
+            f"{60 / lo:.0f} BPM; "
             f"give the metronomes' setting (`bpm`) or check that the recording holds ticks."
         )
     peaks = np.flatnonzero(

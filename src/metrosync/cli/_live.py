@@ -17,6 +17,7 @@ import math
 import sys
 import time
 
+from .._words import plural
 from ..errors import EmptyLogError, MetrosyncError
 from ..lightgate.channels import check_channels, never_changed_text
 from ..lightgate.follow import LogFollower
@@ -117,7 +118,7 @@ class LivePanel:
         from rich.text import Text
 
         elapsed = time.monotonic() - self._start
-        foot = Text(f"{elapsed:.0f} s, {self.follower.n_lines} lines", style="dim")
+        foot = Text(f"{elapsed:.0f} s, {plural(self.follower.n_lines, 'line')}", style="dim")
         if status is None:
             return Panel(Group(Text(note), foot), title=self.title)
         table = Table(box=None, pad_edge=False)
@@ -147,10 +148,11 @@ class LivePanel:
             parts.append(Text(f"{never_changed_text(status.never_changed)}: left out of r",
                               style="yellow"))  # fmt: skip
         if status.records_lost:
-            parts.append(Text(f"the logger LOST {status.records_lost} records (buffer full)",
-                              style="bold red"))  # fmt: skip
+            lost = plural(status.records_lost, "record")
+            parts.append(Text(f"the logger LOST {lost} (buffer full)", style="bold red"))
         if status.restarts:
-            parts.append(Text(f"the logger restarted {status.restarts} times", style="yellow"))
+            restarts = plural(status.restarts, "time")
+            parts.append(Text(f"the logger restarted {restarts}", style="yellow"))
         return Panel(Group(*parts, foot), title=self.title)
 
 

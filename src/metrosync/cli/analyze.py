@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .._words import plural
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
 from ._audio import add_audio_options, audio_requested, run_audio
@@ -105,7 +106,8 @@ def summary(ds) -> str:
     """The printed summary: frequencies, jitter, σ, r_eq and the cleaning report."""
     a = ds.attrs
     lines = [
-        f"metrosync analyze: {ds.sizes['log']} log(s), {ds.sizes['metronome']} metronomes, "
+        f"metrosync analyze: {ds.sizes['log']} log(s), "
+        f"{plural(ds.sizes['metronome'], 'metronome')}, "
         f"common span {float(ds.time[0]):.1f} .. {float(ds.time[-1]):.1f} s",
         "  metronome  frequency (BPM)  period jitter (ms, mean over logs)  passes bridged",
     ]

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .._files import atomic_path
+from .._words import plural
 from ..errors import ParameterError
 from ._io import check_output
 from ._options import HelpFormatter
@@ -83,7 +84,7 @@ def run(args) -> int:
         ds, args.out, run=args.run, fps=args.fps, speedup=speedup,
         start=args.start, end=args.end, dpi=args.dpi,
     )  # fmt: skip
-    print(f"wrote {args.out} ({frames} frames at {args.fps:g} fps, speed-up {speedup:g}, "
+    print(f"wrote {args.out} ({plural(frames, 'frame')} at {args.fps:g} fps, speed-up {speedup:g}, "
           f"{frames / args.fps:.0f} s)")  # fmt: skip
     return 0
 

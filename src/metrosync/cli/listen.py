@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._words import plural
 from ._io import check_output
 from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
@@ -58,5 +59,6 @@ def run(args) -> int:
         sample_rate=args.sample_rate, tick_sound=args.tick_sound,
     )  # fmt: skip
     clicks = sum(len(t) for t in track.click_times)
-    print(f"wrote {args.out} ({track.duration:.1f} s, {clicks} clicks, {track.sample_rate} Hz)")
+    clicks = plural(clicks, "click")
+    print(f"wrote {args.out} ({track.duration:.1f} s, {clicks}, {track.sample_rate} Hz)")
     return 0

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..errors import ParameterError
+from ..observables.death import SILENT_PERIODS
 from ..plots import plot_order
+from ..status import STATUS_STOPPED
 from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import (
     HelpFormatter,
@@ -18,6 +22,10 @@ from ._options import (
     ensemble_defaults,
     simulate_from_args,
 )
+
+#: A swinging metronome's period over its small-swing period, at most (the default swing
+#: ticks about 4 % slower).
+SWING_SLOWER = 1.05
 
 #: Options of the virtual light gate: type, default, help, and the `LightGate` field.
 GATE_OPTIONS = {
@@ -122,9 +130,21 @@ def _simulate_with_gate(args):
     return ds
 
 
-def plural(count: int, noun: str) -> str:
-    """``plural(1, "run") == "1 run"``, ``plural(2, "run") == "2 runs"``."""
-    return f"{count} {noun}" + ("" if count == 1 else "s")
+def _no_phase(ds) -> str:
+    """Why no run has r_eq: too short for every metronome's crossing phase in the
+    final window, with the duration that would do."""
+    a = ds.attrs
+    period = SWING_SLOWER * 120.0 / float(ds.frequency_bpm.min())  # two beats a period
+    # The first upward crossing comes within the first period, the last within the final
+    # one: a window longer than a period, ending at least two periods in, holds a phase.
+    return (
+        f"r_eq averages the crossing phases over the final window, and a metronome has a "
+        f"phase only between two of its upward zero crossings: {a['duration']:g} s with a "
+        f"window of {a['equilibrium_window']:g} s is too short for every metronome to cross "
+        f"upwards before and after a time in the window (one period is up to {period:.2g} "
+        f"s). Give `--duration` of at least {math.ceil(4 * period)} s (the default window is "
+        f"the last quarter), and a `--window` longer than one period."
+    )
 
 
 def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
@@ -169,14 +189,18 @@ def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
         )
     window = f"  equilibrium r (last {a['equilibrium_window']:g} s, crossing phases)"
     ok = status == 0
-    if bad == 0:
+    measured = ok & np.isfinite(ds.r_eq.values)
+    if ok.any() and not measured.any():
+        lines.append(f"{window}: not measured. {_no_phase(ds)}")
+    elif bad == 0 and measured.all():
         lines.append(f"{window}: {a['r_eq_mean']:.4f} +- {a['r_eq_std']:.4f} (sigma_r over runs)")
     elif ok.any():
         mean, spread = ensemble_statistics(ds.r_eq.values[ok])
-        lines.append(
-            f"{window}: {mean:.4f} +- {spread:.4f} (sigma_r over the "
-            f"{plural(int(ok.sum()), 'unflagged run')})"
-        )
+        kind = "unflagged run" if bad else "run"
+        over = plural(int(ok.sum()), kind)
+        if not measured.all():
+            over = f"{int(measured.sum())} of the {over} that have a crossing phase in the window"
+        lines.append(f"{window}: {mean:.4f} +- {spread:.4f} (sigma_r over the {over})")
     else:
         lines.append(f"{window}: not meaningful, every run is flagged")
     if "r_eq_group" in ds and ok.any():
@@ -192,10 +216,26 @@ def summary(ds, elapsed: float, adapted: dict[str, str] | None = None) -> str:
             f"    the r of {'every flagged run' if bad > 1 else 'the flagged run'} is not "
             f"meaningful (see `status` in the dataset; bits in metrosync.status)"
         )
+    stopped = int(((status & STATUS_STOPPED) != 0).sum())
+    if stopped:
+        lines.append(
+            f"    stopped: in {plural(stopped, 'run')} some metronome's escapement gave no "
+            f"impulse in its last {SILENT_PERIODS:g} periods: its swing no longer reaches the "
+            f'escapement, so nothing drives it and it decays ("metronome death", '
+            f"Goldsztein et al., Chaos 32, 043119 (2022)); decaying pendulums can look in "
+            f"step, so these runs are left out of r above"
+        )
+    if "disk_at_rest" in ds:
+        rest = 100 * ds.disk_at_rest.values
+        lines.append(
+            f"  disk held at rest by dry friction: {np.mean(rest):.0f} % of the final "
+            f"{a['equilibrium_window']:g} s (mean over runs; {np.min(rest):.0f} .. "
+            f"{np.max(rest):.0f} %)"
+        )
     if str(a.get("record_every_reason", "")).startswith("raised"):
         lines.append(
-            f"  r(t) recorded every {a['record_interval']:g} s ({a['record_every']} steps), "
-            f"{a['record_every_reason']}"
+            f"  r(t) recorded every {a['record_interval']:g} s "
+            f"({plural(a['record_every'], 'step')}), {a['record_every_reason']}"
         )
     lines.append(f"  {elapsed:.2f} s wall, {steps / max(elapsed, 1e-9):.3g} oscillator-steps/s")
     return "\n".join(lines)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._words import plural
 from ..errors import ParameterError
 from ._io import NETCDF, check_output
 from ._options import HelpFormatter, add_aliases, group_spec
@@ -117,7 +118,7 @@ def run(args) -> int:
     store = args.store if args.store is not None else args.out.with_suffix(".points")
     check_output(store / "log.jsonl", "--store")
     shape = dict(zip(grid.axes, grid.shape, strict=True))
-    print(f"metrosync sweep: {grid.size} points, grid {shape}, store {store}")
+    print(f"metrosync sweep: {plural(grid.size, 'point')}, grid {shape}, store {store}")
     result = sweep(
         grid,
         store,

@@ -49,6 +49,8 @@ class State(NamedTuple):
     force_phi: np.ndarray
     last_up: np.ndarray
     status: np.ndarray
+    last_kick: np.ndarray
+    rest_steps: np.ndarray
 
 
 #: Fields of `Constants` that are not in `SystemArrays`: derived once per call.

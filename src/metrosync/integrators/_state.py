@@ -32,6 +32,10 @@ class StepState:
         (`equations.disk_torque`) plus the dry friction (`equations.dry_friction`).
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
+    last_kick : (B, N) end time of the last step in which the metronome's escapement
+        fired (its impulse), −1 before the first: `observables.death` reads it.
+    rest_steps : (B,) int64 count of steps that ended with the disk held at rest by its
+        dry friction (0 without dry friction).
     r : (B, n_rec) analytic-phase order parameter at each record.
     cross_re, cross_im, cross_count : (B, n_rec, G) running sums of e^{iΦ} over each
         group's metronomes whose crossing-interpolated phase Φ is known at each record.
@@ -97,6 +101,8 @@ class StepState:
             force_phi=disk_torque(sys, phi_dot, no_kick, 0.0) + friction,
             last_up=np.full((b, n), -1.0),
             status=np.where(finite, STATUS_OK, STATUS_DIVERGED).astype(np.int8),
+            last_kick=np.full((b, n), -1.0),
+            rest_steps=np.zeros(b, dtype=np.int64),
         )
         recording = Recording(
             r=np.full((b, n_records), np.nan),
@@ -156,6 +162,11 @@ class Records:
     crossings: list | None = None
     r_group: np.ndarray | None = None
     r_crossing_group: np.ndarray | None = None
+    #: (B, N) time of each metronome's last escapement impulse, −1 if none.
+    last_kick: np.ndarray | None = None
+    #: (B,) time the disk was held at rest by dry friction in the final window, s (set
+    #: by the driver, which knows the window).
+    rest_time: np.ndarray | None = None
 
 
 def records_of(state: StepState) -> Records:
@@ -173,4 +184,5 @@ def records_of(state: StepState) -> Records:
         # One group: views of the global records, no copies.
         r_group=state.group_order(),
         r_crossing_group=state.group_crossing_order() if grouped else r_crossing[:, :, None],
+        last_kick=state.last_kick,
     )

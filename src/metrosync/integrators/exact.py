@@ -55,9 +55,11 @@ def integrate(
     overturn_angle: float,
     on_run_done: Callable[[], None] | None = None,
     group_start: np.ndarray | None = None,
+    rest_since: float = 0.0,
 ) -> Records:
     """Integrate every run to ``duration``, sampling on a grid of step ``grid_dt``;
-    ``group_start`` bounds the groups of metronomes (default: one group)."""
+    ``group_start`` bounds the groups of metronomes (default: one group). The records'
+    ``rest_time`` is the time the disk was stuck from ``rest_since`` to the end."""
     runs, n = theta0.shape
     grid = np.arange(n_records) * grid_dt
     shape = (runs, n_records)
@@ -74,11 +76,14 @@ def integrate(
         crossings=[],
         r_group=np.full(shape + (len(groups),), np.nan),
         r_crossing_group=np.full(shape + (len(groups),), np.nan),
+        last_kick=np.full((runs, n), -1.0),
+        rest_time=np.zeros(runs),
     )
     for b in range(runs):
-        samples, upcrossings, status = _integrate_run(
-            sys.run(b), theta0[b], theta_dot0[b], phi_dot0[b], grid, duration, overturn_angle
-        )
+        samples, upcrossings, status, out.last_kick[b], out.rest_time[b] = _integrate_run(
+            sys.run(b), theta0[b], theta_dot0[b], phi_dot0[b], grid, duration, overturn_angle,
+            rest_since,
+        )  # fmt: skip
         out.status[b] = status
         out.crossings.append(upcrossings)
         th, thd = samples[:, 1 : n + 1], samples[:, n + 2 :]
@@ -96,9 +101,10 @@ def integrate(
     return out
 
 
-def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_angle):
+def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_angle, rest_since):
     """One run. Returns grid samples (T, 2N+2) of [φ, θ, φ̇, θ̇], upward-crossing times
-    per metronome, and the status bits."""
+    per metronome, the status bits, each metronome's last impulse time (−1 if none) and
+    the time the disk was stuck after ``rest_since``."""
     n = theta0.size
     offset = sys.escapement_offset[0]
     off_zero = np.nonzero(offset != 0.0)[0]  # their zero crossings are not events
@@ -130,8 +136,18 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     samples[0] = y
     next_sample = 1
     upcrossings: list[list[float]] = [[] for _ in range(n)]
+    last_kick = np.full(n, -1.0)
+    rest = 0.0
     status = 0
     t = 0.0
+
+    def stuck_for(start, end):  # the part of [start, end] after `rest_since`, if stuck
+        return max(0.0, end - max(start, rest_since)) if mode == 0 else 0.0
+
+    def result(bits):
+        crossings = [np.asarray(c) for c in upcrossings]
+        return samples, crossings, bits, last_kick, rest
+
     while t < duration:
         solver = DOP853(
             lambda s, u, m=mode: rhs(s, u, m), t, y, duration,
@@ -142,7 +158,7 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
             y_old = solver.y.copy()
             solver.step()
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
-                return samples, upcrossings, status | STATUS_DIVERGED
+                return result(status | STATUS_DIVERGED)
             dense = solver.dense_output()
             events = _crossings(dense, y_old, solver.y, offset, n)
             if limit > 0.0:
@@ -162,6 +178,7 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
             if np.any(np.abs(solver.y[1 : n + 1]) > overturn_angle):
                 status |= STATUS_OVERTURNED
             if event is not None:
+                rest += stuck_for(t, t_end)
                 y = dense(t_end)
                 if event == "break":  # |holding torque| reached T: slip against it
                     mode = -int(np.sign(holding(t_end, y)[0]))
@@ -174,13 +191,15 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
                     if direction > 0 and offset[event] == 0.0:
                         upcrossings[event].append(t_end)
                     y = _apply_impulse(sys, y, n, event, direction, rigid)
+                    last_kick[event] = t_end
                     mode = _disk_mode(limit, y[n + 1], holding(t_end, y))
                 t = t_end
                 restarted = True
                 break
         if not restarted:
+            rest += stuck_for(t, duration)
             t = duration
-    return samples, [np.asarray(c) for c in upcrossings], status
+    return result(status)
 
 
 def _crossings(dense, y_old, y_new, offset, n):

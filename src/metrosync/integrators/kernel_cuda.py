@@ -94,7 +94,7 @@ def _block_sum(red, k, tid, nt):
 
 @cuda.jit
 def advance(st, c, settings, rec, scratch):
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count = rec[:4]  # no trajectories on the GPU yet
     r_group, group_start = rec[8:10]
     dt, step0, n_steps, record_every, overturn_angle = settings
@@ -123,6 +123,8 @@ def advance(st, c, settings, rec, scratch):
             th = theta[b, i]
             tn, vp = drift(th, theta_dot[b, i], acc_theta[b, i], dt, dt2)
             kick = escapement(c, (b, i), th, tn)
+            if kick != 0.0:
+                last_kick[b, i] = (s + 1) * dt
             if upward(th, tn):
                 t_cross = t_old + dt * th / (th - tn)
                 if last_up[b, i] >= 0.0:

@@ -41,7 +41,7 @@ from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 def advance(st, c, settings, rec):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
@@ -106,6 +106,7 @@ def advance(st, c, settings, rec):
                 for i in range(n):  # scalar pass; stops at the last of the n_kick impulses
                     if fired[i] == 0.0:
                         continue
+                    last_kick[b, i] = (s + 1) * dt
                     frac = crossing_fraction(c, (b, i), theta[b, i], th_new[i])
                     sigma = frac * dt
                     after = dt - sigma

@@ -39,7 +39,7 @@ from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 def advance(st, c, settings, rec):
     """Same contract as `kernel_located_oscillators.advance`; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
@@ -123,6 +123,7 @@ def advance(st, c, settings, rec):
                 for i in range(n):
                     if fired[i, w] == 0.0:
                         continue
+                    last_kick[b0 + w, i] = t_new
                     frac = crossing_fraction(c, (blk, i, w), th[i, w], tn_s[i, w])
                     sigma = frac * dt
                     after = dt - sigma

@@ -55,7 +55,7 @@ def arrange(constants):
 def advance(st, c, settings, rec):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
@@ -75,9 +75,10 @@ def advance(st, c, settings, rec):
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
-            sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, sincos)  # fmt: skip  # noqa: E501
+            t_new = (s + 1) * dt
+            sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, last_kick[b], t_new, sincos)  # fmt: skip  # noqa: E501
             if sums[5] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, libm_sincos)  # fmt: skip  # noqa: E501
+                sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, th_new, rest, q, crossed, last_kick[b], t_new, libm_sincos)  # fmt: skip  # noqa: E501
             sum_num, sum_den, sum_kick, n_up, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
@@ -92,7 +93,7 @@ def advance(st, c, settings, rec):
                         if n_up == 0:
                             break
             phi_next, phd_pred = drift(phi[b], phi_dot[b], acc_phi[b], dt, dt2)
-            force = disk_torque(c, b, phd_pred, sum_kick) + applied_torque(c, b, (s + 1) * dt)
+            force = disk_torque(c, b, phd_pred, sum_kick) + applied_torque(c, b, t_new)
             others = force
             friction = 0.0
             held = False
@@ -135,6 +136,7 @@ def advance(st, c, settings, rec):
             if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
                 p_phi[b] = momentum_at_rest(c, b, sum_p)
                 phi_dot[b] = 0.0  # not from p_φ: a fused multiply-add would leave ~1e-20
+                rest_steps[b] += 1
             force_phi[b] = force
             acc_phi[b] = phdd
             until_record -= 1
@@ -145,11 +147,12 @@ def advance(st, c, settings, rec):
 
 
 @nb.njit(cache=True, inline="always")
-def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, th_new, rest, q, crossed, trig):  # fmt: skip  # noqa: E501
+def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, th_new, rest, q, crossed, last_kick, t_new, trig):  # fmt: skip  # noqa: E501
     """New angles, kicks and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s metronomes
     (rows ``theta``, ``theta_dot``, ``acc``), with ``trig`` = the vectorizable `sincos`
-    or, for far-wound angles, libm's. Returns the three sums and the counts of upward
-    crossings, overturned and far-wound angles."""
+    or, for far-wound angles, libm's; ``t_new`` into ``last_kick`` (the run's row) where
+    an escapement fires. Returns the three sums and the counts of upward crossings,
+    overturned and far-wound angles."""
     sum_num = 0.0
     sum_den = 0.0
     sum_kick = 0.0
@@ -160,6 +163,7 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, th_new, re
         th = theta[i]
         tn, vp = drift(th, theta_dot[i], acc[i], dt, dt2)
         kick = escapement(c, (b, i), th, tn)
+        last_kick[i] = t_new if kick != 0.0 else last_kick[i]  # a select: it vectorizes
         up = upward(th, tn)
         n_up += 1 if up else 0
         crossed[i] = up  # stored, not recomputed later: measurably faster (!)

@@ -73,7 +73,7 @@ def advance(st, c, settings, rec):
     """Same contract as the other kernels; the state uses the usual (B, N) layout and is
     transposed into blocks here, once per call; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status = st  # fmt: skip  # noqa: E501
+    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
@@ -102,6 +102,7 @@ def advance(st, c, settings, rec):
         for w in range(LANES):
             block_forced |= forced(c, (blk, w))
         ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
+        lk = load_last_kick(last_kick, b0, lanes)
         dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
             dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])  # fmt: skip  # noqa: E501
@@ -116,10 +117,11 @@ def advance(st, c, settings, rec):
                 if alive[w] > 0.0:
                     _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         for s in range(step0, step0 + n_steps):
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, sincos)  # fmt: skip  # noqa: E501
-            if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, libm_sincos)  # fmt: skip  # noqa: E501
             t_old = s * dt
+            t_new = (s + 1) * dt
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, sincos)  # fmt: skip  # noqa: E501
+            if n_far > 0:  # rare: redo the pass with libm trig
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, libm_sincos)  # fmt: skip  # noqa: E501
             for w in range(lanes):
                 if ups[w] > 0 or overs[w] > 0:
                     if alive[w] == 0.0:
@@ -135,7 +137,6 @@ def advance(st, c, settings, rec):
                             t_cross = t_old + dt * t0 / (t0 - tn)
                             upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                             ups[w] -= 1
-            t_new = (s + 1) * dt
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -167,7 +168,7 @@ def advance(st, c, settings, rec):
                     fph[w] = force[w]
                     aph[w] = phdd[w]
             if dry:
-                _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
+                _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0)  # fmt: skip  # noqa: E501
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
@@ -176,14 +177,28 @@ def advance(st, c, settings, rec):
                     if alive[w] > 0.0:
                         _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
         store_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, b0, lanes, th, thd, acc, ph, phd, aph, pp, fph)  # fmt: skip  # noqa: E501
+        for w in range(lanes):
+            for i in range(n):
+                last_kick[b0 + w, i] = lk[i, w]
 
 
 @nb.njit(cache=True, inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, trig):  # fmt: skip  # noqa: E501
+def load_last_kick(last_kick, b0, lanes):
+    """Block-local copy (n, LANES) of the runs' last impulse times (as `load_block`)."""
+    n = last_kick.shape[1]
+    lk = np.empty((n, LANES))
+    for i in range(n):
+        for w in range(LANES):
+            lk[i, w] = last_kick[b0 + min(w, lanes - 1), i]
+    return lk
+
+
+@nb.njit(cache=True, inline="always")
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, trig):  # fmt: skip  # noqa: E501
     """New angles, kicks and the per-lane sums of eqs. (eqm1)–(eqm2) for block ``blk``,
-    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's. Fills
-    the per-lane counts of upward crossings and overturns; returns the number of
-    far-wound angles."""
+    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's; ``t_new``
+    into ``lk`` where a live lane's escapement fires. Fills the per-lane counts of upward
+    crossings and overturns; returns the number of far-wound angles."""
     n_far = 0
     for w in range(th.shape[1]):
         ups[w] = 0
@@ -197,6 +212,8 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
             tn, vp = drift(t0, thd[i, w], acc[i, w], dt, dt2)
             kick = escapement(c, (blk, i, w), t0, tn)
             ups[w] += 1 if upward(t0, tn) else 0
+            fired = (kick != 0.0) & (alive[w] > 0.0)
+            lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
             overs[w] += 1 if abs(tn) > overturn_angle else 0
             n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
             sn, cs = trig(tn)
@@ -226,19 +243,22 @@ def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, fric
 
 
 @nb.njit(cache=True)
-def _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
-    """The disks with dry friction after a step (`_settle_disk`). One call per step, and
-    two levels deep: code of this in the step's loop slows the kernel without the
-    feature by about 6 % (benchmarks/kernel.py at (100, 7))."""
+def _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0):  # fmt: skip  # noqa: E501
+    """The disks with dry friction after a step (`_settle_disk`); counts the steps that
+    end with a disk held in ``rest_steps``. One call per step, and two levels deep:
+    code of this in the step's loop slows the kernel without the feature by about 6 %
+    (benchmarks/kernel.py at (100, 7))."""
     for w in range(lanes):
         if alive[w] > 0.0 and dry_lane[w]:
-            _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt)  # fmt: skip  # noqa: E501
+            if _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+                rest_steps[b0 + w] += 1
 
 
 @nb.njit(cache=True)
 def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
     """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
-    velocity reached 0 within the step, stopped or reversed (`verlet`)."""
+    velocity reached 0 within the step, stopped or reversed (`verlet`). Returns whether
+    it ends the step held at rest."""
     if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step
         end, held = disk_friction_stop(c, (blk, w), friction, phd[w], s_den, dt)
         pp[w] += 0.5 * dt * (end - friction)
@@ -259,6 +279,7 @@ def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, fricti
     if held:  # at rest: φ̇ = 0 exactly, p_φ = R Σ q θ̇
         pp[w] = momentum_at_rest(c, (blk, w), s_p)
         phd[w] = 0.0
+    return held
 
 
 @nb.njit(cache=True, inline="always")

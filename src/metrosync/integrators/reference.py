@@ -55,6 +55,7 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
         vel_pred = state.theta_dot + acc * dt
         phd_pred = state.phi_dot + state.acc_phi * dt
         kick = np.where(alive[:, None], escapement(sys, th, th_new, dt), 0.0)
+        state.last_kick[kick != 0.0] = (s + 1) * dt
         up = (th < 0) & (th_new > 0) & alive[:, None]  # the phase's crossings, at 0
         for b, i in zip(*np.nonzero(up), strict=True):
             t_cross = t_old + dt * th[b, i] / (th[b, i] - th_new[b, i])
@@ -90,6 +91,7 @@ def _steps(state, sys, dt, step0, n_steps, record_every, overturn_angle, rigid, 
             held |= stops
         coupling = sys.radius * np.sum(sys.mh * np.cos(th_new) * new_theta_dot, axis=1)
         new_p = np.where(held, coupling, new_p)  # a disk at rest: p_φ = R Σ m h cos θ θ̇
+        state.rest_steps[held & ok] += 1
         with np.errstate(invalid="ignore"):
             new_phi_dot = np.where(rigid, 0.0, (new_p - coupling) / sys.total_inertia)
         ok2 = ok[:, None]

@@ -77,6 +77,7 @@ def _step(state, sys, c, dt, s, overturn_angle, record_every) -> bool:
     # Each impulse at its instant: `_located_parts.kick` gives its pieces, summed here
     # as the kernels sum them; the disk's jumps follow from the sums.
     kicked = (fire != 0.0) & ok[:, None]
+    state.last_kick[kicked] = t_new
     offset = sys.escapement_offset
     frac = np.where(kicked, (th - offset) / (th - th_new), 0.0)
     sigma = frac * dt

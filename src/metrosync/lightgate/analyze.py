@@ -42,6 +42,7 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
+from .._words import plural
 from ..errors import AnalysisError, ChannelCountError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
@@ -133,7 +134,7 @@ def analyze_logs(
     for log in logs[1:]:
         if log.channels != k:
             raise ChannelCountError(
-                f"{log.source} has {log.channels} gates but {logs[0].source} has {k}; "
+                f"{log.source} has {plural(log.channels, 'gate')} but {logs[0].source} has {k}; "
                 f"repeated runs must use the same gates."
             )
     asked = check_channels(channels, k)
@@ -256,11 +257,13 @@ def _warn_missed_passes(sources, chosen, bridged, extra, irregular, kept) -> Non
                                                 strict=True):  # fmt: skip
         gates = []
         for gate, b, e, i, k in zip(chosen, b_row, e_row, i_row, k_row, strict=True):
-            found = [f"{n} {what}" for n, what in ((b, "missed passes bridged"),
-                     (e, "extra passes dropped"), (i, "irregular intervals")) if n]  # fmt: skip
+            found = [f"{plural(n, *what)}{done}" for n, what, done in (
+                     (b, ("missed pass", "missed passes"), " bridged"),
+                     (e, ("extra pass", "extra passes"), " dropped"),
+                     (i, ("irregular interval",), "")) if n]  # fmt: skip
             if found:
                 periods = max(int(k) - 1 + int(b), 1)
-                gates.append(f"gate {gate}: {', '.join(found)} in {periods} periods")
+                gates.append(f"gate {gate}: {', '.join(found)} in {plural(periods, 'period')}")
         if gates:
             warnings.warn(
                 f"{path}: {'; '.join(gates)}. Frequencies and period jitter there rest on "

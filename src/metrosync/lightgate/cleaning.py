@@ -46,6 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from .._words import plural
 from ..errors import ParameterError
 from .reader import GateLog
 
@@ -98,11 +99,11 @@ class ChannelPasses:
     def summary(self) -> str:
         """One line: passes kept, dropped by reason, flickers closed, bridged, flags."""
         why = ", ".join(f"{n} {r}" for r, n in self.dropped.items() if n) or "none"
-        extra = f", {self.merged} flickers closed" if self.merged else ""
+        extra = f", {plural(self.merged, 'flicker')} closed" if self.merged else ""
         if self.bridged:
-            extra += f", {self.bridged} missed passes bridged"
+            extra += f", {plural(self.bridged, 'missed pass', 'missed passes')} bridged"
         if self.irregular:
-            extra += f", {self.irregular} irregular intervals"
+            extra += f", {plural(self.irregular, 'irregular interval')}"
         flag = " [direction ambiguous: gate too central]" if self.direction_ambiguous else ""
         return f"kept {self.kept.size}, dropped {sum(self.dropped.values())} ({why}){extra}{flag}"
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._words import plural
 from .messages import LoggerHeader
 
 
@@ -81,23 +82,25 @@ class GateLog:
         bits = "no wrap" if self.counter_bits is None else f"{self.counter_bits}-bit counter"
         polarity = " ".join("?" if p < 0 else str(int(p)) for p in self.interrupted_level)
         lines = [
-            f"{self.source}: {len(self.ticks)} records of {self.channels} gates in "
-            f"{self.n_lines} lines, {self.times[-1]:.3f} s, {bits}, {self.wraps} wraps, "
+            f"{self.source}: {plural(len(self.ticks), 'record')} of "
+            f"{plural(self.channels, 'gate')} in {plural(self.n_lines, 'line')}, "
+            f"{self.times[-1]:.3f} s, {bits}, {plural(self.wraps, 'wrap')}, "
             f"interrupted level per gate: {polarity}",
         ]
         if self.header is not None:
             h = self.header
-            lines.append(f"  logger: gate-logger {h.version}, {h.channels} gates, "
+            lines.append(f"  logger: gate-logger {h.version}, {plural(h.channels, 'gate')}, "
                          f"{h.tick * 1e6:g} us tick, {h.counter_bits}-bit counter")  # fmt: skip
         if self.records_lost:
-            lines.append(f"  LOST {self.records_lost} records: the logger's buffer overflowed")
+            lost = plural(self.records_lost, "record")
+            lines.append(f"  LOST {lost}: the logger's buffer overflowed")
         if self.restarts:
             shown = ", ".join(map(str, self.restarts))
             lines.append(
-                f"  the logger restarted {len(self.restarts)} times (records resume at lines "
-                f"{shown}); the time across each gap is the recording computer's clock"
+                f"  the logger restarted {plural(len(self.restarts), 'time')} (records resume "
+                f"at lines {shown}); the time across each gap is the recording computer's clock"
             )
-        lines.append(f"  skipped {len(self.skipped)} lines")
+        lines.append(f"  skipped {plural(len(self.skipped), 'line')}")
         reasons = Counter(s.reason for s in self.skipped)
         for reason, count in sorted(reasons.items()):
             numbers = [s.line_number for s in self.skipped if s.reason == reason]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._words import plural
 from ..plots import finish_figure, new_figure, order_axes
 
 
@@ -20,7 +21,8 @@ def plot_analysis(ds, path: Path | str | None = None):
         ax.plot(t, ds.r_runs.values[k], lw=0.6, alpha=0.5, color="0.5")
     ax.plot(t, ds.r.values, lw=1.5, color="C0", label=f"r, mean of {ds.sizes['log']} log(s)")
     ax.set_title(
-        f"light gate: {ds.sizes['metronome']} metronomes, σ = {ds.attrs['sigma_bpm']:.3f} BPM"
+        f"light gate: {plural(ds.sizes['metronome'], 'metronome')}, "
+        f"σ = {ds.attrs['sigma_bpm']:.3f} BPM"
     )
     order_axes(ax, t[-1], ds.attrs["equilibrium_window"], xlabel="t since first record (s)",
                window_label=rf"$r_\mathrm{{eq}}$ = {ds.attrs['r_eq']:.3f}")  # fmt: skip

@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..errors import (
     ChannelCountError,
     EmptyLogError,
@@ -196,8 +197,8 @@ def assemble(
         restart, gap = False, None  # a gap without a restart: the counter went on
     if not records:
         raise EmptyLogError(
-            f"{source}: no gate record in {len(lines)} lines (a record looks like "
-            f"'0-1-0-0 1450'); {len(skipped)} lines skipped."
+            f"{source}: no gate record in {plural(len(lines), 'line')} (a record looks like "
+            f"'0-1-0-0 1450'); {plural(len(skipped), 'line')} skipped."
         )
     records = _drop_partial_ends(records, skipped, texts, strict, source)
     records = _drop_partial_last_tick(records, skipped, texts, terminated, strict, source)
@@ -254,7 +255,7 @@ def _agree_with_header(header: LoggerHeader, records, tick, bits, source):
     k = len(records[0][1])
     if k != header.channels:
         raise ChannelCountError(
-            f"{source}: line {records[0][0]}: {k} gates, but the logger's header says "
+            f"{source}: line {records[0][0]}: {plural(k, 'gate')}, but the logger's header says "
             f"{header.channels}; the capture mixes loggers. Split it where the logger changed."
         )
     return header.counter_bits if bits == "auto" else bits
@@ -289,13 +290,13 @@ def _drop_partial_ends(records, skipped, lines, strict, source):
     for end in (0, -1):
         if out and len(out[end][1]) != k:
             number = out[end][0]
-            reason = f"partial record ({len(out[end][1])} gates, expected {k})"
+            reason = f"partial record ({plural(len(out[end][1]), 'gate')}, expected {k})"
             _skip(skipped, number, reason, lines[number - 1], strict, source)
             out.pop(end)
     for number, gates, *_ in out:
         if len(gates) != k:
             raise ChannelCountError(
-                f"{source}: line {number}: {len(gates)} gates, but the log has {k} gates per "
+                f"{source}: line {number}: {plural(len(gates), 'gate')}, but the log has {k} per "
                 f"record elsewhere; the gate count must not change within a log. Split the "
                 f"capture where the wiring changed."
             )

@@ -34,6 +34,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .._words import plural
 from ..errors import MetrosyncError, ParameterError
 from .messages import HEADER_REQUEST, LoggerHeader, format_gap, format_note, parse_message
 
@@ -73,10 +74,10 @@ class RecordSummary:
     header: str = "at start"
 
     def __str__(self) -> str:
-        gaps = f", {self.gaps} gaps marked" if self.gaps else ""
+        gaps = f", {plural(self.gaps, 'gap')} marked" if self.gaps else ""
         header = ", no logger header seen" if self.header == "not seen" else ""
-        return (f"recorded {self.lines} lines in {self.seconds:.1f} s to {self.out}{gaps}"
-                f"{header} ({self.ended})")  # fmt: skip
+        return (f"recorded {plural(self.lines, 'line')} in {self.seconds:.1f} s to "
+                f"{self.out}{gaps}{header} ({self.ended})")  # fmt: skip
 
 
 class CaptureFile:

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import write_text
+from .._words import plural
 from ..errors import ParameterError
 from .counter import COUNTER_BITS_RANGE
 from .reader import DEFAULT_TICK, MAX_GATES
@@ -181,7 +182,7 @@ def _capture(time, theta, theta_dot, gate: LightGate) -> tuple[str, np.ndarray]:
     if theta.ndim != 2 or theta.shape != theta_dot.shape or theta.shape[0] != len(time):
         raise ParameterError(
             f"`theta` and `theta_dot` must both have shape (len(time), N), got "
-            f"{theta.shape} and {theta_dot.shape} for {len(time)} times."
+            f"{theta.shape} and {theta_dot.shape} for {plural(len(time), 'time')}."
         )
     n = theta.shape[1]
     if not 1 <= n <= MAX_GATES:
@@ -266,10 +267,10 @@ def _warn_unreached(rare: list[tuple[int, int, int, int, float]], gate: LightGat
     warnings.warn(
         f"the light gate at `offset` = {gate.offset:g} rad (beam {beam[0]:.3g} .. "
         f"{beam[1]:.3g} rad) is reached rarely or never in {len(rare)} of {total} metronome "
-        f"runs ({never} never): e.g. run {b}, metronome {i} passed it {passes} times in "
-        f"{swings} swings through the vertical, swinging up to {swing:.3g} rad. Those logs "
-        f"hold few or no passes; choose an `offset` well inside the swing (the default is "
-        f"0.1 rad).",
+        f"runs ({never} never): e.g. run {b}, metronome {i} passed it {plural(passes, 'time')} "
+        f"in {plural(swings, 'swing')} through the vertical, swinging up to {swing:.3g} rad. "
+        f"Those logs hold few or no passes; choose an `offset` well inside the swing (the "
+        f"default is 0.1 rad).",
         UserWarning,
         stacklevel=3,
     )

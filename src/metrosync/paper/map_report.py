@@ -88,6 +88,8 @@ def sigma_map_section(ds: xr.Dataset) -> list[str]:
     if notes:
         s += ["", "† `metrosync.sweeps.critical` does not trust this extrapolation (left out "
               "of σ* below): " + "; ".join(notes) + "."]  # fmt: skip
+    if (note := theory_half_note(ds)) is not None:
+        s += ["", note]
     s += ["", f"Where ω_c reaches the paper's {target:g} BPM:", ""]
     s += [f"| tuning | σ* from ω_c(∞), peak | from ω_c(∞), rise | from the rise at N = "
           f"{int(ds.n[-1])} | from the theory | reading of Tables 1–2 |",
@@ -102,6 +104,18 @@ def sigma_map_section(ds: xr.Dataset) -> list[str]:
                  + f" | {which_reading(value, err)} ({source}) |")  # fmt: skip
     s += ["", agreement(ds), ""]
     return s
+
+
+def theory_half_note(ds: xr.Dataset) -> str | None:
+    """Why the "theory: r = 1/2" column is empty, when it is (None when it has values)."""
+    if np.isfinite(ds.theory_omega_half.values).any():
+        return None
+    return (
+        'The column "theory: r = 1/2" is "—": its ω is where the reduced phase model '
+        "itself, simulated with 20 000 oscillators for each σ, reaches r_eq = 1/2, which "
+        "takes seconds a σ and tuning; quick mode leaves that simulation out (the threshold "
+        "column needs none), and `metrosync reproduce --full` runs it."
+    )
 
 
 def headline_sigma(x: xr.Dataset) -> tuple[float, float, str]:

@@ -36,6 +36,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from .. import interrupts
 from .._files import atomic_path
+from .._words import plural
 from ..budget import Budget
 from ..errors import ParameterError
 from ..progress import progress_bar
@@ -122,7 +123,7 @@ def plan(start: float, end: float, *, fps: float, speedup: float | None, dpi: fl
     count = frame_count(start, end, fps, speedup)
     if count > MAX_FRAMES:
         raise ParameterError(
-            f"{count} frames exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
+            f"{plural(count, 'frame')} exceed {MAX_FRAMES}; raise `speedup` (now {speedup:g}), "
             f"lower `fps` (now {fps:g}) or shorten the window."
         )
     pixels = float(width * height)
@@ -131,7 +132,7 @@ def plan(start: float, end: float, *, fps: float, speedup: float | None, dpi: fl
         # the canvas, its saved background, the RGB copy and its palette image
         {"one frame's buffers": 13.0 * pixels},
         seconds=count * FRAME_SECONDS * max(1.0, pixels / (640 * 320)),
-        work=f"{count} frames of {width} x {height} pixels",
+        work=f"{plural(count, 'frame')} of {width} x {height} pixels",
         fixes="raise `speedup`, lower `fps` or `dpi`, or shorten the window (`start`, `end`)",
     )
     return speedup, count, budget

@@ -198,7 +198,7 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
         "n_flagged": (
             dims,
             flagged,
-            {"long_name": "runs flagged overturned or diverged (not counting failed points)"},
+            {"long_name": "runs flagged overturned, diverged or stopped (not failed points)"},
         ),
         "seed": (dims, seed, {"long_name": "seed passed to simulate for this point"}),
         "error": (dims, error.astype(str), {"long_name": "why the point has no result ('' = ok)"}),

@@ -20,6 +20,7 @@ from typing import Any
 
 import xarray as xr
 
+from .._words import plural
 from ..budget import Budget, simulation_budget
 from ..errors import Interrupted, OverturnWarning, ParameterError
 from ..simulate import record_stride
@@ -73,11 +74,12 @@ class SweepResult:
         simulated = int((ds.status.values[error == ""] >= 0).sum())
         flagged = int(ds.n_flagged.sum())
         lines = [
-            f"metrosync sweep: {self.grid.size} points over {', '.join(self.grid.axes)}; "
+            f"metrosync sweep: {plural(self.grid.size, 'point')} over {', '.join(self.grid.axes)}; "
             f"{len(ex.computed)} computed, {self.reused} reused from {self.store}",
             f"  {ex.seconds:.2f} s wall, {ex.work:.3g} oscillator-steps, "
             f"{ex.throughput:.3g} oscillator-steps/s",
-            f"  runs flagged (overturned/diverged): {flagged} of {simulated} run(s) simulated"
+            f"  runs flagged (overturned/diverged/stopped): {flagged} of "
+            f"{plural(simulated, 'run')} simulated"
             + ("; their r is not meaningful (status bits: metrosync.status)" if flagged else ""),
         ]
         failures = self.failures()
