@@ -139,7 +139,7 @@ def run_phone(args) -> int:
     with atomic_path(truth_path) as tmp:
         tmp.write_text(truth.to_json())
     dropped = f", {truth.dropped} dropped" if truth.dropped else ""
-    print(f"wrote {args.out} ({truth.frame_times.size} frames{dropped}, "
+    print(f"wrote {args.out} ({plural(truth.frame_times.size, 'frame')}{dropped}, "
           f"{truth.frame_times[-1]:.1f} s, {width}x{height} at {fps:g} fps, camera "
           f"{camera.yaw_deg:+.0f}° aside) and {truth_path}; "
           f"rods seen {np.round(truth.visible * 100).astype(int).tolist()} %")  # fmt: skip

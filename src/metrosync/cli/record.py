@@ -6,6 +6,7 @@ import sys
 import warnings
 from pathlib import Path
 
+from .._words import plural
 from ..errors import ParameterError
 from ._options import HelpFormatter, add_aliases, int_list
 
@@ -75,8 +76,8 @@ def run(args) -> int:
             raise
         # Refused once the logger had spoken (`--channels` it does not have).
         raise ParameterError(
-            f"{error} The {follower.n_lines} lines recorded so far are in {str(args.out)!r}; "
-            f"give --overwrite to record again under that name."
+            f"{error} The {plural(follower.n_lines, 'line')} recorded so far are in "
+            f"{str(args.out)!r}; give --overwrite to record again under that name."
         ) from None
     changes = follower.changes[: follower.gates or 0]
     dead = [k for k, n in enumerate(changes) if n == 0 and k in (args.channels or range(8))]
