@@ -76,7 +76,8 @@ def run(args) -> int:
             raise
         # Refused once the logger had spoken (`--channels` it does not have).
         raise ParameterError(
-            f"{error} The {plural(follower.n_lines, 'line')} recorded so far are in "
+            f"{error} The {plural(follower.n_lines, 'line')} recorded so far "
+            f"{'is' if follower.n_lines == 1 else 'are'} in "
             f"{str(args.out)!r}; give --overwrite to record again under that name."
         ) from None
     changes = follower.changes[: follower.gates or 0]
