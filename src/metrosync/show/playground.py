@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .._files import write_text
 from .._version import __version__
-from ..errors import ParameterError, describe
+from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
 
 #: The page's scripts, in the order they run (each uses those before it).
@@ -102,8 +102,10 @@ def playground_config(
     n = _check_count(n)
     low, high = start["bpm_range"]
     if not (isinstance(bpm, int | float) and math.isfinite(bpm) and low <= bpm <= high):
+        finite = isinstance(bpm, int | float) and math.isfinite(bpm)
+        _, low_text, high_text = shown_range(low, high, float(bpm) if finite else low)
         raise ParameterError(
-            f"`bpm` = {describe(bpm)} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+            f"`bpm` = {describe(bpm)} is outside the tunable range [{low_text}, {high_text}] BPM "
             f"of preset {params.name!r}; choose a BPM in range."
         )
     lo, hi = LIMITS["sigma_bpm"]

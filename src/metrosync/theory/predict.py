@@ -41,7 +41,7 @@ from . import coupling as cp
 from .estimate import estimate
 from .reduced import simulate_reduced
 from .sakaguchi import critical_coupling
-from .tuning import l2_for_bpm, steady_swing
+from .tuning import l2_for_bpm, steady_swing, with_tuning
 
 #: Bumped when a measurement method changes, so that old cache files are not reused.
 CACHE_VERSION = 1
@@ -53,12 +53,16 @@ def default_cache_dir() -> Path:
     return Path(base) / "metrosync" / "theory"
 
 
-def _measure_cached(bpm, method, params, tuning, measure_n, cache: Path | None) -> cp.Coupling:
+def _measure_cached(bpm, method, params, measure_n, cache: Path | None) -> cp.Coupling:
+    """The coupling at ``bpm``, from the cache when an entry has the same key.
+
+    The key holds every parameter of ``params``, the design's ``tuning`` among them.
+    """
     settings = {
         "version": CACHE_VERSION,
         "bpm": float(bpm),
         "method": method,
-        "tuning": tuning,
+        "tuning": params.metronome.tuning,
         "n": measure_n if method == "growth" else 2,
         "dt": cp.MEASURE_DT,
         "params": {k: str(v) for k, v in params.as_dict().items() if k != "preset"},
@@ -71,9 +75,9 @@ def _measure_cached(bpm, method, params, tuning, measure_n, cache: Path | None) 
         except (ValueError, KeyError, TypeError):
             pass  # a damaged entry is measured again and overwritten
     if method == "growth":
-        result = cp.measure_by_growth(bpm, n=measure_n, params=params, tuning=tuning)
+        result = cp.measure_by_growth(bpm, n=measure_n, params=params)
     else:
-        result = cp.measure_by_pair(bpm, params=params, tuning=tuning)
+        result = cp.measure_by_pair(bpm, params=params)
     if path is not None:
         write_text(json.dumps({"settings": settings, "coupling": vars(result)}, indent=1), path)
     return result
@@ -84,7 +88,7 @@ def coupling_curve(
     *,
     n: int | float = math.inf,
     params: ModelParameters | str = "default",
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     method: str = "growth",
     measure_n: int = 32,
     cache: Path | None = None,
@@ -96,8 +100,12 @@ def coupling_curve(
     n : metronomes the coupling is expressed for (``math.inf``: the N → ∞ limit).
     method : ``"growth"`` or ``"pair"`` (`coupling`).   measure_n : N of the growth runs.
     cache : folder of cached measurements (None: measure every time).
+    tuning : how a nominal BPM sets the slider (`metrosync.model.TUNINGS`); None: the
+        design's own ``tuning``. Either way the curve is computed, labelled and cached
+        with one tuning, the design's after this replacement.
     """
-    params = get_preset(params, warn=False)
+    params = with_tuning(get_preset(params, warn=False), tuning)
+    tuning = params.metronome.tuning
     if method not in cp.METHODS:
         raise ParameterError(f"unknown `method` {method!r}; choose one of {list(cp.METHODS)}.")
     bpms = np.asarray(bpms, dtype=float)
@@ -112,10 +120,8 @@ def coupling_curve(
     rows, estimates = [], []
     with progress_bar(total=bpms.size, unit="BPM", enabled=progress, desc="measuring K") as bar:
         for bpm in bpms:
-            rows.append(
-                _measure_cached(bpm, method, params, tuning, measure_n, cache).for_n(n, params)
-            )
-            estimates.append(estimate(bpm, n, params, tuning=tuning))
+            rows.append(_measure_cached(bpm, method, params, measure_n, cache).for_n(n, params))
+            estimates.append(estimate(bpm, n, params))
             bar.update(1)
 
     def column(items, name):
@@ -160,8 +166,10 @@ def coupling_curve(
     )
 
 
-def spread_factor(bpm: float, params: ModelParameters, tuning: str) -> float:
+def spread_factor(bpm: float, params: ModelParameters, tuning: str | None = None) -> float:
     """d(tick rate)/d(nominal BPM) at ``bpm``: how a nominal spread becomes a tick spread."""
+    params = with_tuning(params, tuning)
+    tuning = params.metronome.tuning
     if tuning == "steady-swing":
         return 1.0
     design = params.metronome
@@ -241,7 +249,7 @@ def reduced_theory(
     bpms: Sequence[float] = tuple(range(150, 231, 10)),
     sigmas: Sequence[float] = (0.5, 0.75, 1.0, 1.25, 1.5),
     n: int | float = math.inf,
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     method: str = "growth",
     measure_n: int = 32,
     cache: Path | None = None,
@@ -254,7 +262,7 @@ def reduced_theory(
         ``n`` of them, 16 runs) at every BPM and σ, giving ``r_reduced(sigma, bpm)`` and the
         ω₀ where it reaches 1/2, ``omega_half``; None skips it.
     """
-    params = get_preset(preset, warn=False)
+    params = with_tuning(get_preset(preset, warn=False), tuning)
     if params.overturns:
         raise ParameterError(
             f"preset {params.name!r} overturns (energy-balance amplitude "
@@ -268,7 +276,6 @@ def reduced_theory(
         bpms,
         n=n,
         params=params,
-        tuning=tuning,
         method=method,
         measure_n=measure_n,
         cache=cache,
