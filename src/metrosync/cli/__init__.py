@@ -78,7 +78,9 @@ def main(argv: list[str] | None = None) -> int:
         # The one handler for Ctrl-C: every subcommand's outputs are atomic, so what
         # exists is whole; say what that is, and how to go on.
         command = " ".join(sys.argv[1:2] if argv is None else argv[:1])
-        print(f"metrosync {command}: interrupted: {_kept(interrupt, written)}", file=sys.stderr)
+        kept = _kept(interrupt, written)
+        interrupts.release(interrupt)
+        print(f"metrosync {command}: interrupted: {kept}", file=sys.stderr)
         return 130
 
 
