@@ -207,8 +207,10 @@ def test_an_interrupted_sweep_prints_nothing_after_its_one_line(tmp_path):
     stopped = 0
     for delay in rng.uniform(0.0, 1.5, 12):
         out.unlink(missing_ok=True)
-        child = subprocess.Popen([sys.executable, "-m", "metrosync", *argv],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+        child = subprocess.Popen(
+            [sys.executable, "-m", "metrosync", *argv],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
         child.stdout.readline()  # "N points, grid ...": the merge is next
         time.sleep(delay)
         child.send_signal(signal.SIGINT)
