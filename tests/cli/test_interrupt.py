@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from metrosync import interrupts
+from metrosync.cli import main
 from metrosync.errors import Interrupted
 
 # Runs the command line in a child that leaves a marker when the compiled kernel is
@@ -227,3 +228,24 @@ def test_an_interrupted_sweep_prints_nothing_after_its_one_line(tmp_path):
         else:  # the signal came after the work: it finished whole
             assert child.returncode == 0 and out.is_file(), err
     assert stopped >= 4, "too few interrupts landed during the work to test anything"
+
+
+def test_ctrl_c_absorbed_by_the_work_still_exits_130(monkeypatch, capsys):
+    # A write that took the interrupt and completed (HDF5 finishing a dataset), or a
+    # capture that ends at Ctrl-C: the command still ends as an interrupted one.
+    import metrosync.cli.presets as presets
+
+    def absorbs(args):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass
+        print("work finished")
+        return 0
+
+    monkeypatch.setattr(presets, "run", absorbs)
+    assert main(["presets"]) == 130
+    captured = capsys.readouterr()
+    assert "work finished" in captured.out
+    assert captured.err == "metrosync presets: interrupted: nothing was written\n"

@@ -55,7 +55,12 @@ def test_capture_is_what_was_sent_and_ctrl_c_ends_cleanly(tmp_path):
     wait_until(lambda: out.read_text().count("\n") == CLEAN.count("\n"))
     wait_until(lambda: "r=" in record.text, timeout=10)  # the live line has an r now
     code, err = record.interrupt()
-    assert code == 0, err
+    # Ctrl-C is Ctrl-C (status 130), and the line says the capture is kept.
+    assert code == 130, err
+    assert err.splitlines()[-1] == (
+        f"metrosync record: interrupted: the capture {out} is kept, complete "
+        f"({CLEAN.count(chr(10))} lines)"
+    )
     assert out.read_text() == CLEAN  # CR LF sent, LF written, nothing else changed
     assert f"recorded {CLEAN.count(chr(10))} lines" in record.lines[-1][1]
     assert "(interrupted)" in record.lines[-1][1]
@@ -96,7 +101,7 @@ def test_reconnect_waits_and_marks_the_gap(tmp_path):
     pty.write(f"{HEADER}\r\n0-0-0 3\r\n0-0-1 100\r\n")
     wait_until(lambda: out.read_text().count("\n") == 10)
     code, err = record.interrupt()
-    assert code == 0, err
+    assert code == 130, err
     lines = out.read_text().splitlines()
     assert lines[6].startswith("# metrosync record: gap of ") and str(link) in lines[6]
     gap = float(lines[6].split()[5])

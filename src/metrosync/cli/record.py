@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..errors import ParameterError
+from ..errors import Interrupted, ParameterError
 from ._options import HelpFormatter, add_aliases, int_list
 
 
@@ -16,7 +16,8 @@ def register(subparsers) -> None:
         description="Read the gate-logger's lines from a serial port and write them, line "
         "for line, to a capture file that `metrosync analyze` reads (flushed at once, synced "
         "to disk every second). Shows a live panel: passes and BPM per gate, silent gates, "
-        "and r(t). Ctrl-C ends the recording cleanly.",
+        "and r(t). Ctrl-C ends the recording: the capture is kept, complete, and the exit "
+        "status is 130 as for every command stopped by Ctrl-C.",
         formatter_class=HelpFormatter,
     )
     parser.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyACM0 or COM3")
@@ -71,4 +72,6 @@ def run(args) -> int:
             file=sys.stderr,
         )
         return 1
+    if summary.ended == "interrupted":
+        raise Interrupted(f"the capture {args.out} is kept, complete ({summary.lines} lines)")
     return 0
