@@ -249,3 +249,30 @@ def test_ctrl_c_absorbed_by_the_work_still_exits_130(monkeypatch, capsys):
     captured = capsys.readouterr()
     assert "work finished" in captured.out
     assert captured.err == "metrosync presets: interrupted: nothing was written\n"
+
+
+def test_ctrl_c_while_the_command_starts_is_one_line_not_a_traceback():
+    # Before the entry point ran, the command line's imports (numpy, xarray: half a
+    # second) took Ctrl-C as a traceback ending in KeyboardInterrupt.
+    # Before the interpreter reaches metrosync (its own start-up, runpy), Ctrl-C is
+    # Python's; time that on this machine and begin just after it.
+    begin = time.monotonic()
+    subprocess.run([sys.executable, "-c", "import runpy"], check=True)
+    python = time.monotonic() - begin
+    stopped = 0
+    for delay in python * 1.5 + np.array([0.0, 0.03, 0.06, 0.1, 0.15, 0.25, 0.4, 0.6]):
+        child = subprocess.Popen(
+            [sys.executable, "-m", "metrosync", "simulate", "--duration", "3000"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        time.sleep(delay)
+        child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=60)
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, (delay, err)
+        if child.returncode == -signal.SIGINT:
+            assert err == ""  # the interpreter itself was still starting: killed silently
+            continue
+        assert child.returncode == 130, (delay, err)
+        assert err == "metrosync simulate: interrupted: nothing was written\n"
+        stopped += 1
+    assert stopped >= 5
