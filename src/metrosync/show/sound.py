@@ -194,16 +194,7 @@ def click_track(
     into a tone), a window shorter than one tick of the slowest metronome, and audio
     longer than `MAX_AUDIO_SECONDS`.
     """
-    if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
-        raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
-    if (
-        isinstance(sample_rate, bool)
-        or not isinstance(sample_rate, int | np.integer)
-        or not (8000 <= sample_rate <= 192000)
-    ):
-        raise ParameterError(
-            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
-        )
+    check_sound(speedup, sample_rate)
     start, end = run.window(start, end)
     bpm = 60.0 * np.asarray(run.omega) / np.pi
     check_length(speedup, start, end, fastest_bpm=float(bpm.max()), slowest_bpm=float(bpm.min()))
@@ -229,6 +220,21 @@ def click_track(
         int(sample_rate), n_samples, audio_times, onsets, gains, waveforms, start, end,
         float(speedup),
     )  # fmt: skip
+
+
+def check_sound(speedup: float, sample_rate: int) -> None:
+    """Refuse a ``speedup`` or ``sample_rate`` no click track can have (made before
+    simulating, too)."""
+    if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
+        raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
+    if (
+        isinstance(sample_rate, bool)
+        or not isinstance(sample_rate, int | np.integer)
+        or not (8000 <= sample_rate <= 192000)
+    ):
+        raise ParameterError(
+            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
+        )
 
 
 def _milliseconds(seconds: float) -> str:
