@@ -84,7 +84,7 @@ def test_listen_refuses_a_useless_speedup_before_simulating(
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--dpi", "1e6"], "`dpi` (--dpi) = 1e+06 makes 8 x 4 in frames of 8000000 x 4000000 pixels"),
+        (["--dpi", "1e6"], "`dpi` (--dpi) = 1e+06 makes 8 x 4 in frames of 8000000 x 4000000"),
         (["--fps", "60"], "`fps` (--fps) = 60 is faster than a GIF can play"),
         (["--speedup", "0.001"], "9000001 frames exceed 20000; raise `speedup`"),
     ],
