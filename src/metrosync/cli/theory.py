@@ -93,6 +93,7 @@ def register(subparsers) -> None:
         measure_n="--measure-n",
         changes="--set",
         n="--n",
+        simulate_n="--no-simulate",
     )
     parser.set_defaults(func=run)
 
