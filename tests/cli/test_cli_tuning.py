@@ -72,3 +72,13 @@ def test_sweep_set_tuning_reaches_the_model(tmp_path, capsys, spec):
             "--set", f"tuning={spec}", "--no-progress", "--out", str(out)]  # fmt: skip
     assert main(argv) == 0
     assert xr.load_dataset(out, engine="h5netcdf").attrs["model_tuning"] == spec
+
+
+def test_playground_refuses_a_tuning_its_page_cannot_compute(tmp_path, capsys):
+    # The page sets L2 by the small-amplitude formula: a steady-swing label would lie.
+    out = tmp_path / "p.html"
+    assert main(["playground", "--set", "tuning=steady-swing", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "tunes a metronome by its small-amplitude frequency only" in err
+    assert "--set tuning=" in err and not out.exists()
+    assert main(["playground", "--set", "tuning=small-amplitude", "--out", str(out)]) == 0

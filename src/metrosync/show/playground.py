@@ -94,6 +94,15 @@ def playground_config(
     params = get_preset(preset, warn=False)
     if changes:
         params = params.with_changes(**changes)
+    if params.metronome.tuning != "small-amplitude":
+        # The page's twin of the integrator sets L2 by the closed-form small-amplitude
+        # inversion; the steady-swing tuning needs the half-swing map solved per design.
+        # A page labelled with one tuning and computing with the other would be wrong.
+        raise ParameterError(
+            f"the playground tunes a metronome by its small-amplitude frequency only; "
+            f"`tuning` = {params.metronome.tuning!r} is not available there. Leave out "
+            f"`tuning` (CLI: --set tuning=...)."
+        )
     _check_ranges(params)
     get_preset(params)  # warns if its pendulums overturn, once the values are known to fit
     presets = {name: preset_data(get_preset(name, warn=False)) for name in PRESETS}
