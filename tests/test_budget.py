@@ -3,7 +3,7 @@ allocating; long ones warn before they start; r(t) stays bounded at any duration
 
 from __future__ import annotations
 
-import sys
+import importlib
 import time
 import tracemalloc
 import warnings
@@ -16,7 +16,7 @@ from metrosync import budget, simulate
 from metrosync.budget import Budget, LongRunWarning, ResourceError, simulation_budget
 from metrosync.pacing import Pacer
 
-SIMULATE = sys.modules["metrosync.simulate"]
+SIMULATE = importlib.import_module("metrosync.simulate")
 GiB = 1024.0**3
 
 

@@ -96,7 +96,7 @@ def test_ungrouped_runs_have_no_group_variables():
         ([(7, 184.0, -1.0)], r"`groups` entry 0: `sigma_bpm` must be >= 0 BPM, got -1.0"),
         (
             [(7, 900.0)],
-            r"`groups` entry 0 \(7@900:0\) has BPM 900.0, which is outside .* Move that",
+            r"`groups` entry 0 \(7@900:0\) has BPM 900, which is outside .* Move that",
         ),
         ([(7, 184.0, 400.0)], r"with `groups` entry 0 \(7@184:400\), a drawn natural frequency"),
     ],

@@ -8,28 +8,35 @@ One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
 `reproduce` (the paper's studies), `animate`, `write_wav`, `write_page`, `plot_run`
 (seeing and hearing a run), `write_playground` (the model live in a browser), and
 `reduced_theory`, `simulate_reduced` (the phase-model reduction, `metrosync.theory`).
-Those that need matplotlib, dask or an audio library are imported on first use, so
-that ``import metrosync`` stays quick.
+Each is imported on first use, so that ``import metrosync`` is quick and loads no
+numerical library: the command line sets up its Ctrl-C handling before those load.
 """
 
-from ._version import __version__
-from .ensemble import Ensemble, build_ensemble  # noqa: E402
-from .errors import MetrosyncError, OverturnWarning, ParameterError  # noqa: E402
-from .lightgate import analyze  # noqa: E402
-from .model import (  # noqa: E402
-    PRESETS,
-    Metronome,
-    MetronomeDesign,
-    ModelParameters,
-    Platform,
-    bpm_to_omega,
-    get_preset,
-    omega_to_bpm,
-)
-from .simulate import simulate  # noqa: E402
+import importlib
+import sys
+import types
 
-#: Names served on first use from the modules that need matplotlib, dask or soundfile.
+from ._version import __version__
+
+#: Every public name, and the module that defines it: imported on first use, so that
+#: ``import metrosync`` (and the ``metrosync`` command, until it has set up its Ctrl-C
+#: handling) loads no numerical library.
 _LAZY = {
+    "Ensemble": "ensemble",
+    "build_ensemble": "ensemble",
+    "MetrosyncError": "errors",
+    "OverturnWarning": "errors",
+    "ParameterError": "errors",
+    "analyze": "lightgate",
+    "PRESETS": "model",
+    "Metronome": "model",
+    "MetronomeDesign": "model",
+    "ModelParameters": "model",
+    "Platform": "model",
+    "bpm_to_omega": "model",
+    "get_preset": "model",
+    "omega_to_bpm": "model",
+    "simulate": "simulate",
     "animate": "show",
     "plot_run": "show",
     "write_page": "show",
@@ -59,13 +66,40 @@ __all__ = [
     "get_preset",
     "omega_to_bpm",
     "simulate",
-    *_LAZY,
+    "animate",
+    "plot_run",
+    "write_page",
+    "write_playground",
+    "write_wav",
+    "sweep",
+    "reproduce",
+    "analyze_audio",
+    "reduced_theory",
+    "simulate_reduced",
 ]
 
 
 def __getattr__(name: str):
     if name in _LAZY:
-        import importlib
-
-        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    try:  # a subpackage used as an attribute, as when every module was loaded up front
+        return importlib.import_module(f".{name}", __name__)
+    except ModuleNotFoundError as error:
+        if error.name != f"{__name__}.{name}":
+            raise
     raise AttributeError(f"module 'metrosync' has no attribute {name!r}")
+
+
+class _Package(types.ModuleType):
+    """Keeps `metrosync.simulate` the function once the module of the same name is
+    imported (the import system then sets the package's attribute to the module)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if isinstance(value, types.ModuleType) and _LAZY.get(name) == name:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

@@ -137,7 +137,7 @@ def build_ensemble(
         for k, g in enumerate(groups):
             design.check_tunable(
                 g.bpm,
-                what=f"`groups` entry {k} ({g.label()}) has BPM {{value!r}}, which",
+                what=f"`groups` entry {k} ({g.label()}) has BPM {{value}}, which",
                 fix="Move that group's BPM into the range.",
             )
         n = sum(g.n for g in groups)
@@ -149,7 +149,7 @@ def build_ensemble(
             design.check_tunable(
                 freq[:, lo : lo + g.n],
                 what=f"with `groups` entry {k} ({g.label()}), a drawn natural frequency "
-                "({value:.2f} BPM)",
+                "({value} BPM)",
                 fix="Lower that group's sigma or move its BPM inward.",
             )
         l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
@@ -179,8 +179,7 @@ def build_ensemble(
             freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
             design.check_tunable(
                 freq,
-                what=f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency "
-                "({value:.2f} BPM)",
+                what=f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency ({{value}} BPM)",
                 fix="Lower `sigma_bpm` or move `bpm` inward.",
             )
         l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)

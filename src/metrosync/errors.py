@@ -43,6 +43,24 @@ def require_positive(name: str, value: float, *, allow_zero: bool = False, unit:
     return value
 
 
+def shown_range(low: float, high: float, value: float, *, digits: int = 2) -> tuple[str, str, str]:
+    """``value``, ``low`` and ``high`` as a message prints them: the bounds with the
+    fewest decimals (at least ``digits``) that leave ``value`` on its true side of them.
+
+    >>> shown_range(84.6543, 236.71996, 236.72)
+    ('236.72', '84.65430', '236.71996')
+    >>> shown_range(84.6543, 236.71996, 300)
+    ('300', '84.65', '236.72')
+    """
+    inside = low <= value <= high
+    for places in range(digits, 13):
+        lo, hi = f"{low:.{places}f}", f"{high:.{places}f}"
+        for shown in (f"{value:.6g}", f"{value:.{places}f}"):
+            if inside == (float(lo) <= float(shown) <= float(hi)):
+                return shown, lo, hi
+    return repr(value), repr(low), repr(high)
+
+
 def describe(value: Any) -> str:
     """Short repr for error messages (arrays are summarised, not dumped)."""
     text = repr(value)

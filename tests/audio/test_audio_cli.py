@@ -56,6 +56,9 @@ def test_options_reach_the_analysis(capsys, pair_recording):
         ("silent", ["s.wav", "--bpm", "1000"], "`bpm` (--bpm) must be a tempo in 20..400"),
         ("silent", ["s.wav", "--out", "x.txt"], "`--out` 'x.txt' must end in .nc"),
         ("silent", ["s.wav", "--band", "5000,2000"], "`band` (--band) must be two frequencies"),
+        # The filter's edges must lie below the Nyquist frequency, not be cut down to it.
+        ("silent", ["s.wav", "--band", "1000,30000"], "high < 22050 Hz, the Nyquist frequency"),
+        ("silent", ["s.wav", "--band", "1000,22050"], "got (1000.0, 22050.0)"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, setup, argv, message):
@@ -105,3 +108,10 @@ def test_follow_with_a_recording_warns(capsys, pair_recording):
     code, _, err = run(capsys, "analyze", str(path), "--follow")
     assert code == 0
     assert "a recording ignores --follow" in err
+
+
+def test_a_band_just_below_nyquist_is_used_as_given(capsys, pair_recording):
+    path, _ = pair_recording
+    code, out, err = run(capsys, "analyze", str(path), "--band", "1000,22000")
+    assert code == 0, err
+    assert "error" not in err

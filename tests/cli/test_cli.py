@@ -184,7 +184,7 @@ def test_simulate_groups_from_the_command_line(tmp_path, capsys):
         (["--group", "7@184:x"], "argument --group: BPM and SIGMA must be numbers"),
         (["--group", "7@184", "--n", "7"], "`--group` sets the number and BPM .* drop --n"),
         (["--group", "7@184", "--bpm", "184"], "drop --bpm"),
-        (["--group", "7@900"], r"`groups` \(--group\) entry 0 \(7@900:0.75\) has BPM 900.0"),
+        (["--group", "7@900"], r"`groups` \(--group\) entry 0 \(7@900:0.75\) has BPM 900,"),
         (
             ["--group", "5@184", "--group", "5@200", "--lightgate-dir", "x"],
             r"at most 8 gates, got 10 metronomes \(--group\)",

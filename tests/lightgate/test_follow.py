@@ -91,7 +91,10 @@ def test_analyze_follow_writes_at_ctrl_c_what_analyze_writes(tmp_path):
     writer.join()
     wait_until(lambda: f"lines={len(lines)} r=" in command.text, timeout=20)
     code, err = command.interrupt()
-    assert code == 0, err
+    assert code == 130, err
+    assert err.splitlines()[-1] == (
+        f"metrosync analyze: interrupted: analysed {path} as it stood; wrote {out} (complete)"
+    )
     assert f"wrote {out}" in command.text and "equilibrium r" in command.text
     from metrosync.cli import main
 

@@ -60,7 +60,11 @@ def test_capture_is_what_was_sent_and_ctrl_c_ends_cleanly(tmp_path):
     wait_until(lambda: out.read_text().count("\n") == CLEAN.count("\n"))
     wait_until(lambda: "r=" in record.text, timeout=10)  # the live line has an r now
     code, err = record.interrupt()
-    assert code == 0, err
+    # Ctrl-C is Ctrl-C (status 130), and the line says the capture is kept.
+    assert code == 130, err
+    assert err.splitlines()[-1].startswith(
+        f"metrosync record: interrupted: the capture {out} is kept, complete ("
+    )
     # CR LF sent, LF written, nothing else changed; with no header sent, a note says so.
     text = out.read_text()
     assert text.startswith(CLEAN) and text[len(CLEAN) :].count("\n") == 1
@@ -107,7 +111,7 @@ def test_reconnect_waits_and_marks_the_gap(tmp_path):
     pty.write(f"{HEADER}\r\n0-0-0 3\r\n0-0-1 100\r\n")
     wait_until(lambda: out.read_text().count("\n") == 10)
     code, err = record.interrupt()
-    assert code == 0, err
+    assert code == 130, err
     lines = out.read_text().splitlines()
     assert lines[6].startswith("# metrosync record: gap of ") and str(link) in lines[6]
     gap = float(lines[6].split()[5])
@@ -140,7 +144,7 @@ def test_a_board_that_did_not_reset_is_asked_for_its_header(tmp_path):
     wait_until(lambda: out.read_text().count("\n") == 33)
     time.sleep(REQUEST_WAIT + 0.5)
     code, err = record.interrupt()
-    assert code == 0, err
+    assert code == 130, err
     assert "no logger header" not in out.read_text() + record.lines[-1][1]
     log = read_log(out)
     assert log.header.requested and log.restarts == () and len(log.ticks) == 31
@@ -154,7 +158,7 @@ def test_a_header_at_start_is_kept_and_nothing_is_asked(tmp_path):
     pty.write(f"{HEADER}\r\n" + CLEAN.replace("\n", "\r\n"))
     assert sent_to_logger(pty, timeout=HEADER_WAIT + REQUEST_WAIT + 0.5) == b""
     code, err = record.interrupt()
-    assert code == 0, err
+    assert code == 130, err
     assert out.read_text() == f"{HEADER}\n{CLEAN}"
     assert "no logger header" not in record.lines[-1][1]
 
@@ -168,7 +172,7 @@ def test_no_answer_to_the_request_is_noted_in_the_capture_at_once(tmp_path):
     pty.write("1-0-0 10\r\n")  # the recording goes on after the note
     wait_until(lambda: out.read_text().endswith("1-0-0 10\n"))
     code, err = record.interrupt()
-    assert code == 0, err
+    assert code == 130, err
     assert out.read_text().count("no logger header") == 1
     assert "no logger header seen" in record.lines[-1][1]
     log = read_log(out, strict=True)  # the note is a known line, even when strict

@@ -71,7 +71,7 @@ def test_an_inverted_pendulum_is_refused_by_the_builder():
         ),
         (
             {"sigma_bpm": 60.0},
-            r"^with `sigma_bpm` = 60.0, a drawn natural frequency \(\d+\.\d\d BPM\) is outside "
+            r"^with `sigma_bpm` = 60.0, a drawn natural frequency \(\d+\.\d+ BPM\) is outside "
             r"the tunable range .*Lower `sigma_bpm`",
         ),
     ],

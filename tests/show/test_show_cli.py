@@ -87,8 +87,8 @@ def test_a_bad_time_step_is_reported_by_simulate(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("speedup", "message"),
     [
-        ("1e6", "`speedup` = 1e+06 brings a metronome's ticks 0.312 µs apart"),
-        ("1e-6", "`speedup` = 1e-06 makes 600 s of simulation last 19 years of audio"),
+        ("1e6", "`speedup` (--speedup) = 1e+06 brings a metronome's ticks 0.312 µs apart"),
+        ("1e-6", "`speedup` (--speedup) = 1e-06 makes 600 s of simulation last 19 years of audio"),
     ],
 )
 def test_listen_refuses_a_useless_speedup_before_simulating(
@@ -108,8 +108,8 @@ def test_listen_refuses_a_useless_speedup_before_simulating(
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--dpi", "1e6"], "`dpi` = 1e+06 makes 8 x 4 in frames of 8000000 x 4000000 pixels"),
-        (["--fps", "60"], "`fps` = 60 is faster than a GIF can play"),
+        (["--dpi", "1e6"], "`dpi` (--dpi) = 1e+06 makes 8 x 4 in frames of 8000000 x 4000000"),
+        (["--fps", "60"], "`fps` (--fps) = 60 is faster than a GIF can play"),
         (["--speedup", "0.001"], "9000001 frames exceed 20000; raise `speedup`"),
     ],
 )
@@ -131,3 +131,38 @@ def test_animate_defaults_pick_a_speedup_and_say_so(tmp_path, capsys):
     out = tmp_path / "a.gif"
     assert main(["animate", *SMALL[:2], "--duration", "45", "--dpi", "30", "--out", str(out)]) == 0
     assert "(338 frames at 15 fps, speed-up 2, 23 s)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["listen", "--speedup", "0"], "`speedup` (--speedup) must be a number > 0, got 0.0."),
+        (["listen", "--sample-rate", "10"], "`sample_rate` (--sample-rate) must be an integer"),
+        (["listen", "--runs", "2", "--run", "5"], "`run` (--run) must be an integer in [0, 1]"),
+        (["listen", "--duration", "300", "--start", "700"],
+         "`start` (--start) must be a time in [0, 300) s, got 700.0."),
+        (["listen", "--duration", "300", "--end", "400"],
+         "`end` (--end) must be a time in (0, 300] s, got 400.0."),
+        (["listen", "--speedup", "1000"], "would merge into a tone"),
+        (["page", "--max-rate", "0"], "`max_rate` (--max-rate) must be a number > 0"),
+        (["page", "--run", "3"], "`run` (--run) must be an integer in [0, 0], got 3."),
+        (["page", "--start", "50", "--end", "40"], "`end` (--end) must be a time in (50, 600]"),
+        (["animate", "--run", "1"], "`run` (--run) must be an integer in [0, 0], got 1."),
+        (["animate", "--duration", "300", "--start", "-1"], "`start` (--start) must be a time"),
+        (["animate", "--dpi", "5"], "dpi"),
+    ],
+)  # fmt: skip
+def test_impossible_options_are_refused_before_simulating(monkeypatch, capsys, tmp_path, argv,
+                                                          message):  # fmt: skip
+    import metrosync.cli._show_source as source
+
+    def simulated(args):
+        raise AssertionError("simulated before refusing")
+
+    monkeypatch.setattr(source, "simulate_from_args", simulated)
+    suffix = {"listen": ".wav", "page": ".html", "animate": ".gif"}[argv[0]]
+    out = tmp_path / f"x{suffix}"
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"metrosync {argv[0]}: error: ") and message in err, err
+    assert not out.exists()

@@ -1,5 +1,7 @@
 """What a sweep refuses up front, what it accepts, and how its summary counts."""
 
+import re
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -81,3 +83,15 @@ def test_status_bits_are_documented_in_one_public_place():
         assert f"{bit}      {name}" in status.__doc__
     readme = (__import__("pathlib").Path(__file__).parents[2] / "README.md").read_text()
     assert "[`metrosync.status`](src/metrosync/status.py)" in readme
+
+
+def test_a_value_just_past_the_tunable_range_reads_as_outside_it(tmp_path, capsys):
+    # 236.72 lies 3e-5 BPM above the top of the range; two decimals printed both as 236.72.
+    argv = ["sweep", "--bpm", "100:250:0.01", "--out", str(tmp_path / "q.nc")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    found = re.search(r"= ([\d.]+) is outside the tunable range \[([\d.]+), ([\d.]+)\]", err)
+    assert found, err
+    value, low, high = (float(x) for x in found.groups())
+    assert value > high > low
+    assert not (tmp_path / "q.points").exists()

@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -119,3 +120,34 @@ def test_cli_refuses_an_unwritable_cache_before_measuring(tmp_path, capsys):
 def test_cli_errors_name_the_option(argv, message, capsys, tmp_path):
     assert main(["theory", "--cache", str(tmp_path), *argv]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_a_long_theory_run_warns_with_its_estimate_before_measuring(monkeypatch, capsys):
+    import metrosync.theory.predict as predict
+
+    def measure(*args, **kwargs):
+        raise KeyboardInterrupt  # the user, once the warning is out: stop here
+
+    monkeypatch.setattr(predict, "_measure_cached", measure)
+    argv = ["theory", "--bpm", "150:230:0.01", "--no-cache", "--no-progress"]
+    assert main(argv) == 130
+    err = capsys.readouterr().err.splitlines()
+    assert err[-1] == "metrosync theory: interrupted: nothing was written"
+    (warning,) = err[:-1]
+    found = re.search(r"theory is estimated to take about ([\d.]+) h \(8001 measurements", warning)
+    assert found and 1 < float(found[1]) < 4, warning
+    assert "coarser `bpms` (--bpm) grid" in warning and "(--no-simulate)" in warning
+
+
+def test_cached_measurements_cost_nothing_in_the_estimate(tmp_path):
+    from metrosync.model import get_preset
+    from metrosync.theory.predict import _cache_path, theory_budget
+
+    params, bpms = get_preset("default"), np.arange(150.0, 230.0, 0.5)
+    full = theory_budget(bpms, params=params, cache=tmp_path)
+    for bpm in bpms[:80]:
+        path, _ = _cache_path(bpm, "growth", params, 32, tmp_path)
+        path.write_text("{}")
+    half = theory_budget(bpms, params=params, cache=tmp_path)
+    assert half.seconds == pytest.approx(full.seconds / 2)
+    assert "80 measurements" in half.work and "160 measurements" in full.work

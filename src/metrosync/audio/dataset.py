@@ -55,7 +55,7 @@ def analyze_audio(
     *,
     bpm: float | None = None,
     metronomes: int | None = None,
-    band: tuple[float, float] = det.DEFAULT_BAND,
+    band: tuple[float, float] | None = None,
     sensitivity: float = det.DEFAULT_SENSITIVITY,
     refractory: float | None = None,
     order_window: float | None = None,
@@ -70,7 +70,8 @@ def analyze_audio(
     bpm : the metronomes' setting, BPM; default: found from the ticks.
     metronomes : how many metronomes sound; default: the ticks per beat in the windows
         where they were least together (95th percentile), rounded.
-    band : band-pass edges (Hz) of the detector.
+    band : band-pass edges (Hz) of the detector, below half the sample rate; default
+        `metrosync.audio.settings.DEFAULT_BAND`, its top lowered for a low sample rate.
     sensitivity : threshold above the detection curve's median, in its robust spreads.
     refractory : shortest time between two ticks, s; default 1/32 of the beat, within
         3–30 ms. Ticks closer than this are heard as one.

@@ -41,7 +41,7 @@ from scipy import fft, ndimage, signal
 
 from .._words import plural
 from .reader import AudioFileError, Recording
-from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY
+from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY, DEFAULT_TOP
 
 HOP = 0.5e-3
 AHEAD = 1.0e-3
@@ -87,13 +87,23 @@ class Scan:
 
 
 def band_filter(band, sample_rate: int) -> tuple[tuple[float, float], np.ndarray]:
-    """The band-pass for ``band`` (Hz), its upper edge kept below 0.45 × the rate."""
-    lo, hi = (float(b) for b in band)
-    hi = min(hi, 0.45 * sample_rate)
-    if not (np.isfinite(lo) and 20.0 <= lo < hi):
+    """The band-pass for ``band`` (Hz); None: `DEFAULT_BAND`, its top lowered to
+    `DEFAULT_TOP` × the rate where the rate is too low for it.
+
+    A band given is used as given or refused: the digital Butterworth design needs
+    both edges strictly inside (0, rate/2), the Nyquist frequency (at 44.1 kHz the top
+    must be below 22 050 Hz), and the detector needs ``low`` >= 20 Hz.
+    """
+    if band is None:
+        lo, hi = DEFAULT_BAND[0], min(DEFAULT_BAND[1], DEFAULT_TOP * sample_rate)
+    else:
+        lo, hi = (float(b) for b in band)
+    nyquist = sample_rate / 2
+    if not (np.isfinite(lo) and np.isfinite(hi) and 20.0 <= lo < hi < nyquist):
         raise AudioFileError(
-            f"`band` must be two frequencies 20 Hz <= low < high (the high edge at most "
-            f"0.45 × the sample rate, {0.45 * sample_rate:g} Hz), got {tuple(band)!r}."
+            f"`band` must be two frequencies 20 Hz <= low < high < {nyquist:g} Hz, the "
+            f"Nyquist frequency of this {sample_rate} Hz recording (a digital filter's "
+            f"edges lie below half the sample rate), got {(lo, hi)!r}."
         )
     return (lo, hi), signal.butter(2, (lo, hi), btype="bandpass", fs=sample_rate, output="sos")
 
@@ -101,7 +111,7 @@ def band_filter(band, sample_rate: int) -> tuple[tuple[float, float], np.ndarray
 def scan(
     recording: Recording,
     *,
-    band=DEFAULT_BAND,
+    band=None,
     sensitivity: float = DEFAULT_SENSITIVITY,
     progress=None,
 ) -> Scan:

@@ -6,8 +6,10 @@ sets ``func`` to a handler taking the parsed arguments and returning an exit cod
 Exit codes: 0 success; 1 the work ran but did not fully succeed (a sweep with
 failed or missing points), a file could not be written, or the reader of the output
 went away; 2 bad input, reported in one line that names the option, the value and
-what to do (a `MetrosyncError`); 130 stopped by Ctrl-C (SIGINT), reported in one line
-that says what was kept and how to resume. Warnings print as one line each.
+what to do (a `MetrosyncError`); 130 stopped by Ctrl-C (SIGINT), whatever the command,
+reported in one line that says what was kept and how to resume (`record` keeps its
+capture and `analyze --follow` writes its analysis first: for them Ctrl-C is the usual
+end, and still exits 130). Warnings print as one line each.
 """
 
 from __future__ import annotations
@@ -66,7 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with recording_writes() as written, interrupts.sigint_checked():
             try:
-                return _run(argv)
+                code = _run(argv)
             except Exception:
                 # An interrupt raised inside a library can leave it broken, so that it
                 # fails next with an error of its own (matplotlib: "Invalid affine
@@ -74,11 +76,18 @@ def main(argv: list[str] | None = None) -> int:
                 if interrupts.requested():
                     raise KeyboardInterrupt from None
                 raise
+            if interrupts.requested():
+                # The work took the interrupt and finished what it was doing (a write
+                # that completed): Ctrl-C still ends with its line and status 130.
+                raise KeyboardInterrupt
+            return code
     except KeyboardInterrupt as interrupt:
         # The one handler for Ctrl-C: every subcommand's outputs are atomic, so what
         # exists is whole; say what that is, and how to go on.
         command = " ".join(sys.argv[1:2] if argv is None else argv[:1])
-        print(f"metrosync {command}: interrupted: {_kept(interrupt, written)}", file=sys.stderr)
+        kept = _kept(interrupt, written)
+        interrupts.release(interrupt)
+        print(f"metrosync {command}: interrupted: {kept}", file=sys.stderr)
         return 130
 
 

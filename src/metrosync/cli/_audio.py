@@ -71,9 +71,10 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--band",
         type=band_arg,
-        default=DEFAULT_BAND,
+        default=None,
         metavar="LOW,HIGH",
-        help="band-pass of the tick detector, Hz",
+        help=f"band-pass of the tick detector, Hz, HIGH below half the sample rate (default: "
+        f"{DEFAULT_BAND[0]:g},{DEFAULT_BAND[1]:g}, its top lowered for a low sample rate)",
     )
     g.add_argument(
         "--sensitivity",

@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import time
 
-from ..errors import ParameterError
+from ..errors import Interrupted, ParameterError
 
 #: Seconds between two looks at the followed file.
 POLL_EVERY = 0.1
 
 
 def follow(args, analyze_options: dict) -> int:
-    """Follow ``args.logs[0]`` with the live panel until Ctrl-C, then analyse it whole.
+    """Follow ``args.logs[0]`` with the live panel until Ctrl-C, then analyse it whole
+    and end as an interrupted command does (`Interrupted`: exit status 130).
 
     analyze_options : the keyword arguments `analyze` gets, reading options included.
     """
@@ -51,4 +52,10 @@ def follow(args, analyze_options: dict) -> int:
                       polarity=reading["polarity"], **analyze_options)  # fmt: skip
     print(summary(ds))
     write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
-    return 0
+    # Ctrl-C is how a follow ends, but it is still Ctrl-C: exit status 130, as for every
+    # command, with what it wrote.
+    written = [str(path) for path in (args.out, args.plot) if path is not None]
+    raise Interrupted(
+        f"analysed {path} as it stood"
+        + (f"; wrote {' and '.join(written)} (complete)" if written else "")
+    )

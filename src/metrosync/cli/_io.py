@@ -33,18 +33,32 @@ def figure_suffixes() -> tuple[str, ...]:
 
 
 def check_output(
-    path: Path | None, option: str, *, suffixes: Sequence[str] | str | None = None
+    path: Path | None,
+    option: str,
+    *,
+    suffixes: Sequence[str] | str | None = None,
+    folder: bool = False,
 ) -> None:
     """Refuse an output path that cannot be written, before any work is done.
+
+    Every output option does this one thing with folders: missing ones are created
+    when the output is written; a folder that can be neither created nor written in
+    is refused here, before anything runs.
 
     path : the file to write (None: nothing asked, nothing checked).
     option : the option that gave it, for the message (``"--plot"``).
     suffixes : the suffixes accepted (lower case, with the dot), `NETCDF`, `FIGURE`;
         None accepts any.
+    folder : ``path`` is a folder the command writes files into (``--store``).
     """
     if path is None:
         return
     path = Path(path)
+    if folder:
+        if path.exists() and not path.is_dir():
+            raise ParameterError(f"`{option}` {str(path)!r} is a file; give a folder.")
+        _check_folder(path / "x", option, path)  # a file in it: the folder is its parent
+        return
     if path.is_dir():
         raise ParameterError(f"`{option}` {str(path)!r} is a directory; give a file name.")
     if suffixes == FIGURE:
@@ -52,6 +66,11 @@ def check_output(
     if suffixes is not None and path.suffix.lower() not in suffixes:
         shown = ", ".join(suffixes[:8]) + (", ..." if len(suffixes) > 8 else "")
         raise ParameterError(f"`{option}` {str(path)!r} must end in {shown}, the format it writes.")
+    _check_folder(path, option, path)
+
+
+def _check_folder(path: Path, option: str, shown: Path) -> None:
+    """Refuse ``path`` when its folder can be neither created nor written in."""
     folder = path.parent
     while not folder.exists():  # the missing folders will be created
         folder = folder.parent
@@ -65,7 +84,7 @@ def check_output(
         except OSError as error:
             problem = f"cannot create files in {str(folder)!r} ({error.strerror})"
     if problem:
-        raise ParameterError(f"`{option}` {str(path)!r}: {problem}; choose another path.")
+        raise ParameterError(f"`{option}` {str(shown)!r}: {problem}; choose another path.")
 
 
 def read_dataset(path: Path, what: str = "input file"):

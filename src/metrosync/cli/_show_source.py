@@ -9,11 +9,12 @@ simulation options is an error, not a silent choice.
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import read_dataset
-from ._options import add_ensemble_options, simulate_from_args
+from ._options import add_aliases, add_ensemble_options, ensemble_defaults, simulate_from_args
 
 
 def add_source_options(parser: argparse.ArgumentParser, *, record_seconds: float | None) -> None:
@@ -41,10 +42,15 @@ def add_source_options(parser: argparse.ArgumentParser, *, record_seconds: float
     shown.add_argument("--run", type=int, default=0, help="which run of the ensemble")
     shown.add_argument("--start", type=float, default=None, help="start of the time window, s")
     shown.add_argument("--end", type=float, default=None, help="end of the time window, s")
+    add_aliases(parser, run="--run", start="--start", end="--end")
 
 
-def load_or_simulate(args):
-    """The dataset to show: read ``args.input``, or simulate from the ensemble options."""
+def load_or_simulate(args, check: Callable[[float, float], None] | None = None):
+    """The dataset to show: read ``args.input``, or simulate from the ensemble options.
+
+    check : the command's own check of the window [start, end] (s) it will show, called
+        before simulating (a file's window is checked by the library once it is read).
+    """
     if args.input is not None:
         changed = [
             name
@@ -59,9 +65,32 @@ def load_or_simulate(args):
                 f"(got {str(args.input)!r} and {options})."
             )
         return read_dataset(args.input)
+    check_before_simulating(args, check)
     if args.save_every is None:
         seconds = args._record_seconds
         # A bad --dt is reported by `simulate`; it must not break this arithmetic first.
         usable = seconds is not None and args.dt > 0 and args.dt < float("inf")
         args.save_every = max(1, round(seconds / args.dt)) if usable else 1
     return simulate_from_args(args)
+
+
+def check_before_simulating(args, check: Callable[[float, float], None] | None = None) -> None:
+    """Refuse what the options already make impossible, before anything is simulated.
+
+    What a simulation will hold follows from the options: ``--runs`` runs (or its
+    default) over [0, ``--duration``] s. ``--run``, ``--start`` and ``--end`` are checked
+    against them with the checks the library makes on a recording, then ``check`` runs
+    on the window. A bad ``--runs`` or ``--duration`` is left to `simulate`, which says
+    what is wrong with it.
+    """
+    from ..show.recording import check_run, check_window
+
+    _, runs, _ = ensemble_defaults(args)
+    if isinstance(runs, int) and runs >= 1:
+        check_run(args.run, runs)
+    duration = args.duration
+    if not (isinstance(duration, int | float) and 0 < duration < float("inf")):
+        return
+    start, end = check_window(args.start, args.end, 0.0, float(duration))
+    if check is not None:
+        check(start, end)

@@ -66,8 +66,8 @@ def register(subparsers) -> None:
                      help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
     out.add_argument("--follow", action="store_true",
                      help="follow a LOG that is still being written (by `metrosync record` or "
-                     "a terminal program), with a live panel; at Ctrl-C analyse it and write "
-                     "--out/--plot")  # fmt: skip
+                     "a terminal program), with a live panel; at Ctrl-C analyse it, write "
+                     "--out/--plot and exit 130")  # fmt: skip
     add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt", channels="--channels")
     add_audio_options(parser)
     parser.set_defaults(func=run)

@@ -8,7 +8,7 @@ from .._files import atomic_path
 from .._words import plural
 from ..errors import ParameterError
 from ._io import check_output
-from ._options import HelpFormatter
+from ._options import HelpFormatter, add_aliases
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -53,6 +53,7 @@ def register(subparsers) -> None:
         "--size", default="1280x720",
         help="frame size WIDTHxHEIGHT, px (width even, height a multiple of 4)",
     )  # fmt: skip
+    add_aliases(parser, speedup="--speedup", fps="--fps", dpi="--dpi")
     parser.set_defaults(func=run)
 
 
@@ -64,15 +65,14 @@ def run(args) -> int:
     if args.fps is None:
         args.fps = 15.0
     check_output(args.out, "--out", suffixes=(".gif", ".mp4"))
-    if args.input is None and args.duration > 0:
-        # Before simulating: refuse what the options already make impossible, and warn
-        # about a long rendering, on the window the simulation will cover.
-        start = 0.0 if args.start is None else args.start
-        end = args.duration if args.end is None else args.end
-        if end > start:
-            plan(start, end, fps=args.fps, speedup=args.speedup, dpi=args.dpi, size=(8.0, 4.0),
-                 path=args.out)[2].check()  # fmt: skip
-    ds = load_or_simulate(args)
+
+    def check(start: float, end: float) -> None:
+        # Refuse what the options make impossible, and warn about a long rendering, on
+        # the window the simulation will cover.
+        plan(start, end, fps=args.fps, speedup=args.speedup, dpi=args.dpi, size=(8.0, 4.0),
+             path=args.out)[2].check()  # fmt: skip
+
+    ds = load_or_simulate(args, check)
     speedup = args.speedup
     if speedup is None:
         from ..show.animation import auto_speedup

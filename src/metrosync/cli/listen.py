@@ -6,7 +6,7 @@ from pathlib import Path
 
 from .._words import plural
 from ._io import check_output
-from ._options import HelpFormatter
+from ._options import HelpFormatter, add_aliases
 from ._show_source import add_source_options, load_or_simulate
 
 #: The choices of ``--tick-sound`` (`metrosync.show.sound.TICK_SOUNDS`, not imported
@@ -39,21 +39,23 @@ def register(subparsers) -> None:
         help="a short click, or a real metronome's tick (impacts and ring, one sound "
         "per metronome, tick and tock different)",
     )
+    add_aliases(parser, speedup="--speedup", sample_rate="--sample-rate")
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from ..show.sound import check_length, write_wav
+    from ..show.sound import check_length, check_sound, write_wav
 
     check_output(args.out, "--out", suffixes=(".wav",))
-    if args.input is None and args.duration > 0 and args.bpm > 0 and args.speedup > 0:
-        # Before simulating: the lengths the options already fix (the nominal BPM
-        # stands for the metronomes; the drawn frequencies are checked again after).
-        start = 0.0 if args.start is None else args.start
-        end = args.duration if args.end is None else args.end
-        if end > start:
+    check_sound(args.speedup, args.sample_rate)
+
+    def check(start: float, end: float) -> None:
+        # The nominal BPM stands for the metronomes; the drawn frequencies are checked
+        # again once simulated.
+        if args.bpm > 0:
             check_length(args.speedup, start, end, fastest_bpm=args.bpm, slowest_bpm=args.bpm)
-    ds = load_or_simulate(args)
+
+    ds = load_or_simulate(args, check)
     track = write_wav(
         ds, args.out, run=args.run, speedup=args.speedup, start=args.start, end=args.end,
         sample_rate=args.sample_rate, tick_sound=args.tick_sound,

@@ -28,9 +28,10 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
-    from ..show.page import write_page
+    from ..show.page import check_max_rate, write_page
 
     check_output(args.out, "--out", suffixes=(".html", ".htm"))
+    check_max_rate(args.max_rate)
     ds = load_or_simulate(args)
     path = write_page(ds, args.out, run=args.run, start=args.start, end=args.end,
                       max_rate=args.max_rate)  # fmt: skip

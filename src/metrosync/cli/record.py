@@ -7,7 +7,7 @@ import warnings
 from pathlib import Path
 
 from .._words import plural
-from ..errors import ParameterError
+from ..errors import Interrupted, ParameterError
 from ._options import HelpFormatter, add_aliases, int_list
 
 
@@ -20,7 +20,8 @@ def register(subparsers) -> None:
         "to disk every second). A board that did not reset when the port opened is asked "
         "for its header after 2 s; a note in the capture says when none came. Shows a live "
         "panel: passes and BPM per gate, silent gates and gates that never changed (left "
-        "out of r), and r(t). Ctrl-C ends the recording cleanly.",
+        "out of r), and r(t). Ctrl-C ends the recording: the capture is kept, complete, and "
+        "the exit status is 130 as for every command stopped by Ctrl-C.",
         formatter_class=HelpFormatter,
     )
     parser.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyACM0 or COM3")
@@ -93,4 +94,6 @@ def run(args) -> int:
             file=sys.stderr,
         )
         return 1
+    if summary.ended == "interrupted":
+        raise Interrupted(f"the capture {args.out} is kept, complete ({summary.lines} lines)")
     return 0

@@ -83,7 +83,7 @@ def run(args) -> int:
     # every file written there).
     if args.out.exists() and not args.out.is_dir():
         raise ParameterError(f"`--out` {str(args.out)!r} is a file; give a folder.")
-    check_output(args.out / "REPORT.md", "--out")
+    check_output(args.out, "--out", folder=True)
 
     try:
         rep = reproduce(

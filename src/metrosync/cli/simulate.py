@@ -104,7 +104,7 @@ def _simulate_with_gate(args):
         raise ParameterError(
             f"`--lightgate-dir` {str(args.lightgate_dir)!r} is a file; give a directory."
         )
-    check_output(args.lightgate_dir / "run000.log", "--lightgate-dir")
+    check_output(args.lightgate_dir, "--lightgate-dir", folder=True)
     asked = args.save_every
     fine = simulate_from_args(argparse.Namespace(**{**vars(args), "save_every": 1}))
     paths = write_logs(fine, args.lightgate_dir, gate)

@@ -116,7 +116,7 @@ def run(args) -> int:
     check_scheduler(args.scheduler, args.workers)
     grid = grid_from_args(args)
     store = args.store if args.store is not None else args.out.with_suffix(".points")
-    check_output(store / "log.jsonl", "--store")
+    check_output(store, "--store", folder=True)
     shape = dict(zip(grid.axes, grid.shape, strict=True))
     print(f"metrosync sweep: {plural(grid.size, 'point')}, grid {shape}, store {store}")
     result = sweep(

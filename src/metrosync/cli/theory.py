@@ -36,8 +36,9 @@ def register(subparsers) -> None:
     g.add_argument(
         "--tuning",
         choices=("small-amplitude", "steady-swing"),
-        default="small-amplitude",
-        help="how a nominal BPM sets the slider",
+        default=None,
+        help="how a nominal BPM sets the slider; the same as --set tuning=NAME (default: the "
+        "preset's, small-amplitude)",
     )
     g = parser.add_argument_group("prediction")
     g.add_argument(
@@ -92,6 +93,7 @@ def register(subparsers) -> None:
         measure_n="--measure-n",
         changes="--set",
         n="--n",
+        simulate_n="--no-simulate",
     )
     parser.set_defaults(func=run)
 
@@ -124,6 +126,11 @@ def run(args) -> int:
     n = _n(args.n)
     params = get_preset(args.preset, warn=False)
     changes = parse_changes(args.changes)
+    given = changes.get("tuning")
+    if args.tuning is not None and given is not None and given != args.tuning:
+        raise ParameterError(
+            f"`--tuning {args.tuning}` and `--set tuning={given}` disagree; give the tuning once."
+        )
     if changes:
         params = params.with_changes(**changes)
     cache = None if args.no_cache else (args.cache or default_cache_dir())

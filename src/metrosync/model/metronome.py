@@ -34,7 +34,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import ParameterError, describe, require_finite, require_positive
+from ..errors import ParameterError, describe, require_finite, require_positive, shown_range
 
 STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
 #: How a nominal BPM becomes a slider position (see the module docstring).
@@ -162,14 +162,15 @@ class MetronomeDesign:
         that works: the `l2_bounds` that reach it, or why no slider position does."""
         low, high = self.bpm_range()
         lo, hi = self.l2_bounds
+        shown, low_text, high_text = shown_range(low, high, bpm)
         text = (
-            f"`{name}` = {bpm:.6g} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+            f"`{name}` = {shown} is outside the tunable range [{low_text}, {high_text}] BPM "
             f"of this metronome design (slider L2 in {self.l2_bounds} m). Choose a BPM in range"
         )
         if bpm > high and lo == 0:
             # The slider at the pivot is the fastest setting: no bounds reach further.
             return text + (
-                f"; no slider position beats faster than {high:.2f} BPM (L2 = 0), so a faster "
+                f"; no slider position beats faster than {high_text} BPM (L2 = 0), so a faster "
                 f"metronome needs a shorter rod `l1`."
             )
         inverted = self.w1 * self.l1 / self.w2 if self.w2 > 0 else math.inf
@@ -203,7 +204,7 @@ class MetronomeDesign:
         not for a grid the program built). The message offers
         `l2_bounds` that would reach it (`out_of_range`). A caller whose values are not
         the user's own (drawn frequencies, a sweep axis) gives ``what`` (``{value}`` is
-        the first value out of range) and ``fix`` instead.
+        the first value out of range, as text with the range's decimals) and ``fix`` instead.
         """
         bpm_arr = np.asarray(bpm, dtype=float)
         if not np.all(np.isfinite(bpm_arr)):
@@ -217,9 +218,10 @@ class MetronomeDesign:
         if what is None and fix is None:
             where = "".join(f"[{int(k)}]" for k in first) if index else ""
             raise ParameterError(self.out_of_range(f"{name}{where}", value))
-        subject = what.format(value=value) if what else f"`{name}` = {value:.6g}"
+        shown, low_text, high_text = shown_range(low, high, value)
+        subject = what.format(value=shown) if what else f"`{name}` = {shown}"
         raise ParameterError(
-            f"{subject} is outside the tunable range [{low:.2f}, {high:.2f}] BPM of this "
+            f"{subject} is outside the tunable range [{low_text}, {high_text}] BPM of this "
             f"metronome design (slider L2 in {self.l2_bounds} m). "
             f"{fix or 'Choose a BPM in range.'}"
         )

@@ -29,10 +29,15 @@ from ._page_template import TEMPLATE
 from .recording import RecordedRun
 
 
-def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0) -> dict:
-    """The JSON-ready data of a run's window [start, end] (see the module docstring)."""
+def check_max_rate(max_rate: float) -> None:
+    """Refuse a ``max_rate`` that keeps no record (made before simulating, too)."""
     if not (isinstance(max_rate, int | float) and math.isfinite(max_rate) and max_rate > 0):
         raise ParameterError(f"`max_rate` must be a number > 0 records/s, got {max_rate!r}.")
+
+
+def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0) -> dict:
+    """The JSON-ready data of a run's window [start, end] (see the module docstring)."""
+    check_max_rate(max_rate)
     start, end = run.window(start, end)
     stride = max(1, int(math.ceil(1.0 / (max_rate * run.record_interval) - 1e-9)))
     first = int(np.searchsorted(run.time, start, side="right")) - 1

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from .._files import write_text
 from .._version import __version__
-from ..errors import ParameterError, describe
+from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
 
 #: The page's scripts, in the order they run (each uses those before it).
@@ -94,6 +94,15 @@ def playground_config(
     params = get_preset(preset, warn=False)
     if changes:
         params = params.with_changes(**changes)
+    if params.metronome.tuning != "small-amplitude":
+        # The page's twin of the integrator sets L2 by the closed-form small-amplitude
+        # inversion; the steady-swing tuning needs the half-swing map solved per design.
+        # A page labelled with one tuning and computing with the other would be wrong.
+        raise ParameterError(
+            f"the playground tunes a metronome by its small-amplitude frequency only; "
+            f"`tuning` = {params.metronome.tuning!r} is not available there. Leave out "
+            f"`tuning` (CLI: --set tuning=...)."
+        )
     _check_ranges(params)
     get_preset(params)  # warns if its pendulums overturn, once the values are known to fit
     presets = {name: preset_data(get_preset(name, warn=False)) for name in PRESETS}
@@ -102,8 +111,10 @@ def playground_config(
     n = _check_count(n)
     low, high = start["bpm_range"]
     if not (isinstance(bpm, int | float) and math.isfinite(bpm) and low <= bpm <= high):
+        finite = isinstance(bpm, int | float) and math.isfinite(bpm)
+        _, low_text, high_text = shown_range(low, high, float(bpm) if finite else low)
         raise ParameterError(
-            f"`bpm` = {describe(bpm)} is outside the tunable range [{low:.2f}, {high:.2f}] BPM "
+            f"`bpm` = {describe(bpm)} is outside the tunable range [{low_text}, {high_text}] BPM "
             f"of preset {params.name!r}; choose a BPM in range."
         )
     lo, hi = LIMITS["sigma_bpm"]

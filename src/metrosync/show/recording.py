@@ -74,10 +74,7 @@ class RecordedRun:
                 "the dataset holds no trajectories (theta, phi); simulate with "
                 "`trajectories=True` (CLI: `--save-every K`)."
             )
-        runs = ds.sizes["run"]
-        if isinstance(run, bool) or not isinstance(run, int | np.integer) or not 0 <= run < runs:
-            raise ParameterError(f"`run` must be an integer in [0, {runs - 1}], got {run!r}.")
-        run = int(run)
+        run = check_run(run, ds.sizes["run"])
         status = int(ds.status.values[run]) if "status" in ds else 0
         if status & 2:
             raise ParameterError(
@@ -143,14 +140,7 @@ class RecordedRun:
 
     def window(self, start: float | None = None, end: float | None = None) -> tuple[float, float]:
         """Check and complete a time window [start, end] inside the recording, s."""
-        t0, t1 = float(self.time[0]), float(self.time[-1])
-        start = t0 if start is None else float(start)
-        end = t1 if end is None else float(end)
-        if not (math.isfinite(start) and t0 <= start < t1):
-            raise ParameterError(f"`start` must be a time in [{t0:g}, {t1:g}) s, got {start!r}.")
-        if not (math.isfinite(end) and start < end <= t1):
-            raise ParameterError(f"`end` must be a time in ({start:g}, {t1:g}] s, got {end!r}.")
-        return start, end
+        return check_window(start, end, float(self.time[0]), float(self.time[-1]))
 
     def theta_at(self, times) -> np.ndarray:
         """(K, N) pendulum angles at ``times`` (K,), Hermite-interpolated."""
@@ -174,6 +164,32 @@ class RecordedRun:
     def r_at(self, times) -> np.ndarray:
         """(K,) recorded r at ``times`` (linear interpolation)."""
         return np.interp(np.asarray(times, dtype=float), self.time, self.r)
+
+
+def check_run(run, runs: int) -> int:
+    """``run`` as an index of one of ``runs`` runs; `ParameterError` otherwise.
+
+    The one check of a run index, also made before simulating, from the runs asked for.
+    """
+    if isinstance(run, bool) or not isinstance(run, int | np.integer) or not 0 <= run < runs:
+        raise ParameterError(f"`run` must be an integer in [0, {runs - 1}], got {run!r}.")
+    return int(run)
+
+
+def check_window(
+    start: float | None, end: float | None, t0: float, t1: float
+) -> tuple[float, float]:
+    """Check and complete a time window [start, end] inside a recording of [t0, t1], s.
+
+    The one check of a window, also made before simulating, on [0, duration].
+    """
+    start = t0 if start is None else float(start)
+    end = t1 if end is None else float(end)
+    if not (math.isfinite(start) and t0 <= start < t1):
+        raise ParameterError(f"`start` must be a time in [{t0:g}, {t1:g}) s, got {start!r}.")
+    if not (math.isfinite(end) and start < end <= t1):
+        raise ParameterError(f"`end` must be a time in ({start:g}, {t1:g}] s, got {end!r}.")
+    return start, end
 
 
 def hermite(time, y, y_dot, times) -> np.ndarray:

@@ -52,7 +52,7 @@ from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
 from ..observables.order import crossing_phase
 from ..simulate import simulate
-from .tuning import l2_for_bpm, relaxation_rate, steady_swing
+from .tuning import l2_for_bpm, relaxation_rate, steady_swing, with_tuning
 
 METHODS = ("growth", "pair")
 #: Most metronomes in a growth run (its trajectories are kept in memory).
@@ -132,9 +132,9 @@ def disk_scale(n: int | float, params: ModelParameters | str = "default") -> flo
     return n / (p.disk_inertia(int(n)) + n * mass * p.radius**2)
 
 
-def _tuned(bpm: float, params: ModelParameters, tuning: str):
+def _tuned(bpm: float, params: ModelParameters):
     design = params.metronome
-    metronome = design.with_l2(float(l2_for_bpm(design, bpm, tuning=tuning)))
+    metronome = design.with_l2(float(l2_for_bpm(design, bpm, tuning=design.tuning)))
     return metronome, steady_swing(metronome)
 
 
@@ -195,7 +195,7 @@ def measure_by_growth(
     *,
     n: int = 32,
     params: ModelParameters | str = "default",
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     eps: float = 0.02,
     r_max: float = 0.08,
     dt: float = MEASURE_DT,
@@ -205,12 +205,12 @@ def measure_by_growth(
     eps : size of the splay's first-mode perturbation (r starts at eps/2).
     r_max : end of the fitted window (r stays in the linear regime below it).
     """
-    params = get_preset(params, warn=False)
+    params = with_tuning(get_preset(params, warn=False), tuning)
     check_growth_n(n)
-    metronome, swing = _tuned(bpm, params, tuning)
+    metronome, swing = _tuned(bpm, params)
     from .estimate import estimate  # it builds on this module
 
-    guess = estimate(bpm, n, params, tuning=tuning)
+    guess = estimate(bpm, n, params)
     rate = max(guess.k_cos / 2, 1e-3)
     t_min = 5.0
     duration = min(t_min + 2.0 * math.log(2 * r_max / eps) / rate + 10.0, 2000.0)
@@ -264,10 +264,10 @@ def measure_by_growth(
     )
 
 
-def _locked_pair(bpm, detune, params, tuning, dt, start_lag, duration=300.0):
+def _locked_pair(bpm, detune, params, dt, start_lag, duration=300.0):
     design = params.metronome
     pair = [
-        design.with_l2(float(l2_for_bpm(design, b, tuning=tuning)))
+        design.with_l2(float(l2_for_bpm(design, b, tuning=design.tuning)))
         for b in (bpm - detune / 2, bpm + detune / 2)
     ]
     swings = [steady_swing(m) for m in pair]
@@ -308,17 +308,17 @@ def measure_by_pair(
     bpm: float,
     *,
     params: ModelParameters | str = "default",
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     points: int = 7,
     dt: float = MEASURE_DT,
 ) -> Coupling:
     """K₁ e^{−iα₁} at N = 2 from the locking curve of a detuned pair (see module docs)."""
-    params = get_preset(params, warn=False)
+    params = with_tuning(get_preset(params, warn=False), tuning)
     if isinstance(points, bool) or not isinstance(points, int) or points < 4:
         raise ParameterError(f"`points` must be an integer >= 4 detunings, got {points!r}.")
-    _, swing = _tuned(bpm, params, tuning)
+    _, swing = _tuned(bpm, params)
     # A first small detuning gives the slope δω/Δ*, hence the locking range to span.
-    dw, lag, _, _ = _locked_pair(bpm, 0.05, params, tuning, dt, 0.05)
+    dw, lag, _, _ = _locked_pair(bpm, 0.05, params, dt, 0.05)
     edge_bpm = 0.05 / math.sin(lag) if lag > 0 else 0.0
     if not (lag > 0 and edge_bpm > 0.1):
         raise ParameterError(
@@ -327,9 +327,7 @@ def measure_by_pair(
         )
     rows = []
     for fraction in np.linspace(0.1, 0.85, points):
-        row = _locked_pair(
-            bpm, fraction * edge_bpm, params, tuning, dt, math.asin(min(fraction, 0.95))
-        )
+        row = _locked_pair(bpm, fraction * edge_bpm, params, dt, math.asin(min(fraction, 0.95)))
         if row[3]:
             rows.append(row[:3])
     if len(rows) < 4:

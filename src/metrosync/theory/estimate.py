@@ -31,7 +31,7 @@ from scipy.special import ellipk
 
 from ..model import ModelParameters, get_preset
 from .coupling import Coupling, _tuned, disk_scale
-from .tuning import relaxation_rate
+from .tuning import relaxation_rate, with_tuning
 
 
 def _mean_cos_squared(amplitude: float) -> float:
@@ -50,11 +50,11 @@ def estimate(
     n: int | float,
     params: ModelParameters | str = "default",
     *,
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
 ) -> Coupling:
     """The first-order analytic K e^{−iα} (module docstring); its error is not known (0)."""
-    params = get_preset(params, warn=False)
-    metronome, swing = _tuned(bpm, params, tuning)
+    params = with_tuning(get_preset(params, warn=False), tuning)
+    metronome, swing = _tuned(bpm, params)
     p = params.platform
     scale = disk_scale(n, params)
     mu_per_n = (metronome.mass * p.radius * metronome.h) ** 2 / metronome.inertia * scale

@@ -28,7 +28,7 @@ from ..model import ModelParameters, get_preset
 from .coupling import Coupling
 from .predict import _measure_cached
 from .reduced import simulate_reduced
-from .tuning import tick_rate_bpm
+from .tuning import tick_rate_bpm, with_tuning
 
 
 def simulate_fitted(
@@ -41,7 +41,7 @@ def simulate_fitted(
     dt: float = 0.1,
     seed: int | None = 0,
     preset: ModelParameters | str = "default",
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     coupling: Coupling | None = None,
     equilibrium_window: float | None = None,
     cache: Path | None = None,
@@ -54,10 +54,10 @@ def simulate_fitted(
     coupling : K e^{−iα} to use; default measured at ``bpm`` (growth method) for ``n``.
     cache : folder of cached coupling measurements.
     """
-    params = get_preset(preset, warn=False)
+    params = with_tuning(get_preset(preset, warn=False), tuning)
     ensemble = build_ensemble(n, bpm, params=params, sigma_bpm=sigma_bpm, runs=runs, seed=seed)
     if coupling is None:
-        coupling = _measure_cached(bpm, "growth", params, tuning, 32, cache)
+        coupling = _measure_cached(bpm, "growth", params, 32, cache)
     coupling = coupling.for_n(ensemble.n, params)
     ticks = tick_rate_bpm(params.metronome, ensemble.l2, exact=False)
     omega = math.pi / 60.0 * ticks
@@ -77,7 +77,7 @@ def simulate_fitted(
         bpm=float(bpm),
         sigma_bpm=float(sigma_bpm),
         preset=params.name,
-        tuning=tuning,
+        tuning=params.metronome.tuning,
         k_err=coupling.k_err,
         alpha_err=coupling.alpha_err,
         coupling_method=coupling.method,

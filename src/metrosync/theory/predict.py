@@ -34,6 +34,7 @@ from scipy.optimize import brentq
 
 from .._files import write_text
 from .._version import __version__
+from ..budget import Budget
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
 from ..progress import progress_bar
@@ -41,7 +42,7 @@ from . import coupling as cp
 from .estimate import estimate
 from .reduced import simulate_reduced
 from .sakaguchi import critical_coupling
-from .tuning import l2_for_bpm, steady_swing
+from .tuning import l2_for_bpm, steady_swing, with_tuning
 
 #: Bumped when a measurement method changes, so that old cache files are not reused.
 CACHE_VERSION = 1
@@ -53,27 +54,79 @@ def default_cache_dir() -> Path:
     return Path(base) / "metrosync" / "theory"
 
 
-def _measure_cached(bpm, method, params, tuning, measure_n, cache: Path | None) -> cp.Coupling:
+#: CPU seconds of one measurement of K, per BPM: "growth" at N = 32 (it grows with N),
+#: "pair" (measured 0.68 s and 5.7 s on the 2-core x86-64 development machine).
+MEASURE_SECONDS = {"growth": 0.9, "pair": 7.0}
+#: CPU seconds of the reduced model per oscillator, BPM and σ (20 000 oscillators:
+#: measured 0.023 s), and of bisecting r = 1/2 per σ (measured 0.11 s).
+REDUCED_OSC_SECONDS, HALF_SECONDS = 1.5e-6, 0.15
+
+
+def theory_budget(
+    bpms: Sequence[float],
+    *,
+    sigmas: int = 0,
+    method: str = "growth",
+    measure_n: int = 32,
+    params: ModelParameters,
+    cache: Path | None = None,
+    reduced: int = 0,
+) -> Budget:
+    """The time `reduced_theory` (``sigmas`` > 0) or `coupling_curve` will take.
+
+    bpms : the nominal BPM measured; those already in ``cache`` cost nothing.
+    sigmas : spreads for which the reduced model runs.   reduced : its oscillators per
+        BPM and σ (runs × size; 0: not run).
+    """
+    todo = sum(
+        not _cache_path(b, method, params, measure_n, cache)[0].is_file() if cache else True
+        for b in bpms
+    )
+    scale = measure_n / 32 if method == "growth" else 1.0
+    seconds = todo * MEASURE_SECONDS.get(method, 0.0) * scale  # a bad method: refused next
+    work = f"{todo} measurements of K by {method!r}"
+    if reduced and sigmas:
+        seconds += sigmas * (len(bpms) * reduced * REDUCED_OSC_SECONDS + HALF_SECONDS)
+        work += f", the reduced model at {len(bpms)} BPM x {sigmas} sigma"
+    return Budget(
+        "theory",
+        seconds=seconds,
+        work=work,
+        fixes="measure fewer BPM (a coarser `bpms` grid)"
+        + (", or skip the reduced model (`simulate_n`)" if reduced and sigmas else ""),
+    )
+
+
+def _cache_path(bpm, method, params, measure_n, cache: Path | None):
+    """The cache entry of a measurement, and the settings it is keyed by.
+
+    The key holds every parameter of ``params``, the design's ``tuning`` among them.
+    """
     settings = {
         "version": CACHE_VERSION,
         "bpm": float(bpm),
         "method": method,
-        "tuning": tuning,
+        "tuning": params.metronome.tuning,
         "n": measure_n if method == "growth" else 2,
         "dt": cp.MEASURE_DT,
         "params": {k: str(v) for k, v in params.as_dict().items() if k != "preset"},
     }
     key = hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:20]
-    path = None if cache is None else Path(cache) / f"{method}-{bpm:g}-{key}.json"
+    return (None if cache is None else Path(cache) / f"{method}-{bpm:g}-{key}.json"), settings
+
+
+def _measure_cached(bpm, method, params, measure_n, cache: Path | None) -> cp.Coupling:
+    """The coupling at ``bpm``, from the cache when an entry has the same key."""
+    path, settings = _cache_path(bpm, method, params, measure_n, cache)
     if path is not None and path.is_file():
         try:
             return cp.Coupling(**json.loads(path.read_text())["coupling"])
         except (ValueError, KeyError, TypeError):
             pass  # a damaged entry is measured again and overwritten
     if method == "growth":
-        result = cp.measure_by_growth(bpm, n=measure_n, params=params, tuning=tuning)
+        result = cp.measure_by_growth(bpm, n=measure_n, params=params)
     else:
-        result = cp.measure_by_pair(bpm, params=params, tuning=tuning)
+        result = cp.measure_by_pair(bpm, params=params)
     if path is not None:
         write_text(json.dumps({"settings": settings, "coupling": vars(result)}, indent=1), path)
     return result
@@ -84,11 +137,12 @@ def coupling_curve(
     *,
     n: int | float = math.inf,
     params: ModelParameters | str = "default",
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     method: str = "growth",
     measure_n: int = 32,
     cache: Path | None = None,
     progress: bool = False,
+    budget: Budget | None = None,
 ) -> xr.Dataset:
     """K(ω₀, N), α(ω₀) measured at each nominal BPM, with the analytic estimate beside it.
 
@@ -96,8 +150,15 @@ def coupling_curve(
     n : metronomes the coupling is expressed for (``math.inf``: the N → ∞ limit).
     method : ``"growth"`` or ``"pair"`` (`coupling`).   measure_n : N of the growth runs.
     cache : folder of cached measurements (None: measure every time).
+    tuning : how a nominal BPM sets the slider (`metrosync.model.TUNINGS`); None: the
+        design's own ``tuning``. Either way the curve is computed, labelled and cached
+        with one tuning, the design's after this replacement.
+    budget : the time of the whole request the curve is part of (`theory_budget`),
+        checked once the inputs are (a warning above `metrosync.budget.WARN_SECONDS`);
+        default: the curve's own.
     """
-    params = get_preset(params, warn=False)
+    params = with_tuning(get_preset(params, warn=False), tuning)
+    tuning = params.metronome.tuning
     if method not in cp.METHODS:
         raise ParameterError(f"unknown `method` {method!r}; choose one of {list(cp.METHODS)}.")
     bpms = np.asarray(bpms, dtype=float)
@@ -109,13 +170,15 @@ def coupling_curve(
     if method == "growth":
         cp.check_growth_n(measure_n, "measure_n")
     l2_for_bpm(params.metronome, bpms, tuning=tuning)  # every BPM tunable, before any work
+    if budget is None:
+        budget = theory_budget(bpms, method=method, measure_n=measure_n, params=params,
+                               cache=cache)  # fmt: skip
+    budget.check()
     rows, estimates = [], []
     with progress_bar(total=bpms.size, unit="BPM", enabled=progress, desc="measuring K") as bar:
         for bpm in bpms:
-            rows.append(
-                _measure_cached(bpm, method, params, tuning, measure_n, cache).for_n(n, params)
-            )
-            estimates.append(estimate(bpm, n, params, tuning=tuning))
+            rows.append(_measure_cached(bpm, method, params, measure_n, cache).for_n(n, params))
+            estimates.append(estimate(bpm, n, params))
             bar.update(1)
 
     def column(items, name):
@@ -160,8 +223,10 @@ def coupling_curve(
     )
 
 
-def spread_factor(bpm: float, params: ModelParameters, tuning: str) -> float:
+def spread_factor(bpm: float, params: ModelParameters, tuning: str | None = None) -> float:
     """d(tick rate)/d(nominal BPM) at ``bpm``: how a nominal spread becomes a tick spread."""
+    params = with_tuning(params, tuning)
+    tuning = params.metronome.tuning
     if tuning == "steady-swing":
         return 1.0
     design = params.metronome
@@ -241,7 +306,7 @@ def reduced_theory(
     bpms: Sequence[float] = tuple(range(150, 231, 10)),
     sigmas: Sequence[float] = (0.5, 0.75, 1.0, 1.25, 1.5),
     n: int | float = math.inf,
-    tuning: str = "small-amplitude",
+    tuning: str | None = None,
     method: str = "growth",
     measure_n: int = 32,
     cache: Path | None = None,
@@ -254,7 +319,7 @@ def reduced_theory(
         ``n`` of them, 16 runs) at every BPM and σ, giving ``r_reduced(sigma, bpm)`` and the
         ω₀ where it reaches 1/2, ``omega_half``; None skips it.
     """
-    params = get_preset(preset, warn=False)
+    params = with_tuning(get_preset(preset, warn=False), tuning)
     if params.overturns:
         raise ParameterError(
             f"preset {params.name!r} overturns (energy-balance amplitude "
@@ -264,15 +329,23 @@ def reduced_theory(
     sigmas = np.asarray(sigmas, dtype=float)
     if sigmas.ndim != 1 or sigmas.size == 0 or not np.all(np.isfinite(sigmas) & (sigmas > 0)):
         raise ParameterError(f"`sigmas` must be spreads > 0 BPM, got {sigmas.tolist()!r}.")
+    if simulate_n is None:
+        size = 0
+    else:  # N → ∞: one large population; finite N: 16 populations of N, averaged.
+        size, runs = (simulate_n, 1) if n == math.inf else (int(n), 16)
+    budget = theory_budget(
+        np.atleast_1d(np.asarray(bpms, dtype=float)), sigmas=sigmas.size, method=method,
+        measure_n=measure_n, params=params, cache=cache, reduced=size * runs if size else 0,
+    )  # fmt: skip
     ds = coupling_curve(
         bpms,
         n=n,
         params=params,
-        tuning=tuning,
         method=method,
         measure_n=measure_n,
         cache=cache,
         progress=progress,
+        budget=budget,
     )
     centre = [predict_onset(ds, s) for s in sigmas]
     # More coupling moves the crossing down: the +1σ curve gives the lower bound.
@@ -294,9 +367,12 @@ def reduced_theory(
         {"units": "rad/s", "long_name": "Sakaguchi threshold K_c(alpha, sigma_omega)"},
     )
     if simulate_n is not None:
-        # N → ∞: one large population; finite N: 16 populations of N, averaged.
-        size, runs = (simulate_n, 1) if n == math.inf else (int(n), 16)
-        r = np.stack([order_curve(ds, s, n=size, runs=runs) for s in sigmas])
+        r = np.empty((sigmas.size, ds.bpm.size))
+        with progress_bar(total=r.size, unit="point", enabled=progress,
+                          desc="reduced model") as bar:  # fmt: skip
+            for (i, j), _ in np.ndenumerate(r):  # `order_curve`, one point at a time
+                r[i, j] = _reduced_r(ds, sigmas[i], float(ds.bpm[j]), size, runs)
+                bar.update(1)
         ds["r_reduced"] = (
             ("sigma", "bpm"),
             r,

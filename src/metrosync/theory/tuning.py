@@ -54,8 +54,8 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-from ..errors import ParameterError
-from ..model import Metronome, MetronomeDesign
+from ..errors import ParameterError, shown_range
+from ..model import Metronome, MetronomeDesign, ModelParameters
 
 #: Slider positions in the per-design table of the tick-rate ratio (interpolation
 #: error below 1e-4 BPM, checked in the tests).
@@ -291,10 +291,10 @@ def steady_swing_l2(design: MetronomeDesign, bpm):
     low, high = steady_swing_bpm_range(design)
     bad = (bpm_arr < low) | (bpm_arr > high)
     if np.any(bad):
-        worst = bpm_arr[bad].flat[0]
+        shown, low_text, high_text = shown_range(low, high, float(bpm_arr[bad].flat[0]))
         raise ParameterError(
-            f"`bpm` = {worst:.6g} is outside the steady-swing tunable range [{low:.2f}, "
-            f"{high:.2f}] BPM of this metronome design (slider L2 in {design.l2_bounds} m). "
+            f"`bpm` = {shown} is outside the steady-swing tunable range [{low_text}, "
+            f"{high_text}] BPM of this metronome design (slider L2 in {design.l2_bounds} m). "
             f"Choose a BPM in range, or widen `l2_bounds`."
         )
     table = _table(design)
@@ -332,3 +332,17 @@ def l2_for_bpm(design: MetronomeDesign, bpm, *, tuning: str = "small-amplitude")
     # The design's one range check and message (it names the range and a fix) first.
     replace(design, tuning=tuning).check_tunable(bpm)
     return solve(design, bpm)
+
+
+def with_tuning(params: ModelParameters, tuning: str | None) -> ModelParameters:
+    """``params`` whose design uses ``tuning``; None keeps the design's own.
+
+    The theory's functions take ``tuning=`` beside ``params``; this is the one place
+    where the two meet, so that what is computed, labelled, stored and cached is the
+    design's ``tuning`` and nothing else.
+    """
+    if tuning is None or tuning == params.metronome.tuning:
+        return params
+    if not isinstance(tuning, str) or tuning not in TUNINGS:
+        raise ParameterError(f"unknown `tuning` {tuning!r}; choose one of {sorted(TUNINGS)}.")
+    return params.with_changes(tuning=tuning)

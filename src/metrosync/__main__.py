@@ -1,0 +1,24 @@
+"""The ``metrosync`` command (``python -m metrosync``, and the installed script).
+
+This module is the entry point because it imports nothing heavy before `main` runs:
+a Ctrl-C while the command line's own modules load (argparse, the error types) ends
+with the same one line and status 130 as one during the work, never a traceback.
+From `metrosync.cli.main` on, `metrosync.interrupts` takes over.
+"""
+
+import sys
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line (`metrosync.cli.main`); returns the exit code."""
+    try:
+        from .cli import main as run
+    except KeyboardInterrupt:
+        command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
+        print(f"metrosync {command}: interrupted: nothing was written", file=sys.stderr)
+        return 130
+    return run(argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
