@@ -12,7 +12,11 @@ Those that need matplotlib, dask or an audio library are imported on first use, 
 that ``import metrosync`` stays quick.
 """
 
-from ._version import __version__
+from .integrators._cache import use_user_cache
+
+use_user_cache()  # before numba is imported: the compiled kernels outlive a reinstall
+
+from ._version import __version__  # noqa: E402
 from .ensemble import Ensemble, build_ensemble  # noqa: E402
 from .errors import MetrosyncError, OverturnWarning, ParameterError  # noqa: E402
 from .lightgate import analyze  # noqa: E402
