@@ -46,8 +46,8 @@ HERE = Path(__file__).resolve().parent
 #: (`SystemArrays`, in model/system.py, re-exported by equations.py).
 STAMPED_OUTSIDE = ("status.py", "equations.py", "model/system.py")
 #: Seconds to compile each kernel (with and without trajectories it has one
-#: signature), by `kernel_name`, measured with an empty cache on the 2-core x86-64 development
-#: machine (numba 0.68.1, 2026-11-25).
+#: signature), by `kernel_name`, measured with an empty cache on the 2-core x86-64
+#: development machine (numba 0.68.1, 2026-11-25).
 COMPILE_SECONDS = {
     "kernel_runs.advance": 20.0,
     "kernel_oscillators.advance": 12.0,
@@ -103,16 +103,20 @@ def source_stamp() -> str:
     return digest.hexdigest()
 
 
-def kernel_cache_dir() -> Path:
-    """The folder numba keeps this package's compiled kernels in."""
+def _cache_folder(source: Path) -> Path:
+    """The folder numba caches the compiled functions of source file ``source`` in."""
     import numba
     from numba.core.caching import _CacheLocator
 
-    root = numba.config.CACHE_DIR
-    if not root:
-        return HERE / "__pycache__"
+    if not numba.config.CACHE_DIR:
+        return source.parent / "__pycache__"
     # numba's own naming of a source folder's place under NUMBA_CACHE_DIR
-    return Path(root) / _CacheLocator.get_suitable_cache_subpath(str(HERE / "verlet.py"))
+    return Path(numba.config.CACHE_DIR) / _CacheLocator.get_suitable_cache_subpath(str(source))
+
+
+def kernel_cache_dir() -> Path:
+    """The folder numba keeps this package's compiled kernels in."""
+    return _cache_folder(HERE / "verlet.py")
 
 
 def cache_dirs() -> list[Path]:
@@ -128,13 +132,7 @@ def cache_dirs() -> list[Path]:
 
 def _folder_of(function) -> Path:
     """The folder numba caches ``function`` (a dispatcher) in."""
-    import numba
-    from numba.core.caching import _CacheLocator
-
-    source = Path(function.py_func.__code__.co_filename).resolve()
-    if not numba.config.CACHE_DIR:
-        return source.parent / "__pycache__"
-    return Path(numba.config.CACHE_DIR) / _CacheLocator.get_suitable_cache_subpath(str(source))
+    return _cache_folder(Path(function.py_func.__code__.co_filename).resolve())
 
 
 def kernel_name(function) -> str:
