@@ -31,7 +31,7 @@ from cdp import Browser  # noqa: E402
 
 from metrosync.show.playground import write_playground  # noqa: E402
 
-SIZE = {"width": 1340, "height": 700, "deviceScaleFactor": 1, "mobile": False}
+SIZE = {"width": 1280, "height": 720, "deviceScaleFactor": 1, "mobile": False}  # a projector
 
 
 def open_page(browser: Browser, path: Path) -> None:
@@ -87,7 +87,9 @@ def lesson(browser: Browser, folder: Path, out: Path) -> None:
     press(browser, "play")  # pause, so that the numbers hold still
     browser.pump(0.5)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_bytes(browser.screenshot({"x": 0, "y": 0, "width": SIZE["width"], "height": 668}))
+    out.write_bytes(
+        browser.screenshot({"x": 0, "y": 0, "width": SIZE["width"], "height": SIZE["height"]})
+    )
     print(f"wrote {out} (t = {browser.evaluate('window.metrosync.session.t'):.0f} s, "
           f"r = {browser.evaluate('window.metrosync.r'):.2f})")  # fmt: skip
 

@@ -16,7 +16,11 @@ import importlib
 import sys
 import types
 
-from ._version import __version__
+from .integrators._cache import use_user_cache
+
+use_user_cache()  # before numba is imported: the compiled kernels outlive a reinstall
+
+from ._version import __version__  # noqa: E402
 
 #: Every public name, and the module that defines it: imported on first use, so that
 #: ``import metrosync`` (and the ``metrosync`` command, until it has set up its Ctrl-C

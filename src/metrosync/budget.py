@@ -13,6 +13,8 @@ shrink it; it warns (`LongRunWarning`) when the work is estimated to take longer
 Estimates err on the safe side: sizes count every large array together with the
 temporaries that live beside it, and times use throughputs below those measured on
 the 2-core x86-64 development machine, so that a warning may come early, not late.
+They are of the work itself: compiling the kernels, once per machine on first use, is
+announced on its own (`metrosync.integrators._cache`) and counted in no throughput.
 """
 
 from __future__ import annotations

@@ -1,9 +1,16 @@
-"""The compile-cache guard covers every source the compiled kernels depend on."""
+"""The compile cache: where it lives, how a cold one is announced and kept out of
+throughputs, and the guard that covers every source the compiled kernels depend on."""
 
+import os
+import re
+import subprocess
 import sys
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numba as nb
+import pytest
 
 from metrosync.integrators import _cache, kernel_oscillators, kernel_runs
 
@@ -40,3 +47,93 @@ def test_every_module_of_the_package_counts_as_ours(tmp_path):
                  "trig.sincos-53.py311.nbi"):  # fmt: skip
         assert _cache._ours(folder / name)
     assert not _cache._ours(folder / "somebody_else.f-1.py311.nbi")
+
+
+def python(code: str, **env: str) -> list[str]:
+    """Run ``code`` in a fresh interpreter with ``env`` (None removes a variable)."""
+    environ = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    environ.update(env)
+    done = subprocess.run([sys.executable, "-c", code], env=environ, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return done.stdout.splitlines()
+
+
+WHERE = (
+    "import os, metrosync, numba; print(os.environ.get('NUMBA_CACHE_DIR'), numba.config.CACHE_DIR)"
+)
+
+
+def test_the_compiled_kernels_live_in_the_user_s_cache_folder(tmp_path):
+    """A reinstall replaces the package's folder; the compiled kernels are kept outside."""
+    user = tmp_path / "xdg" / "metrosync" / "numba"
+    assert python(WHERE, XDG_CACHE_HOME=str(tmp_path / "xdg")) == [f"{user} {user}"]
+    assert user.is_dir()
+    # numba imported first (by the user's own code) still takes it
+    first = WHERE.replace("import os, metrosync, numba", "import numba, os, metrosync")
+    assert python(first, XDG_CACHE_HOME=str(tmp_path / "xdg")) == [f"{user} {user}"]
+    # the user's own NUMBA_CACHE_DIR is honoured
+    mine = tmp_path / "mine"
+    assert python(WHERE, NUMBA_CACHE_DIR=str(mine), XDG_CACHE_HOME=str(tmp_path / "xdg")) == [
+        f"{mine} {mine}"
+    ]
+    # a cache folder that cannot be made leaves numba's default, beside the sources
+    (tmp_path / "a-file").write_text("")
+    assert python(WHERE, XDG_CACHE_HOME=str(tmp_path / "a-file")) == ["None "]
+
+
+def test_the_kernel_folder_is_numba_s_own_for_this_package(tmp_path, monkeypatch):
+    monkeypatch.setattr(nb.config, "CACHE_DIR", str(tmp_path))
+    folder = _cache.kernel_cache_dir()
+    assert folder.parent == tmp_path and folder.name.startswith("integrators_")
+    assert _cache._folder_of(kernel_runs.advance) == folder
+    assert _cache.kernel_name(kernel_runs.advance) == "kernel_runs.advance"
+    assert not _cache.is_cached(kernel_runs.advance)
+    folder.mkdir()
+    (folder / "kernel_runs.advance-72.py311.nbi").write_bytes(b"")
+    assert _cache.is_cached(kernel_runs.advance)
+    assert not _cache.is_cached(kernel_oscillators.advance)
+
+
+def test_a_sweep_point_s_seconds_leave_out_compiling(monkeypatch):
+    """A point whose simulation spent most of its time compiling reports the rest."""
+    from metrosync.sweeps import executors
+
+    def compiles_then_fails(**kwargs):
+        time.sleep(0.3)
+        monkeypatch.setattr(_cache, "_compile_seconds", _cache.compile_seconds() + 0.25)
+        raise RuntimeError("a point that fails is timed too")
+
+    monkeypatch.setattr(sys.modules["metrosync.simulate"], "simulate", compiles_then_fails)
+    spec = SimpleNamespace(key="k", kwargs={"runs": 2}, keep="run_mean_r")
+    executors.run_point(spec)  # the first call also imports what a failed point needs
+    ds, seconds, _ = executors.run_point(spec)
+    assert "a point that fails" in ds.attrs["error"]
+    assert 0.03 < seconds < 0.2, seconds
+
+
+@pytest.mark.slow
+def test_a_cold_cache_is_announced_once_and_left_out_of_the_throughput(tmp_path):
+    code = (
+        "import sys; from metrosync.cli import main; "
+        "sys.exit(main(['simulate', '--n', '3', '--runs', '2', '--duration', '5']))"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"), "NUMBA_NUM_THREADS": "1"}
+    runs = [subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                           timeout=600) for _ in range(2)]  # fmt: skip
+    for done in runs:
+        assert done.returncode == 0, done.stderr
+    cold, warm = runs
+    announced = [line for line in cold.stderr.splitlines() if "compiling kernels" in line]
+    assert len(announced) == 1, cold.stderr
+    assert re.fullmatch(r"metrosync: compiling kernels, once: about \d+ s \(kept in .+\)",
+                        announced[0]), announced  # fmt: skip
+    assert "compiling" not in warm.stderr + warm.stdout
+    pattern = r"([\d.]+) s wall(?: \(([\d.]+) s of it compiling kernels, once\))?, ([\d.e+]+) osc"
+    (wall, compiling, cold_rate), (_, none, warm_rate) = (
+        re.search(pattern, done.stdout).groups() for done in runs
+    )
+    assert none is None and float(compiling) > 0.5 * float(wall)
+    # Compiling took seconds, the simulation milliseconds: counted in, the cold rate would
+    # be hundreds of times the warm one's inverse.
+    assert float(cold_rate) > float(warm_rate) / 20, (cold_rate, warm_rate)

@@ -193,7 +193,9 @@ def test_a_corrupt_compile_cache_is_rebuilt_not_used(tmp_path):
     index = sorted(Path(tmp_path / "cache").rglob("kernel_*.advance-*.nbi"))
     assert index, "the kernel was not cached again"
     before = index[0].stat().st_mtime_ns
-    (tmp_path / "cache" / "metrosync-kernels.stamp").write_text("an older source")
+    (stamp,) = Path(tmp_path / "cache").rglob("metrosync-kernels.stamp")
+    assert stamp.parent == index[0].parent  # beside this install's kernels, not others'
+    stamp.write_text("an older source")
     third = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert third.returncode == 0 and third.stdout == first.stdout, third.stderr
     assert index[0].stat().st_mtime_ns > before

@@ -68,3 +68,14 @@ def test_plan_and_kept_points_count_what_an_interrupted_run_left(tiny, studies):
     kept, total = kept_points(tiny.out, "quick", studies)
     assert kept == total == len(plan("quick", studies)) > 0
     assert kept_points(tiny.out, "full", studies)[0] == 0  # other statistics, other keys
+
+
+def test_the_report_says_how_long_compiling_took_and_that_it_is_left_out():
+    from types import SimpleNamespace
+
+    from metrosync.paper.report import _compile_lines
+
+    (line, _) = _compile_lines(SimpleNamespace(compile_s=41.6))
+    assert line.startswith("Compiling the kernels took 42 s of this invocation's wall time")
+    assert "metrosync/numba" in line
+    assert _compile_lines(SimpleNamespace(compile_s=0.3)) == []  # loaded from the cache

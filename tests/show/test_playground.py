@@ -323,6 +323,69 @@ def test_controls_take_effect_and_continue_from_the_state(browser, tmp_path):
     assert browser.console_errors() == []
 
 
+def viewport_shot(browser, width: int, height: int, path: Path):
+    """Set the window to ``width`` × ``height``, let the page draw, save a screenshot of
+    what shows; returns it as an RGB array (height, width, 3)."""
+    import io
+
+    from PIL import Image
+
+    browser.call("Emulation.setDeviceMetricsOverride", {
+        "width": width, "height": height, "deviceScaleFactor": 1, "mobile": False,
+    })  # fmt: skip
+    frames = browser.evaluate("window.metrosync.frames")
+    wait_for(browser, f"window.metrosync.frames > {frames + 3}")
+    png = browser.screenshot()
+    path.write_bytes(png)
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
+
+
+def inside(rect: dict, width: int, height: int) -> bool:
+    return (rect["x"] >= 0 and rect["y"] >= 0 and rect["x"] + rect["width"] <= width
+            and rect["y"] + rect["height"] <= height)  # fmt: skip
+
+
+@pytest.mark.parametrize(("width", "height"), [(1280, 720), (1920, 1080)])
+def test_disk_r_and_its_chart_show_together_on_one_screen(browser, tmp_path, width, height):
+    """A projector's 1280 × 720 and a 1920 × 1080 screen: the disk, the r readout and
+    the r(t) chart are all inside the window, unscrolled, and drawn at the size they
+    show at; the explanation is one click away."""
+    open_offline(browser, write_playground(tmp_path / "play.html", n=7, sigma_bpm=0.0))
+    click(browser, "play")
+    set_control(browser, "speed", 50)
+    wait_for(browser, "window.metrosync.session.t > 45")
+    click(browser, "play")  # pause, so that the screenshot and the numbers agree
+    set_control(browser, "speed", 1)  # the chart then spans the last 60 s
+    shot = viewport_shot(browser, width, height, tmp_path / f"playground-{width}x{height}.png")
+    assert shot.shape == (height, width, 3)
+    assert browser.evaluate("[window.scrollX, window.scrollY]") == [0, 0]
+    rects = {name: canvas_rect(browser, name) for name in ("disk", "r-value", "order", "wheel")}
+    for name, rect in rects.items():
+        assert inside(rect, width, height), (name, rect, (width, height))
+    assert min(rects["disk"]["width"], rects["disk"]["height"]) >= 0.55 * height
+    assert rects["order"]["width"] >= 0.3 * width and rects["order"]["height"] >= 0.3 * height
+    # The canvas draws at the size it shows at: the r(t) curve (its colour, #1f77b4)
+    # spans most of the chart's width in the screenshot.
+    o = {k: round(v) for k, v in rects["order"].items()}
+    chart = shot[o["y"] : o["y"] + o["height"], o["x"] : o["x"] + o["width"]].astype(int)
+    curve = np.abs(chart - [0x1F, 0x77, 0xB4]).sum(axis=2) < 60
+    columns = np.flatnonzero(curve.any(axis=0))
+    assert columns.size and columns[-1] - columns[0] > 0.5 * o["width"], columns
+    r_shown = float(browser.evaluate("document.getElementById('r-value').textContent"))
+    assert r_shown == pytest.approx(browser.evaluate("window.metrosync.r"), abs=5e-4)
+    # The explanation: hidden, then shown (and on screen) after one click.
+    note = "document.querySelector('#about .note')"
+    assert not browser.evaluate(f"{note}.checkVisibility()")
+    click(browser, "about-toggle")
+    assert browser.evaluate(f"{note}.checkVisibility()")
+    about = browser.evaluate(
+        f"(() => {{ const r = {note}.getBoundingClientRect();"
+        " return {x: r.x, y: r.y, width: r.width, height: r.height}; })()"
+    )
+    assert inside(about, width, height) and "phase wheel" in browser.evaluate(f"{note}.textContent")
+    assert browser.console_errors() == []
+
+
 def test_locked_metronomes_tick_at_one_rate(browser, tmp_path):
     """σ = 0.5 BPM, N = 7: once locked, the measured tick rates agree far better than
     the natural frequencies do; on a held disk they keep their spread."""

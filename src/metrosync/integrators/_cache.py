@@ -1,17 +1,31 @@
-"""Guard numba's on-disk compile cache: a damaged or stale file is deleted (and the
-kernel recompiled), never loaded.
+"""Where numba keeps the compiled kernels, what compiling them costs, and a guard
+that never lets a damaged or stale cache file be loaded.
 
-numba invalidates a cached function only when its own source file changes, not when
-a function it inlines from another file does (`_physics`, `_kernel_parts`,
+Place. The kernels are compiled on first use (tens of seconds each) and kept on disk.
+numba's default place is the package's own ``__pycache__``, which a reinstall
+deletes; `use_user_cache` (called when metrosync is imported) points numba at
+``$XDG_CACHE_HOME/metrosync/numba`` (``~/.cache/metrosync/numba``) instead, unless
+``NUMBA_CACHE_DIR`` is set already, which is then honoured. numba files each source
+folder's functions under a subfolder named after that folder's path
+(`kernel_cache_dir`), so installs in several environments do not meet.
+
+Cost. `compile_kernel` compiles a kernel for the arguments it is about to get,
+before it runs, and says so on stderr, once, when the cache holds nothing for it
+("compiling kernels, once: about N s"); the seconds spent are added to
+`compile_seconds`, which timings subtract so that throughputs (a sweep point's
+``compute_seconds``, the printed oscillator-steps/s, REPORT.md's ``--full``
+estimate) measure the simulation, not its first compilation.
+
+Guard. numba invalidates a cached function only when its own source file changes,
+not when a function it inlines from another file does (`_physics`, `_kernel_parts`,
 `trig.sincos`), nor when a global it froze at compile time changes (the bits of
-`metrosync.status`). A stamp holding the hash of every module of this package, and of
-the modules outside it that the kernels depend on (`STAMPED_OUTSIDE`), sits beside
-the cache; when it does not match, every cached function of this package is removed.
-
-numba raises on a truncated or corrupt cache file instead of recompiling. Before the
-first kernel call, `heal_compile_cache` reads each of this package's cache files the
-way numba does (an index: a pickled version, then a pickled payload; a data file: one
-pickle) and removes the ones that fail, together with their index.
+`metrosync.status`). A stamp holding the hash of every module of this package, and
+of the modules outside it that the kernels depend on (`STAMPED_OUTSIDE`), sits in the
+cache folder; when it does not match, every cached function of this package is
+removed. numba raises on a truncated or corrupt cache file instead of recompiling.
+Before the first kernel call, `heal_compile_cache` reads each of this package's
+cache files the way numba does (an index: a pickled version, then a pickled payload;
+a data file: one pickle) and removes the ones that fail, together with their index.
 """
 
 from __future__ import annotations
@@ -19,9 +33,10 @@ from __future__ import annotations
 import hashlib
 import os
 import pickle
+import sys
+import tempfile
+import time
 from pathlib import Path
-
-import numba
 
 _checked = False
 STAMP_NAME = "metrosync-kernels.stamp"
@@ -30,6 +45,50 @@ HERE = Path(__file__).resolve().parent
 #: status bits they freeze, and the system constants their argument list is made of
 #: (`SystemArrays`, in model/system.py, re-exported by equations.py).
 STAMPED_OUTSIDE = ("status.py", "equations.py", "model/system.py")
+#: Seconds to compile each kernel (with and without trajectories it has one
+#: signature), by `kernel_name`, measured with an empty cache on the 2-core x86-64
+#: development machine (numba 0.68.1, 2026-11-25).
+COMPILE_SECONDS = {
+    "kernel_runs.advance": 20.0,
+    "kernel_oscillators.advance": 12.0,
+    "kernel_located_runs.advance": 26.0,
+    "kernel_located_oscillators.advance": 17.0,
+    "reduced._advance_runs": 6.0,
+    "reduced._advance_serial": 3.0,
+    "reduced._advance_threads": 3.0,
+}
+#: Seconds spent compiling kernels in this process (loading them from the cache
+#: included); timings of simulation work subtract what accrued meanwhile.
+_compile_seconds = 0.0
+
+
+def user_cache_dir() -> Path:
+    """``$XDG_CACHE_HOME/metrosync/numba`` (``~/.cache/metrosync/numba``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "metrosync" / "numba"
+
+
+def use_user_cache() -> Path | None:
+    """Point numba's compile cache at `user_cache_dir` unless ``NUMBA_CACHE_DIR`` is
+    set; return the cache root in use (None: numba's default, beside the sources,
+    because the user folder cannot be written)."""
+    chosen = os.environ.get("NUMBA_CACHE_DIR")
+    if not chosen:
+        folder = user_cache_dir()
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            tempfile.TemporaryFile(dir=folder).close()
+        except OSError:  # a read-only home: keep numba's default
+            return None
+        chosen = os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    if "numba" in sys.modules:  # imported before metrosync: have it read the variable
+        sys.modules["numba"].config.reload_config()
+    return Path(chosen)
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent compiling (or loading) kernels so far."""
+    return _compile_seconds
 
 
 def stamped_sources() -> list[Path]:
@@ -44,17 +103,70 @@ def source_stamp() -> str:
     return digest.hexdigest()
 
 
+def _cache_folder(source: Path) -> Path:
+    """The folder numba caches the compiled functions of source file ``source`` in."""
+    import numba
+    from numba.core.caching import _CacheLocator
+
+    if not numba.config.CACHE_DIR:
+        return source.parent / "__pycache__"
+    # numba's own naming of a source folder's place under NUMBA_CACHE_DIR
+    return Path(numba.config.CACHE_DIR) / _CacheLocator.get_suitable_cache_subpath(str(source))
+
+
+def kernel_cache_dir() -> Path:
+    """The folder numba keeps this package's compiled kernels in."""
+    return _cache_folder(HERE / "verlet.py")
+
+
 def cache_dirs() -> list[Path]:
-    dirs = [HERE / "__pycache__"]
-    override = numba.config.CACHE_DIR or os.environ.get("NUMBA_CACHE_DIR")
-    if override:
-        dirs.append(Path(override))
-    for folder in dirs:  # so that the stamp is written before numba's first file
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError:
-            pass
-    return [d for d in dirs if d.is_dir()]
+    """The folders to guard: this package's kernel folder, created if missing so that
+    the stamp is written before numba's first file."""
+    folder = kernel_cache_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        pass
+    return [folder] if folder.is_dir() else []
+
+
+def _folder_of(function) -> Path:
+    """The folder numba caches ``function`` (a dispatcher) in."""
+    return _cache_folder(Path(function.py_func.__code__.co_filename).resolve())
+
+
+def kernel_name(function) -> str:
+    """``module.function``, as numba begins the names of its cache files."""
+    return f"{function.py_func.__module__.rsplit('.', 1)[-1]}.{function.py_func.__qualname__}"
+
+
+def is_cached(function) -> bool:
+    """Whether the cache holds a compiled ``function`` (a dispatcher) for some arguments."""
+    prefix = kernel_name(function) + "-"
+    return any(path.name.startswith(prefix) for path in _folder_of(function).glob("*.nbi"))
+
+
+def compile_kernel(function, *args) -> None:
+    """Compile ``function`` (a numba dispatcher) for ``args`` unless done in this process
+    already: announced on stderr when the cache holds nothing for it, and timed into
+    `compile_seconds`."""
+    global _compile_seconds
+    signature = tuple(function.typeof_pyval(arg) for arg in args)
+    if signature in function.overloads:
+        return
+    if not is_cached(function):
+        seconds = COMPILE_SECONDS.get(kernel_name(function), 10.0)
+        print(
+            f"metrosync: compiling kernels, once: about {seconds:.0f} s "
+            f"(kept in {_folder_of(function).parent} for later runs)",
+            file=sys.stderr,
+            flush=True,
+        )
+    started = time.perf_counter()
+    try:
+        function.compile(signature)
+    finally:
+        _compile_seconds += time.perf_counter() - started
 
 
 def _readable(path: Path) -> bool:

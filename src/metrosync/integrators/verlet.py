@@ -51,7 +51,7 @@ from __future__ import annotations
 
 from . import kernel_oscillators, kernel_runs
 from ._abi import constants_of, settings_of
-from ._cache import heal_compile_cache
+from ._cache import compile_kernel, heal_compile_cache
 from ._state import StepState
 
 #: Kernel modules by memory layout (see each module's docstring): each has
@@ -89,7 +89,7 @@ def advance_in_layout(
     """`advance_state` for a scheme whose kernel modules by layout are ``layouts``."""
     heal_compile_cache()
     kernel = layouts[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
-    kernel.advance(
+    args = (
         state.kernel_state(),
         kernel.arrange(constants_of(sys, dt)),
         settings_of(
@@ -101,3 +101,5 @@ def advance_in_layout(
         ),
         state.kernel_recording(),
     )
+    compile_kernel(kernel.advance, *args)
+    kernel.advance(*args)

@@ -27,6 +27,7 @@ import xarray as xr
 from .._files import write_netcdf
 from .._version import __version__
 from ..errors import Interrupted, ParameterError
+from ..integrators._cache import compile_seconds
 from ..sweeps import PointStore
 from ..sweeps.executors import check_scheduler
 from ..sweeps.points import PointSpec
@@ -69,6 +70,7 @@ class Reproduction:
     comparison_note: str = NO_EXPERIMENT
     full_work: dict[str, float] = field(default_factory=dict)
     wall_s: float = 0.0
+    compile_s: float = 0.0
     version: str = __version__
 
     @property
@@ -128,6 +130,7 @@ def reproduce(
 
 
 def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler, n_workers):
+    compiled = compile_seconds()
     say("parameter consistency table")
     consistency = consistency_table(_bpms(chosen, mode))
     write_netcdf(consistency, out / "consistency.nc")
@@ -171,6 +174,7 @@ def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
         rep.comparison_note = f"Simulated r from the `{FIG8_TOP.name}` study ({mode} mode)."
     rep.verdicts = all_verdicts(rep.datasets)
     rep.wall_s = time.perf_counter() - started
+    rep.compile_s = compile_seconds() - compiled
     rep.report = write_report(out / "REPORT.md", rep)
     say(f"wrote {rep.report}")
     return rep

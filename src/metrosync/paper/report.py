@@ -211,10 +211,12 @@ def _timing_section(rep) -> list[str]:
         "",
         "*compute* is the time each point took when it was computed, stored with the point, "
         "so it counts reused points too; *throughput* is oscillator-steps per compute "
-        "second (the first point a process computes also carries loading, or compiling, "
-        "the kernels); *wall now* is what this invocation took. The `--full` estimate "
-        "scales each study's throughput to its `--full` oscillator-steps.",
+        "second (compiling the kernels is left out; the first point a process computes "
+        "carries loading them, a fraction of a second); *wall now* is what this invocation "
+        "took. The `--full` estimate scales each study's throughput to its `--full` "
+        "oscillator-steps.",
         "",
+        *_compile_lines(rep),
         f"Estimated `--full` total: about {_duration(total_est)} on this machine"
         + (f" (no estimate for {', '.join(missing)})" if missing else "")
         + ". It scales with cores; results are identical for any thread count. For "
@@ -249,6 +251,19 @@ def _cached_lines(rep) -> list[str]:
         )
         lines.append(f"- `{r.study.name}`: {r.cached_points} of {r.points} points ({shown})")
     return lines + [""]
+
+
+def _compile_lines(rep) -> list[str]:
+    seconds = getattr(rep, "compile_s", 0.0)
+    if seconds < 1.0:
+        return []
+    return [
+        f"Compiling the kernels took {seconds:.0f} s of this invocation's wall time. That "
+        "happens once per machine and metrosync version: the compiled code is kept in the "
+        "user's cache folder (`$XDG_CACHE_HOME/metrosync/numba`, or `NUMBA_CACHE_DIR`), "
+        "and later runs load it in well under a second.",
+        "",
+    ]
 
 
 def _seconds(value: float) -> str:

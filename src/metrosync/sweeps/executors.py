@@ -70,14 +70,16 @@ class Execution:
 
 def run_point(spec: PointSpec, threads: int | None = None):
     """Simulate one point; returns (point dataset, seconds, host). Never raises for a
-    simulation error: that becomes a failed point."""
+    simulation error: that becomes a failed point. The seconds leave out compiling the
+    kernels (once per machine), so that they measure the point's own work."""
+    from ..integrators._cache import compile_seconds
     from ..simulate import simulate
 
     if threads is not None:
         import numba
 
         numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    started = time.perf_counter()
+    compiling, started = compile_seconds(), time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         # The sweep estimated its whole work up front; a point's own estimate is noise.
@@ -87,7 +89,8 @@ def run_point(spec: PointSpec, threads: int | None = None):
         except Exception as error:  # noqa: BLE001 - one bad point must not stop a sweep
             ds = kept_dataset(spec, None, f"{type(error).__name__}: {error}")
     ds.attrs["warnings"] = " | ".join(sorted({str(w.message) for w in caught})) or "none"
-    return ds, time.perf_counter() - started, socket.gethostname()
+    seconds = time.perf_counter() - started - (compile_seconds() - compiling)
+    return ds, seconds, socket.gethostname()
 
 
 def check_scheduler(scheduler: str | None, n_workers: int | None) -> None:

@@ -29,6 +29,7 @@ from numba import njit, prange
 
 from .._version import __version__
 from ..errors import ParameterError, describe
+from ..integrators._cache import compile_kernel
 from ..observables.order import ensemble_statistics
 from ..progress import progress_bar
 
@@ -262,22 +263,14 @@ def simulate_reduced(
             if n >= LARGE_N:
                 advance = _advance_threads if threads else _advance_serial
                 for b in range(runs):
-                    advance(
-                        cr[b],
-                        ci[b],
-                        om[b],
-                        *args,
-                        z[b],
-                        dt,
-                        count,
-                        record_every,
-                        rec[b],
-                        step // record_every,
-                    )
+                    call = (cr[b], ci[b], om[b], *args, z[b], dt, count, record_every, rec[b],
+                            step // record_every)  # fmt: skip
+                    compile_kernel(advance, *call)
+                    advance(*call)
             else:
-                _advance_runs(
-                    cr, ci, om, *args, z, dt, count, record_every, rec, step // record_every
-                )
+                call = (cr, ci, om, *args, z, dt, count, record_every, rec, step // record_every)
+                compile_kernel(_advance_runs, *call)
+                _advance_runs(*call)
             step += count
             bar.update(round(count * dt, 6))
 

@@ -146,6 +146,17 @@
     $("status").textContent = notes.join(" ");
   }
 
+  // A canvas draws at the size the layout gives it (one canvas pixel per CSS pixel),
+  // so it stays sharp and in proportion when the window is resized.
+  function fit(canvas) {
+    const w = Math.max(1, Math.round(canvas.clientWidth));
+    const h = Math.max(1, Math.round(canvas.clientHeight));
+    if (canvas.width !== w || canvas.height !== h) {
+      canvas.width = w;
+      canvas.height = h;
+    }
+  }
+
   function frame(now) {
     frames++;
     fpsFrames++;
@@ -182,6 +193,7 @@
         achievedSim = 0; achievedWall = 0;
       }
     }
+    for (const g of Object.values(graphics)) fit(g.canvas);
     const o = Physics.order(session.state, session.system, phases);
     View.disk(graphics.disk, session, phases, session.settings.hold);
     View.wheel(graphics.wheel, phases, session.state.n, o.r, o.psi);
