@@ -16,7 +16,7 @@ import importlib
 import sys
 import types
 
-from .integrators._cache import use_user_cache
+from ._kernel_cache_dir import use_user_cache
 
 use_user_cache()  # before numba is imported: the compiled kernels outlive a reinstall
 

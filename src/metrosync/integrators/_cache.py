@@ -31,12 +31,12 @@ a data file: one pickle) and removes the ones that fail, together with their ind
 from __future__ import annotations
 
 import hashlib
-import os
 import pickle
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from .._kernel_cache_dir import use_user_cache, user_cache_dir  # noqa: F401  (re-exported)
 
 _checked = False
 STAMP_NAME = "metrosync-kernels.stamp"
@@ -60,30 +60,6 @@ COMPILE_SECONDS = {
 #: Seconds spent compiling kernels in this process (loading them from the cache
 #: included); timings of simulation work subtract what accrued meanwhile.
 _compile_seconds = 0.0
-
-
-def user_cache_dir() -> Path:
-    """``$XDG_CACHE_HOME/metrosync/numba`` (``~/.cache/metrosync/numba``)."""
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "metrosync" / "numba"
-
-
-def use_user_cache() -> Path | None:
-    """Point numba's compile cache at `user_cache_dir` unless ``NUMBA_CACHE_DIR`` is
-    set; return the cache root in use (None: numba's default, beside the sources,
-    because the user folder cannot be written)."""
-    chosen = os.environ.get("NUMBA_CACHE_DIR")
-    if not chosen:
-        folder = user_cache_dir()
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-            tempfile.TemporaryFile(dir=folder).close()
-        except OSError:  # a read-only home: keep numba's default
-            return None
-        chosen = os.environ["NUMBA_CACHE_DIR"] = str(folder)
-    if "numba" in sys.modules:  # imported before metrosync: have it read the variable
-        sys.modules["numba"].config.reload_config()
-    return Path(chosen)
 
 
 def compile_seconds() -> float:
