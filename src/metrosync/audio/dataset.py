@@ -35,18 +35,24 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
+from ..observables.order import equilibrium_order
 from ..errors import ParameterError
+from ..observables import crossings as ph
 from . import detection as det
-from .attribution import attribute_pair
+from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
 from .summary import summary_text
-from .tempo import beat_period
+from .separation import separate, sureness, tick_length_words
+from .tempo import MIN_TICKS, beat_period
+from .trains import Train
 
-#: Default refractory time, as a fraction of the beat, and its bounds (s).
-REFRACTORY_BEATS = 1 / 32
-REFRACTORY_RANGE = (3e-3, 30e-3)
+#: Default refractory time, s: impacts closer than this are heard as one. The impacts of
+#: one tick are grouped afterwards, from the recording's own tick structure.
+REFRACTORY = 3e-3
+#: Spacing of the r(t) grid, s (as the light gate's default).
+GRID_DT = 0.1
 
 
 def analyze_audio(
@@ -90,33 +96,52 @@ def analyze_audio(
                       desc="reading") as bar:  # fmt: skip
         scan = det.scan(recording, band=band, sensitivity=sensitivity, progress=bar)
     hop_s = scan.hop / rate
-    candidates = det.pick_ticks(scan, round(REFRACTORY_RANGE[0] / hop_s))
-    rough = beat_period(candidates * hop_s, bpm)
     if refractory is None:
-        refractory = float(np.clip(REFRACTORY_BEATS * rough, *REFRACTORY_RANGE))
+        refractory = REFRACTORY
     hops = det.pick_ticks(scan, max(1, round(refractory / hop_s)))
-    ticks = det.refine(recording, scan, hops)
-    order = np.argsort(ticks.time, kind="stable")
-    ticks = det.Ticks(ticks.time[order], ticks.strength[order],
-                      ticks.channel_strength[order], ticks.rise[order])  # fmt: skip
-    period = beat_period(ticks.time, bpm)
+    impacts = det.refine(recording, scan, hops)
+    order = np.argsort(impacts.time, kind="stable")
+    impacts = det.Ticks(impacts.time[order], impacts.strength[order],
+                        impacts.channel_strength[order], impacts.rise[order])  # fmt: skip
+    if impacts.time.size < MIN_TICKS:
+        beat_period(impacts.time)  # raises the error that says what to try
+    sep = separate(recording, impacts)
+    heads = np.flatnonzero(sep.head)
+    ticks = det.Ticks(*(getattr(impacts, f)[heads] for f in det.Ticks.__dataclass_fields__))
+    where = np.full(impacts.time.size, -1, dtype=np.int64)
+    where[heads] = np.arange(heads.size)
+    trains = [_on_ticks(t, where) for t in sep.trains]
+    if trains:
+        periods = np.array([t.period for t in trains])
+        period = float(np.median(periods))
+    else:
+        period = beat_period(ticks.time, bpm)
     if bpm is not None:
-        heard = 60.0 / beat_period(ticks.time)
-        if abs(heard * period / 60.0 - 1) > 0.15:
-            warnings.warn(
-                f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
-                f"analysis keeps near your setting, at {60 / period:.1f} BPM. Check the "
-                f"setting, or leave `bpm` out.",
-                UserWarning,
-                stacklevel=2,
-            )
+        _check_bpm(bpm, period if trains else beat_period(ticks.time))
+        if not trains:
+            period = beat_period(ticks.time, bpm)
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
     # Synchronized metronomes tick as one; the windows where they were least together
     # count them best.
-    busiest = np.nanpercentile(acoustic.ticks_per_beat, 95)
-    n = int(metronomes) if metronomes is not None else max(1, round(busiest))
+    busiest = max(1, round(float(np.nanpercentile(acoustic.ticks_per_beat, 95))))
+    note = sep.note
+    if metronomes is not None:
+        n = int(metronomes)
+        source = "given"
+    elif trains:
+        n = len(trains)
+        source = f"told apart by {sep.method}"
+    else:
+        n = busiest
+        source = "most ticks per beat in a window (95th percentile), rounded"
+    if trains and n != len(trains):
+        note = (f"{len(trains)} metronome(s) told apart, {n} expected"
+                + (f"; {note}" if note else ""))  # fmt: skip
+    elif trains and busiest > len(trains):
+        note = (f"up to {busiest} ticks per beat are heard but only {len(trains)} metronome(s) "
+                f"told apart; the others sound alike and keep the same tempo")  # fmt: skip
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
@@ -124,27 +149,22 @@ def analyze_audio(
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)
-    stats, attribution, why = [], None, ""
-    if n == 1:
-        s = beat_statistics(ticks.time, period, ticks.strength)
+    stats, kept = [], []
+    for m, t in enumerate(trains):
+        s = beat_statistics(ticks.time[t.index], t.period, ticks.strength[t.index])
         stats.append(s)
-        label[:] = 0
-        is_tock[:] = s.is_tock
-        interval[:-1] = _beats(ticks.time, s.beat_number)
-    elif n == 2:
-        attribution, why = attribute_pair(ticks.time, ticks.strength,
-                                          ticks.channel_strength, period)  # fmt: skip
-        if attribution is not None:
-            label = attribution.labels
-            phase = attribution.phase_difference
-            for g in (0, 1):
-                mine = np.flatnonzero(label == g)
-                s = beat_statistics(ticks.time[mine], period, ticks.strength[mine])
-                stats.append(s)
-                is_tock[mine] = s.is_tock
-                interval[mine[:-1]] = _beats(ticks.time[mine], s.beat_number)
-    else:
-        why = "telling metronomes apart is done for two"
+        own = t.index[~t.masked]
+        label[own] = m
+        is_tock[own] = s.is_tock[~t.masked]
+        gaps = np.full(t.index.size, np.nan)
+        gaps[:-1] = _beats(ticks.time[t.index], s.beat_number)
+        interval[own] = gaps[~t.masked]
+        kept.append(ph.kept_from_half_periods(ticks.time[t.index], s.beat_number,
+                                              parity=1 if s.is_tock[0] else 0))  # fmt: skip
+        if m > 0:
+            mine = np.flatnonzero(label == m)
+            phase[mine] = phase_difference(ticks.time[trains[0].index], ticks.time[mine],
+                                           trains[0].period)  # fmt: skip
     wanted = WINDOW_BEATS * period if order_window is None else order_window
     if span < wanted:
         warnings.warn(
@@ -155,6 +175,9 @@ def analyze_audio(
             stacklevel=2,
         )
     ds = _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase)
+    pendulums = _pendulum_phases(kept, GRID_DT)
+    ds = ds.merge(pendulums)
+    ds.attrs.update(pendulums.attrs)
     ds.attrs.update(
         path=str(recording.path),
         sample_rate=rate,
@@ -165,11 +188,12 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="given (bpm)" if bpm is not None else "found from the ticks",
+        tempo_source="median of the metronomes' own tempi" if trains
+        else "given (bpm)" if bpm is not None else "found from the ticks",
         metronomes=n,
-        metronomes_source="given"
-        if metronomes is not None
-        else "most ticks per beat in a window (95th percentile), rounded",
+        metronomes_source=source,
+        impacts=int(impacts.time.size),
+        tick_structure=tick_length_words(sep),
         ticks_per_beat=per_beat,
         band=list(scan.band),
         sensitivity=sensitivity,
@@ -177,12 +201,55 @@ def analyze_audio(
         order_window=acoustic.window,
         order_step=acoustic.step,
         cluster_gap=cluster_gap,
-        attribution=attribution.method if attribution is not None else "none",
-        attribution_note=why,
+        attribution=sep.method if len(trains) > 1 else "none",
+        attribution_confidence=sep.confidence if trains else 0.0,
+        attribution_sureness=sureness(sep.confidence) if trains else "",
+        attribution_note=note,
         metrosync_version=__version__,
     )
     ds.attrs["summary"] = summary_text(ds)
     return ds
+
+
+def _pendulum_phases(kept: list, dt: float) -> xr.Dataset:
+    """frequency_bpm, period_jitter (metronome) and r (time), as the light gate has them,
+    through `observables.crossings`; the ticks of each metronome are its passes."""
+    if not kept:
+        return xr.Dataset(attrs={"r_eq": math.nan, "sigma_bpm": math.nan})
+    freq = np.array([ph.mean_frequency_bpm(k, c) for k, c in kept])
+    jitter = np.array([ph.period_jitter(k, c) for k, c in kept])
+    spans = [(float(k[0]), float(k[-1])) for k, _ in kept if len(k) >= 2]
+    grid = ph.common_grid(spans, dt) if len(spans) == len(kept) else np.empty(0)
+    r = ph.order_on_grid(kept, grid) if grid.size else np.empty(0)
+    r_eq = float(equilibrium_order(r, grid, 0.25 * (grid[-1] - grid[0]))) if grid.size else math.nan
+    data = {
+        "frequency_bpm": (("metronome",), freq, {"units": "BPM", "long_name": "mean frequency "
+                          "(two beats per period), as the light gate's"}),
+        "period_jitter": (("metronome",), jitter,
+                          {"units": "s", "long_name": "std of single periods (tick to tick)"}),
+        "r": (("time",), r, {"long_name": "order parameter of the pendulums from the ticks "
+                             "(each metronome's tick taken as the same direction)"}),
+    }  # fmt: skip
+    coords = {"time": ("time", grid, {"units": "s", "long_name": "time in the recording"})}
+    attrs = {"r_eq": r_eq, "sigma_bpm": ph.frequency_spread(freq)}
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _on_ticks(train: Train, where: np.ndarray) -> Train:
+    """The train with indices into the ticks instead of the impacts."""
+    return replace(train, index=where[train.index])
+
+
+def _check_bpm(bpm: float, period: float) -> None:
+    heard = 60.0 / period
+    if abs(heard / bpm - 1) > 0.15:
+        warnings.warn(
+            f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
+            f"analysis keeps the tempo it heard for each metronome. Check the "
+            f"setting, or leave `bpm` out.",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def _beats(times: np.ndarray, number: np.ndarray) -> np.ndarray:

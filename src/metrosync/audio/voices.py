@@ -1,0 +1,195 @@
+"""Telling metronomes apart by their sound: each impact's spectrum, clustered into voices.
+
+Contract: `impact_features(recording, times)` reads the few milliseconds after each
+impact onset (K,) and returns `Features`; `cluster_voices(features)` groups the
+impacts into voices and returns `Voices`, whose ``labels`` (K,) are 0..V−1, or −1 for
+an impact that sounds like none of them (two ticks at once, a bump, a stray sound).
+
+Features. The first `FEATURE_LENGTH` of sound after the onset (channels averaged,
+tapered) is cut into `BANDS` bands spaced evenly in log frequency from `LOW_EDGE` to
+16 kHz (or 0.45 × the rate); the feature is each band's level in dB minus the mean
+over the bands: the spectral shape, whatever the loudness. Two metronomes of
+different makes differ there more than in loudness, and a microphone, a room or a
+phone's filter colours every tick alike. The loudness itself (dB, weighted by
+`LEVEL_WEIGHT`) and, with several channels, each channel's level minus their mean
+(dB: where the metronome stands relative to the microphones) are added.
+
+Clustering. k-means (k-means++ seeds, the best of `RESTARTS`) for k = 1 ..
+`MAX_VOICES`; the largest k is kept whose voices are all far apart for their spreads
+(along the line between two centres, |μ_a − μ_b| / √((σ_a² + σ_b²)/2) ≥
+`MIN_SEPARATION`: halves of one voice split apart come out near 2.7) and each holds at
+least `MIN_SHARE` of the impacts. An impact farther from its centre than `OUTLIER`
+times its voice's median distance is left out (−1). A voice is a sound, not yet a
+metronome: a tick and a tock that sound different are two voices of one metronome, and
+two metronomes of one make are one voice (`trains` sorts that out).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft, signal
+from scipy.cluster.vq import kmeans2
+
+from .detection import _segments
+from .reader import Recording
+
+FEATURE_LENGTH = 6e-3
+#: Sound kept before the onset, s (the onset is timed to a fraction of a sample).
+FEATURE_LEAD = 0.3e-3
+BANDS = 16
+LOW_EDGE = 500.0
+HIGH_EDGE = 16000.0
+LEVEL_WEIGHT = 0.5
+MAX_VOICES = 8
+RESTARTS = 4
+MIN_SEPARATION = 4.0
+MIN_SHARE = 0.02
+OUTLIER = 4.0
+#: Impacts clustered at most (a random sample; the rest go to the nearest centre).
+SAMPLE = 6000
+
+
+@dataclass(frozen=True)
+class Features:
+    """What each impact sounds like.
+
+    shape : (K, B) band levels minus their mean, dB.
+    level : (K,) loudness over the bands, dB.
+    channel_level : (K, C) each channel's level minus the channels' mean, dB.
+    """
+
+    shape: np.ndarray
+    level: np.ndarray
+    channel_level: np.ndarray
+
+    def matrix(self) -> np.ndarray:
+        """(K, D) the vectors clustered: shape, weighted loudness, channel balance."""
+        parts = [self.shape, LEVEL_WEIGHT * (self.level - np.median(self.level))[:, None]]
+        if self.channel_level.shape[1] > 1:
+            parts.append(self.channel_level)
+        return np.column_stack(parts)
+
+
+@dataclass(frozen=True)
+class Voices:
+    """Impacts grouped by their sound.
+
+    labels : (K,) voice of each impact, −1 for none.
+    count : number of voices V.
+    separation : smallest distance between two voices in units of their spread
+        (inf for one voice).
+    tried : the separations of every k tried, for the record.
+    """
+
+    labels: np.ndarray
+    count: int
+    separation: float
+    tried: dict
+
+
+def _bands(rate: int, nfft: int) -> np.ndarray:
+    """(BANDS, nfft//2 + 1) 0/1 matrix summing the power spectrum into bands."""
+    top = min(HIGH_EDGE, 0.45 * rate)
+    edges = np.geomspace(min(LOW_EDGE, top / 4), top, BANDS + 1)
+    freqs = np.fft.rfftfreq(nfft, 1.0 / rate)
+    which = np.searchsorted(edges, freqs, side="right") - 1
+    m = np.zeros((BANDS, freqs.size))
+    inside = (which >= 0) & (which < BANDS)
+    m[which[inside], np.flatnonzero(inside)] = 1.0
+    return m
+
+
+def impact_features(recording: Recording, times: np.ndarray, *, chunk: int = 4096) -> Features:
+    """`Features` of the impacts at ``times`` (K,), s, sorted (see the module docstring)."""
+    rate = recording.sample_rate
+    lead = round(FEATURE_LEAD * rate)
+    length = lead + round(FEATURE_LENGTH * rate)
+    nfft = fft.next_fast_len(max(1024, 2 * length))
+    taper = signal.windows.tukey(length, 0.3).astype(np.float32)
+    bands = _bands(rate, nfft)
+    starts = np.round(np.asarray(times) * rate).astype(np.int64) - lead
+    k, c = starts.size, recording.channels
+    shape = np.empty((k, BANDS))
+    level = np.empty(k)
+    channel = np.zeros((k, c))
+    if k == 0:
+        return Features(shape, level, channel)
+    for first, seg in _segments(recording, starts, length, chunk):
+        sl = slice(first, first + seg.shape[0])
+        spectra = np.abs(fft.rfft(seg * taper[None, :, None], n=nfft, axis=1)) ** 2
+        per_channel = np.einsum("bf,nfc->nbc", bands, spectra) + 1e-14
+        mixed = 10 * np.log10(per_channel.mean(axis=2))
+        level[sl] = 10 * np.log10(per_channel.sum(axis=1).mean(axis=1))
+        shape[sl] = mixed - mixed.mean(axis=1, keepdims=True)
+        if c > 1:
+            total = 10 * np.log10(per_channel.sum(axis=1))
+            channel[sl] = total - total.mean(axis=1, keepdims=True)
+    return Features(shape, level, channel)
+
+
+def cluster_voices(features: Features, *, seed: int = 0) -> Voices:
+    """Group impacts by their sound (see the module docstring)."""
+    x = features.matrix()
+    k = x.shape[0]
+    if k < 8:
+        return Voices(np.zeros(k, dtype=np.int16), 1, math.inf, {})
+    rng = np.random.default_rng(seed)
+    sample = x if k <= SAMPLE else x[rng.choice(k, SAMPLE, replace=False)]
+    best = (np.zeros(sample.shape[0], dtype=int), sample.mean(axis=0, keepdims=True), math.inf)
+    tried = {}
+    for v in range(2, MAX_VOICES + 1):
+        if sample.shape[0] < v * 8:
+            break
+        centres, labels = _kmeans(sample, v, rng)
+        sizes = np.bincount(labels, minlength=v)
+        if sizes.min() < max(4, MIN_SHARE * sample.shape[0]):
+            tried[v] = math.nan
+            continue
+        sep = _min_separation(sample, labels, centres)
+        tried[v] = sep
+        if sep >= MIN_SEPARATION:
+            best = (labels, centres, sep)
+    labels, centres, sep = best
+    d = np.linalg.norm(x[:, None, :] - centres[None, :, :], axis=2)
+    nearest = np.argmin(d, axis=1)
+    mine = d[np.arange(k), nearest]
+    out = nearest.astype(np.int16)
+    for v in range(centres.shape[0]):
+        sel = nearest == v
+        if sel.any():
+            typical = float(np.median(mine[sel])) or 1e-9
+            out[sel & (mine > OUTLIER * typical)] = -1
+    return Voices(out, int(centres.shape[0]), float(sep), tried)
+
+
+def _kmeans(x: np.ndarray, v: int, rng) -> tuple[np.ndarray, np.ndarray]:
+    best, best_cost = None, math.inf
+    for _ in range(RESTARTS):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "one of the clusters is empty": judged below
+            centres, labels = kmeans2(x, v, minit="++", iter=30, seed=rng)
+        cost = float(np.sum((x - centres[labels]) ** 2))
+        if cost < best_cost:
+            best, best_cost = (centres, labels), cost
+    return best
+
+
+def _min_separation(x: np.ndarray, labels: np.ndarray, centres: np.ndarray) -> float:
+    """Smallest separation of two clusters along the line between their centres."""
+    out = math.inf
+    v = centres.shape[0]
+    for a in range(v):
+        for b in range(a + 1, v):
+            u = centres[a] - centres[b]
+            norm = np.linalg.norm(u)
+            if norm == 0:
+                return 0.0
+            u = u / norm
+            pa, pb = x[labels == a] @ u, x[labels == b] @ u
+            spread = math.sqrt(0.5 * (pa.var() + pb.var())) or 1e-9
+            out = min(out, abs(pa.mean() - pb.mean()) / spread)
+    return out
