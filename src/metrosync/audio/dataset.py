@@ -45,7 +45,7 @@ from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
 from .summary import summary_text
 from .separation import separate, sureness, tick_length_words
-from .tempo import MIN_TICKS, beat_period
+from .tempo import HINT_RANGE, MIN_TICKS, beat_period
 from .trains import Train
 
 #: Default refractory time, s: impacts closer than this are heard as one. The impacts of
@@ -106,20 +106,24 @@ def analyze_audio(
     if impacts.time.size < MIN_TICKS:
         beat_period(impacts.time)  # raises the error that says what to try
     sep = separate(recording, impacts)
+    heard = _median_bpm(sep)
+    if bpm is not None and not (heard and abs(heard / bpm - 1) <= HINT_RANGE):
+        hinted = separate(recording, impacts, bpm=bpm)
+        near = _median_bpm(hinted)
+        if near and abs(near / bpm - 1) <= HINT_RANGE:
+            sep, heard = hinted, near
     heads = np.flatnonzero(sep.head)
     ticks = det.Ticks(*(getattr(impacts, f)[heads] for f in det.Ticks.__dataclass_fields__))
     where = np.full(impacts.time.size, -1, dtype=np.int64)
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
     if trains:
-        periods = np.array([t.period for t in trains])
-        period = float(np.median(periods))
+        period = 60.0 / heard
     else:
+        heard = 60.0 / beat_period(ticks.time)
         period = beat_period(ticks.time, bpm)
     if bpm is not None:
-        _check_bpm(bpm, period if trains else beat_period(ticks.time))
-        if not trains:
-            period = beat_period(ticks.time, bpm)
+        _check_bpm(bpm, heard)
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
@@ -145,7 +149,7 @@ def analyze_audio(
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
-    label = np.full(k, -1, dtype=np.int8)
+    label = sep.labels()[heads]
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)
@@ -153,12 +157,11 @@ def analyze_audio(
     for m, t in enumerate(trains):
         s = beat_statistics(ticks.time[t.index], t.period, ticks.strength[t.index])
         stats.append(s)
-        own = t.index[~t.masked]
-        label[own] = m
-        is_tock[own] = s.is_tock[~t.masked]
+        mine = label[t.index] == m
+        is_tock[t.index[mine]] = s.is_tock[mine]
         gaps = np.full(t.index.size, np.nan)
         gaps[:-1] = _beats(ticks.time[t.index], s.beat_number)
-        interval[own] = gaps[~t.masked]
+        interval[t.index[mine]] = gaps[mine]
         kept.append(ph.kept_from_half_periods(ticks.time[t.index], s.beat_number,
                                               parity=1 if s.is_tock[0] else 0))  # fmt: skip
         if m > 0:
@@ -188,7 +191,7 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="median of the metronomes' own tempi" if trains
+        tempo_source="the median of the metronomes' own tempi" if trains
         else "given (bpm)" if bpm is not None else "found from the ticks",
         metronomes=n,
         metronomes_source=source,
@@ -240,13 +243,16 @@ def _on_ticks(train: Train, where: np.ndarray) -> Train:
     return replace(train, index=where[train.index])
 
 
-def _check_bpm(bpm: float, period: float) -> None:
-    heard = 60.0 / period
-    if abs(heard / bpm - 1) > 0.15:
+def _median_bpm(sep) -> float:
+    """The median of the metronomes' tempi, BPM (0 when none was found)."""
+    return float(np.median([60.0 / t.period for t in sep.trains])) if sep.trains else 0.0
+
+
+def _check_bpm(bpm: float, heard: float) -> None:
+    if abs(heard / bpm - 1) > HINT_RANGE:
         warnings.warn(
             f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
-            f"analysis keeps the tempo it heard for each metronome. Check the "
-            f"setting, or leave `bpm` out.",
+            f"analysis keeps the tempo it heard. Check the setting, or leave `bpm` out.",
             UserWarning,
             stacklevel=3,
         )

@@ -5,7 +5,8 @@ Contract: `separate(recording, impacts)` takes every impact the detector heard
 impacts start a tick (``head``), and each metronome's tick train (indices into the
 impacts), or none with the reason.
 
-Steps: the impacts are grouped into voices by their sound (`voices`); within each
+Steps: the impacts are grouped into voices by their sound (`voices`: the grouping with
+the most voices in which every voice carries tick trains of its own); within each
 voice the impacts of one tick become one tick, timed at its first impact, and the
 voice's ticks are followed as trains, one per metronome that sounds like it, told
 apart by tempo (`trains`); a tick and a tock that sound different are joined into
@@ -25,6 +26,9 @@ import numpy as np
 
 from . import trains as tr
 from .voices import MIN_SEPARATION, Voices, cluster_voices, impact_features
+
+#: Share of a voice's ticks that its trains must hold for the voice to stand.
+CARRIED = 0.5
 
 
 @dataclass(frozen=True)
@@ -52,10 +56,14 @@ class Separation:
     note: str = ""
 
     def labels(self) -> np.ndarray:
-        """(K,) metronome of each impact that starts a tick (−1: none, or not a tick)."""
+        """(K,) metronome of each impact that starts a tick: the one train that took it;
+        −1: none, or two trains share it (their ticks fell together)."""
         out = np.full(self.head.size, -1, dtype=np.int8)
+        claims = np.zeros(self.head.size, dtype=np.int64)
+        for t in self.trains:
+            claims[t.index] += 1
         for m, t in enumerate(self.trains):
-            own = t.index[~t.masked]
+            own = t.index[claims[t.index] == 1]
             out[own] = m
         return out
 
@@ -69,21 +77,19 @@ def sureness(confidence: float) -> str:
     return "unsure: check the plot"
 
 
-def separate(recording, impacts, *, seed: int = 0) -> Separation:
-    """Tell the metronomes of ``recording`` apart (see the module docstring)."""
+def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> Separation:
+    """Tell the metronomes of ``recording`` apart (see the module docstring).
+
+    bpm : the metronomes' setting: their beats are sought within ±15 % of it (or of
+        twice it, for a tick and a tock that sound different).
+    """
+    beat_range = tr.BEAT_RANGE if bpm is None else (0.85 * 60 / bpm, 2.3 * 60 / bpm)
     times = impacts.time
     features = impact_features(recording, times)
-    voices = cluster_voices(features, seed=seed)
-    head, gaps = tr.group_impacts(times, voices.labels)
-    found, of_voice = [], []
-    for v in range(voices.count):
-        own = np.flatnonzero(head & (voices.labels == v))
-        others = np.flatnonzero(head & (voices.labels != v))
-        for t in tr.trains_of_voice(times, own, others=others):
-            found.append(t)
-            of_voice.append(v)
-    found, of_voice = tr.drop_shared(found, of_voice)
-    found, groups = tr.join_tick_and_tock(times, found, of_voice)
+    for voices in cluster_voices(features, seed=seed):
+        head, gaps, found, groups = _trains(times, voices, beat_range)
+        if voices.count == 1 or _all_voices_carry(head, voices, found, groups):
+            break
     if not found:
         return Separation(head, voices, gaps=gaps, note="no steady tick train was found")
     loud = [float(np.mean(impacts.strength[t.index])) for t in found]
@@ -109,6 +115,42 @@ def separate(recording, impacts, *, seed: int = 0) -> Separation:
     if distinct > 1:
         conf *= min(1.0, voices.separation / (2 * MIN_SEPARATION))
     return Separation(head, voices, found, groups, gaps, method, float(conf), "")
+
+
+def _trains(times, voices: Voices, beat_range):
+    head, gaps = tr.group_impacts(times, voices.labels)
+    found, of_voice = [], []
+    for v in range(voices.count):
+        own = np.flatnonzero(head & (voices.labels == v))
+        others = np.flatnonzero(head & (voices.labels != v))
+        for t in tr.trains_of_voice(times, own, others=others, beat_range=beat_range):
+            found.append(t)
+            of_voice.append(v)
+    found, of_voice = tr.drop_shared(found, of_voice)
+    found, of_voice, folded = tr.fold_parts(times, found, of_voice)
+    for index in folded:
+        head[index] = False
+    found, groups = tr.join_tick_and_tock(times, found, of_voice)
+    return head, gaps, found, groups
+
+
+def _all_voices_carry(head, voices: Voices, found, groups) -> bool:
+    """Each voice has at least `CARRIED` of its ticks in trains of its own, or in trains
+    of other voices as ticks that hid theirs (a voice of ticks that fall together)."""
+    for v in range(voices.count):
+        mine = head & (voices.labels == v)
+        if not mine.any():  # folded into another voice's ticks
+            continue
+        placed = np.zeros(head.size, dtype=bool)
+        shared = np.zeros(head.size, dtype=bool)
+        for t, g in zip(found, groups, strict=True):
+            if v in g:
+                placed[t.index[~t.masked]] = True
+            else:
+                shared[t.index[t.masked]] = True
+        if placed[mine].mean() < CARRIED and shared[mine].mean() < CARRIED:
+            return False
+    return True
 
 
 def tick_length_words(sep: Separation) -> str:

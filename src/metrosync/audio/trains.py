@@ -148,7 +148,7 @@ def _nearest(times: np.ndarray, pool: np.ndarray, target: float) -> tuple[int, f
 
 
 def _walk(t: np.ndarray, p: int, d: float, beats: int = 6) -> tuple[int, float, float]:
-    """(hits, mean error / beat, beat) of a short walk from t[p] with a first beat d:
+    """(hits, mean error (s) where a swing predicted, beat) of a short walk from t[p] with a first beat d:
     once a full swing has been heard, each tick is predicted one swing after the tick
     two beats back; the beat returned is half the last swing heard."""
     when = [t[p]]
@@ -171,14 +171,14 @@ def _walk(t: np.ndarray, p: int, d: float, beats: int = 6) -> tuple[int, float, 
                 swing = t[c] - when[n - 2]
         else:
             when.append(None)
-    return hits, err / max(hits, 1) / d, 0.5 * swing
+    return hits, err / max(hits, 1), 0.5 * swing
 
 
-def _seed(times, own_idx, start: int):
+def _seed(times, own_idx, start: int, beat_range=BEAT_RANGE):
     """(position in own_idx, beat) of the first tick from ``start`` on with a steady
-    successor, or None."""
+    successor one beat (in ``beat_range``, s) later, or None."""
     t = times[own_idx]
-    lo, hi = BEAT_RANGE
+    lo, hi = beat_range
     for p in range(start, own_idx.size):
         cand = np.flatnonzero((t > t[p] + lo) & (t < t[p] + hi))[:64]
         if cand.size == 0:
@@ -188,7 +188,8 @@ def _seed(times, own_idx, start: int):
         if most < 5:
             continue
         best_err = min(w[1] for w in walks if w[0] == most)
-        fit = [w[2] for w in walks if w[0] == most and w[1] <= 1.5 * best_err + 2e-3]
+        # the shortest beat that walks as well: twice the beat walks too
+        fit = [w[2] for w in walks if w[0] == most and w[1] <= best_err + max(3e-3, 0.02 * w[2])]
         return p, min(fit)
     return None
 
@@ -225,7 +226,7 @@ def _follow(times, own_idx, other_idx, seed_pos, beat, end_time):
     return got, period
 
 
-def track(times, own, *, others=None, start: int = 0):
+def track(times, own, *, others=None, start: int = 0, beat_range=BEAT_RANGE):
     """The `Train` through one seed at or after own[start] (see the module docstring).
 
     times : (K,) all tick times, sorted. own : (P,) sorted indices of the voice's ticks
@@ -235,7 +236,7 @@ def track(times, own, *, others=None, start: int = 0):
     times = np.asarray(times, dtype=float)
     own = np.asarray(own, dtype=np.int64)
     others = np.zeros(0, dtype=np.int64) if others is None else np.asarray(others, np.int64)
-    found = _seed(times, own, start)
+    found = _seed(times, own, start, beat_range)
     if found is None:
         return None, own.size
     pos, beat = found
@@ -262,13 +263,16 @@ def track(times, own, *, others=None, start: int = 0):
     return Train(index, numbers, float(mean_beat), masked), pos + 1
 
 
-def trains_of_voice(times, own, *, others=None, min_ticks: int = 8) -> list[Train]:
-    """Every metronome heard in one voice's ticks ``own`` (sorted indices into times)."""
+def trains_of_voice(
+    times, own, *, others=None, min_ticks: int = 8, beat_range=BEAT_RANGE
+) -> list[Train]:
+    """Every metronome heard in one voice's ticks ``own`` (sorted indices into times),
+    its first beat sought in ``beat_range`` (s)."""
     left = np.asarray(own, dtype=np.int64)
     out: list[Train] = []
     start = 0
     while left.size >= min_ticks and start < left.size:
-        train, start = track(times, left, others=others, start=start)
+        train, start = track(times, left, others=others, start=start, beat_range=beat_range)
         if train is None:
             break
         if train.index.size < min_ticks or train.coverage < MIN_COVERAGE:
@@ -297,6 +301,34 @@ def drop_shared(trains: list[Train], voice: list[int]) -> tuple[list[Train], lis
         keep.append(taken.mean() < 0.5)
     return ([t for t, k in zip(trains, keep, strict=True) if k],
             [v for v, k in zip(voice, keep, strict=True) if k])  # fmt: skip
+
+
+def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int]):
+    """Trains that are part of another's ticks, folded into it: (trains, voices,
+    indices of the folded ticks). A train is part of another when its period is a
+    multiple (2 or more) of the other's and its ticks keep a fixed lag, within
+    `MAX_TICK_LENGTH`, to the other's: a later impact of a real tick that sounds
+    different every few ticks, or the pre-echo a lossy coder smears ahead of a click."""
+    keep = [True] * len(trains)
+    folded = []
+    for b, tb in enumerate(trains):
+        for a, ta in enumerate(trains):
+            if a == b or not keep[a]:
+                continue
+            ratio = tb.period / ta.period
+            k = round(ratio)
+            if k < 2 or abs(ratio - k) > 0.01 * k:
+                continue
+            t_a, t_b = times[ta.index], times[tb.index]
+            j = np.clip(np.searchsorted(t_a, t_b), 1, t_a.size - 1)
+            lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
+                           t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
+            if abs(np.median(lag)) < MAX_TICK_LENGTH and np.std(lag) < LAG_BIN * 1.5:
+                keep[b] = False
+                folded.append(tb.index[~tb.masked])
+                break
+    return ([t for t, k in zip(trains, keep, strict=True) if k],
+            [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
 
 
 def join_tick_and_tock(times: np.ndarray, trains: list[Train], voice: list[int]):

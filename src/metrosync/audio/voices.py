@@ -15,10 +15,13 @@ phone's filter colours every tick alike. The loudness itself (dB, weighted by
 (dB: where the metronome stands relative to the microphones) are added.
 
 Clustering. k-means (k-means++ seeds, the best of `RESTARTS`) for k = 1 ..
-`MAX_VOICES`; the largest k is kept whose voices are all far apart for their spreads
+`MAX_VOICES`; a grouping is kept when its voices are all far apart for their spreads
 (along the line between two centres, |μ_a − μ_b| / √((σ_a² + σ_b²)/2) ≥
-`MIN_SEPARATION`: halves of one voice split apart come out near 2.7) and each holds at
-least `MIN_SHARE` of the impacts. An impact farther from its centre than `OUTLIER`
+`MIN_SEPARATION`, the spread taken as at least `SPREAD_FLOOR`: halves of one voice
+split apart come out near 2.7) and each holds at least `MIN_SHARE` of the impacts
+(and 8; smaller groups are odd impacts, not voices). `cluster_voices` returns every
+grouping kept, the most voices first: the caller keeps the first whose voices each
+carry a tick train. An impact farther from its centre than `OUTLIER`
 times its voice's median distance is left out (−1). A voice is a sound, not yet a
 metronome: a tick and a tock that sound different are two voices of one metronome, and
 two metronomes of one make are one voice (`trains` sorts that out).
@@ -49,6 +52,9 @@ RESTARTS = 4
 MIN_SEPARATION = 4.0
 MIN_SHARE = 0.02
 OUTLIER = 4.0
+#: Smallest spread a voice is credited with, dB: identical clicks vary by less, and
+#: must not make voices of their rounding.
+SPREAD_FLOOR = 1.0
 #: Impacts clustered at most (a random sample; the rest go to the nearest centre).
 SAMPLE = 6000
 
@@ -131,29 +137,39 @@ def impact_features(recording: Recording, times: np.ndarray, *, chunk: int = 409
     return Features(shape, level, channel)
 
 
-def cluster_voices(features: Features, *, seed: int = 0) -> Voices:
-    """Group impacts by their sound (see the module docstring)."""
+def cluster_voices(features: Features, *, seed: int = 0) -> list[Voices]:
+    """The ways to group the impacts by their sound that pass the test of the module
+    docstring, the most voices first, ending with one voice."""
     x = features.matrix()
     k = x.shape[0]
-    if k < 8:
-        return Voices(np.zeros(k, dtype=np.int16), 1, math.inf, {})
+    if k < 16:
+        return [Voices(np.zeros(k, dtype=np.int16), 1, math.inf, {})]
     rng = np.random.default_rng(seed)
     sample = x if k <= SAMPLE else x[rng.choice(k, SAMPLE, replace=False)]
-    best = (np.zeros(sample.shape[0], dtype=int), sample.mean(axis=0, keepdims=True), math.inf)
+    smallest = max(8, MIN_SHARE * sample.shape[0])
+    found = {1: (sample.mean(axis=0, keepdims=True), math.inf)}
     tried = {}
     for v in range(2, MAX_VOICES + 1):
         if sample.shape[0] < v * 8:
             break
         centres, labels = _kmeans(sample, v, rng)
-        sizes = np.bincount(labels, minlength=v)
-        if sizes.min() < max(4, MIN_SHARE * sample.shape[0]):
-            tried[v] = math.nan
+        big = np.flatnonzero(np.bincount(labels, minlength=v) >= smallest)
+        if big.size < 2:
             continue
-        sep = _min_separation(sample, labels, centres)
+        # a handful of odd impacts (two ticks at once, a bump) is not a voice
+        keep = np.isin(labels, big)
+        relabel = np.full(v, -1)
+        relabel[big] = np.arange(big.size)
+        sep = _min_separation(sample[keep], relabel[labels[keep]], centres[big])
         tried[v] = sep
-        if sep >= MIN_SEPARATION:
-            best = (labels, centres, sep)
-    labels, centres, sep = best
+        if sep >= MIN_SEPARATION and sep > found.get(big.size, (None, -1.0))[1]:
+            found[big.size] = (centres[big], sep)
+    return [_assign(x, *found[n], tried) for n in sorted(found, reverse=True)]
+
+
+def _assign(x: np.ndarray, centres: np.ndarray, sep: float, tried: dict) -> Voices:
+    """Every impact to its nearest centre, or −1 when far from all of them."""
+    k = x.shape[0]
     d = np.linalg.norm(x[:, None, :] - centres[None, :, :], axis=2)
     nearest = np.argmin(d, axis=1)
     mine = d[np.arange(k), nearest]
@@ -161,9 +177,9 @@ def cluster_voices(features: Features, *, seed: int = 0) -> Voices:
     for v in range(centres.shape[0]):
         sel = nearest == v
         if sel.any():
-            typical = float(np.median(mine[sel])) or 1e-9
+            typical = max(float(np.median(mine[sel])), SPREAD_FLOOR)
             out[sel & (mine > OUTLIER * typical)] = -1
-    return Voices(out, int(centres.shape[0]), float(sep), tried)
+    return Voices(out, int(centres.shape[0]), float(sep), dict(tried))
 
 
 def _kmeans(x: np.ndarray, v: int, rng) -> tuple[np.ndarray, np.ndarray]:
@@ -190,6 +206,6 @@ def _min_separation(x: np.ndarray, labels: np.ndarray, centres: np.ndarray) -> f
                 return 0.0
             u = u / norm
             pa, pb = x[labels == a] @ u, x[labels == b] @ u
-            spread = math.sqrt(0.5 * (pa.var() + pb.var())) or 1e-9
+            spread = max(math.sqrt(0.5 * (pa.var() + pb.var())), SPREAD_FLOOR)
             out = min(out, abs(pa.mean() - pb.mean()) / spread)
     return out
