@@ -35,16 +35,16 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
-from ..observables.order import equilibrium_order
 from ..errors import ParameterError
 from ..observables import crossings as ph
+from ..observables.order import equilibrium_order
 from . import detection as det
 from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
-from .summary import summary_text
 from .separation import separate, sureness, tick_length_words
+from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
 from .trains import Train
 
@@ -136,7 +136,7 @@ def analyze_audio(
         source = "given"
     elif trains:
         n = len(trains)
-        source = f"told apart by {sep.method}"
+        source = "one tick train" if n == 1 else f"told apart by {sep.method}"
     else:
         n = busiest
         source = "most ticks per beat in a window (95th percentile), rounded"
@@ -191,8 +191,11 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="the median of the metronomes' own tempi" if trains
-        else "given (bpm)" if bpm is not None else "found from the ticks",
+        tempo_source="the median of the metronomes' own tempi"
+        if trains
+        else "given (bpm)"
+        if bpm is not None
+        else "found from the ticks",
         metronomes=n,
         metronomes_source=source,
         impacts=int(impacts.time.size),

@@ -10,7 +10,8 @@ the most voices in which every voice carries tick trains of its own); within eac
 voice the impacts of one tick become one tick, timed at its first impact, and the
 voice's ticks are followed as trains, one per metronome that sounds like it, told
 apart by tempo (`trains`); a tick and a tock that sound different are joined into
-one metronome. Metronomes are numbered by loudness, the loudest first.
+one metronome. An impact that sounds like no voice and that no train took is an
+odd sound, not a tick. Metronomes are numbered by loudness, the loudest first.
 
 How sure. `confidence` in [0, 1] is the product of the share of ticks placed in a
 train, the smallest coverage (share of a train's beats heard) and, when voices were
@@ -87,7 +88,7 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     times = impacts.time
     features = impact_features(recording, times)
     for voices in cluster_voices(features, seed=seed):
-        head, gaps, found, groups = _trains(times, voices, beat_range)
+        head, gaps, found, groups = _trains(times, impacts.strength, voices, beat_range)
         if voices.count == 1 or _all_voices_carry(head, voices, found, groups):
             break
     if not found:
@@ -109,6 +110,8 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     placed = np.zeros(times.size, dtype=bool)
     for t in found:
         placed[t.index] = True
+    # an odd sound (no voice) that no metronome took is not a tick: a bump, a pre-echo
+    head &= placed | (voices.labels >= 0)
     share = placed[head].mean() if head.any() else 0.0
     coverage = min(t.coverage for t in found)
     conf = share * coverage
@@ -117,8 +120,8 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     return Separation(head, voices, found, groups, gaps, method, float(conf), "")
 
 
-def _trains(times, voices: Voices, beat_range):
-    head, gaps = tr.group_impacts(times, voices.labels)
+def _trains(times, strength, voices: Voices, beat_range):
+    head, gaps = tr.group_impacts(times, voices.labels, strength)
     found, of_voice = [], []
     for v in range(voices.count):
         own = np.flatnonzero(head & (voices.labels == v))
@@ -159,4 +162,3 @@ def tick_length_words(sep: Separation) -> str:
     if not g.size or g.max() <= 0:
         return "one impact per tick"
     return f"a tick's impacts span up to {1e3 * g.max():.0f} ms, counted as one tick"
-

@@ -53,6 +53,8 @@ import numpy as np
 MAX_TICK_LENGTH = 0.09
 LAG_BIN = 2e-3
 MIN_SHARE_LATE = 0.05
+#: A tick's onset is its first impact at most this much (dB) below its loudest.
+ONSET_DROP = 20.0
 SWING_TOLERANCE = 0.03
 BEAT_TOLERANCE = 0.10
 MASKED_TOLERANCE = 4e-3
@@ -84,9 +86,13 @@ class Train:
         return self.index.size / (self.beat[-1] + 1) if self.index.size else 0.0
 
 
-def group_impacts(times: np.ndarray, voices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def group_impacts(
+    times: np.ndarray, voices: np.ndarray, strength: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """(first (K,) bool, gap (V,) s): see the module docstring. Impacts of no voice
-    (−1) that fall within a tick's gap are folded into it too."""
+    (−1) that fall within a tick's gap are folded into it too. With ``strength`` (K,),
+    dB, a tick's onset is its first impact within `ONSET_DROP` of its loudest: a
+    faint sound just ahead of a tick (a lossy coder's pre-echo) does not time it."""
     times = np.asarray(times, dtype=float)
     k = times.size
     first = np.ones(k, dtype=bool)
@@ -100,11 +106,20 @@ def group_impacts(times: np.ndarray, voices: np.ndarray) -> tuple[np.ndarray, np
         if gap <= 0:
             continue
         start = -np.inf
-        for i in mine:
-            if times[i] - start <= gap:
-                first[i] = False
-            else:
-                start = times[i]
+        group: list[int] = []
+        for i in [*mine, -1]:
+            if i >= 0 and times[i] - start <= gap:
+                group.append(i)
+                continue
+            if strength is not None and len(group) > 1:
+                loud = strength[group]
+                onset = group[int(np.argmax(loud >= loud.max() - ONSET_DROP))]
+                first[group] = False
+                first[onset] = True
+            elif group:
+                first[group[1:]] = False
+            if i >= 0:
+                start, group = times[i], [i]
     # strays right after a tick of any voice belong to that tick
     if count and (voices < 0).any():
         heads = np.flatnonzero(first & (voices >= 0))
@@ -148,8 +163,8 @@ def _nearest(times: np.ndarray, pool: np.ndarray, target: float) -> tuple[int, f
 
 
 def _walk(t: np.ndarray, p: int, d: float, beats: int = 6) -> tuple[int, float, float]:
-    """(hits, mean error (s) where a swing predicted, beat) of a short walk from t[p] with a first beat d:
-    once a full swing has been heard, each tick is predicted one swing after the tick
+    """(hits, mean error (s) where a swing predicted, beat) of a short walk from t[p]
+    with a first beat d: once a full swing has been heard, each tick is predicted one swing after the tick
     two beats back; the beat returned is half the last swing heard."""
     when = [t[p]]
     hits, err, last, swing = 0, 0.0, 0, 2 * d
