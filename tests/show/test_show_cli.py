@@ -20,6 +20,30 @@ def test_listen_simulates_every_step(tmp_path, capsys):
     assert "clicks" in capsys.readouterr().out
 
 
+def test_listen_sounds_real_ticks_on_request(tmp_path, capsys):
+    import numpy as np
+
+    paths = {}
+    for sound in ("click", "realistic"):
+        paths[sound] = tmp_path / f"{sound}.wav"
+        argv = ["listen", *SMALL, "--seed", "2", "--tick-sound", sound, "--out", str(paths[sound])]
+        assert main(argv) == 0
+    capsys.readouterr()
+    read = {}
+    for sound, path in paths.items():
+        with wave.open(str(path)) as f:
+            read[sound] = np.frombuffer(f.readframes(f.getnframes()), "<i2").reshape(-1, 2)
+    assert read["click"].shape == read["realistic"].shape
+    # The same ticks with longer sounds: far more sound between them.
+    busy = {k: np.mean(np.abs(v.astype(float)).sum(axis=1) > 30) for k, v in read.items()}
+    assert busy["realistic"] > 5 * busy["click"]
+    # Each file's first sound starts at the same first tick.
+    first = {
+        k: np.flatnonzero(np.abs(v.astype(float)).sum(axis=1) > 30)[0] for k, v in read.items()
+    }
+    assert abs(first["realistic"] - first["click"]) <= 3
+
+
 def test_animate_and_page_read_a_simulation_file(recorded_ds, tmp_path):
     source = tmp_path / "run.nc"
     write_netcdf(recorded_ds, source)

@@ -196,3 +196,55 @@ def test_a_metronome_out_of_beat_clicks_where_its_escapement_acts():
     plain = metrosync.simulate(1, 192, duration=2.0, record_every=1, trajectories=True)
     assert "escapement_offset" not in plain
     np.testing.assert_array_equal(RecordedRun.from_dataset(plain).tick_angles, [0.0])
+
+
+# -- realistic tick sounds -----------------------------------------------------------
+
+
+def test_realistic_ticks_start_on_the_crossings_tick_up_and_tock_down(pair_ds):
+    from metrosync.show.ticks import voices
+
+    run = RecordedRun.from_dataset(pair_ds)
+    track = click_track(run, start=1.0, end=11.0, tick_sound="realistic")
+    samples = track.samples
+    assert 0.05 < np.abs(samples).max() <= 0.9
+    sounds = voices(2)
+    found = crossing_times(run)
+    # Each metronome rendered alone: its ticks where the energy rises.
+    for metronome in (0, 1):
+        one = RecordedRun.from_dataset(pair_ds.isel(metronome=[metronome]))
+        alone = click_track(one, start=1.0, end=11.0, tick_sound="realistic").samples.sum(axis=1)
+        times = found[metronome][(found[metronome] >= 1.0) & (found[metronome] < 11.0)] - 1.0
+        up = run.theta_dot_at(times + 1.0)[:, metronome] > 0
+        np.testing.assert_array_equal(track.is_tock[metronome], ~up)
+        onsets = []
+        for t in times:
+            k = int(round(t * 44100))
+            seg = np.abs(alone[max(k - 200, 0) : k + 200])
+            onsets.append((max(k - 200, 0) + np.flatnonzero(seg > 0.05 * seg.max())[0]) / 44100)
+        assert np.max(np.abs(np.array(onsets) - times)) < 1e-4
+        # The tock is the softer, and each metronome sounds with its own voice.
+        voice = sounds[metronome]
+        tick = np.abs(alone[int(round(times[up][0] * 44100)) :][:4000]).max()
+        tock = np.abs(alone[int(round(times[~up][0] * 44100)) :][:4000]).max()
+        assert tock < tick
+        np.testing.assert_array_equal(track.waveforms[metronome], voice.waveform(44100))
+    # The other sound: one 6 ms click per crossing, the same at every crossing.
+    plain = click_track(run, start=1.0, end=11.0)
+    assert plain.tock_waveforms is None and plain.waveforms[0].size == round(0.006 * 44100)
+
+
+def test_realistic_ticks_never_clip_even_sped_up(recorded_ds, tmp_path):
+    track = write_wav(recorded_ds, tmp_path / "fast.wav", speedup=6.0, tick_sound="realistic")
+    (channels, _, _, frames), samples = read_wav(tmp_path / "fast.wav")
+    assert frames == track.n_samples
+    assert 0.02 < np.abs(samples).max() <= 0.9 + 1e-4
+    with pytest.raises(ParameterError, match=r"`tick_sound` must be one of 'click', 'realistic'"):
+        click_track(RecordedRun.from_dataset(recorded_ds), tick_sound="wood")
+
+
+def test_the_cli_offers_the_tick_sounds_the_library_knows():
+    from metrosync.cli.listen import TICK_SOUNDS as offered
+    from metrosync.show.sound import TICK_SOUNDS
+
+    assert offered == TICK_SOUNDS

@@ -8,6 +8,10 @@ from ._io import check_output
 from ._options import HelpFormatter
 from ._show_source import add_source_options, load_or_simulate
 
+#: The choices of ``--tick-sound`` (`metrosync.show.sound.TICK_SOUNDS`, not imported
+#: here so that the parser stays light).
+TICK_SOUNDS = ("click", "realistic")
+
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
@@ -17,7 +21,9 @@ def register(subparsers) -> None:
         "pendulum (the instant a metronome ticks; for a metronome out of beat, "
         "--set escapement_offset=RAD, where θ crosses that angle), panned by its place "
         "on the disk. "
-        "Simulating here records every step, so clicks fall on the simulated crossings.",
+        "Simulating here records every step, so clicks fall on the simulated crossings. "
+        "--tick-sound realistic makes each tick sound like a real metronome's: several "
+        "impacts ringing through resonances of its own, tick and tock different.",
         formatter_class=HelpFormatter,
     )
     add_source_options(parser, record_seconds=None)
@@ -25,6 +31,13 @@ def register(subparsers) -> None:
     out.add_argument("--out", type=Path, default=Path("metrosync.wav"), help="FILE.wav")
     out.add_argument("--speedup", type=float, default=1.0, help="play faster than real time")
     out.add_argument("--sample-rate", type=int, default=44100, help="samples per second")
+    out.add_argument(
+        "--tick-sound",
+        choices=TICK_SOUNDS,
+        default="click",
+        help="a short click, or a real metronome's tick (impacts and ring, one sound "
+        "per metronome, tick and tock different)",
+    )
     parser.set_defaults(func=run)
 
 
@@ -42,7 +55,7 @@ def run(args) -> int:
     ds = load_or_simulate(args)
     track = write_wav(
         ds, args.out, run=args.run, speedup=args.speedup, start=args.start, end=args.end,
-        sample_rate=args.sample_rate,
+        sample_rate=args.sample_rate, tick_sound=args.tick_sound,
     )  # fmt: skip
     clicks = sum(len(t) for t in track.click_times)
     print(f"wrote {args.out} ({track.duration:.1f} s, {clicks} clicks, {track.sample_rate} Hz)")

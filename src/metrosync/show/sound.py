@@ -19,6 +19,15 @@ has a pitch of its own so that the ear can tell them apart. Each click has the g
 0.9/N, so the file never clips and a synchronized ensemble sounds louder, as it does
 in the room.
 
+Two tick sounds (``tick_sound``, see `TICK_SOUNDS`): ``"click"``, a 6 ms decaying
+cosine burst, and ``"realistic"``, the tick of a real metronome
+(`metrosync.show.ticks`): a main impact, secondary impacts 15–35 ms later and a ring
+of about 80 ms through resonances of its own (metronome i gets voice i of
+``ticks.voices(N)``). A realistic tick starts at the crossing; an upward crossing
+sounds a tick, a downward one the tock, which sounds different and softer. Its gain
+is 0.9/N over the loudest peak of the voices and over how many of one metronome's
+ticks can sound at once (they overlap when sped up), so the file never clips either.
+
 The audio is rendered and written in blocks of `BLOCK_SAMPLES`, so memory does not
 depend on its length. Refused before any sample is made: a speed-up that brings a
 metronome's ticks closer together than one click (they would merge into a tone), a
@@ -50,6 +59,8 @@ PITCH_RANGE = (1800.0, 2600.0)
 BLOCK_SAMPLES = 1 << 16
 #: Longest audio written, s.
 MAX_AUDIO_SECONDS = 3600.0
+#: The tick sounds `click_track` knows.
+TICK_SOUNDS = ("click", "realistic")
 
 
 @dataclass(frozen=True)
@@ -63,6 +74,10 @@ class ClickTrack:
     gains : N arrays (K_i, 2) of each click's left and right gain.
     waveforms : N arrays, the click of each metronome.
     start, end, speedup : the simulated window [start, end] (s) and the speed-up.
+    tock_waveforms : N arrays, the tock of each metronome, or None when tick and tock
+        sound alike (then ``waveforms`` sounds at every crossing).
+    is_tock : N (K_i,) bool arrays, which clicks are tocks (downward crossings), or
+        None with ``tock_waveforms``.
     """
 
     sample_rate: int
@@ -74,6 +89,8 @@ class ClickTrack:
     start: float
     end: float
     speedup: float
+    tock_waveforms: list[np.ndarray] | None = None
+    is_tock: list[np.ndarray] | None = None
 
     @property
     def duration(self) -> float:
@@ -94,16 +111,13 @@ class ClickTrack:
 
     def _render(self, first: int, stop: int) -> np.ndarray:
         block = np.zeros((stop - first, 2))
-        for onset, gain, click in zip(self.onsets, self.gains, self.waveforms, strict=True):
-            # The clicks that sound in [first, stop): onsets from first − len + 1 on.
-            lo, hi = np.searchsorted(onset, [first - click.size + 1, stop])
-            if lo == hi:
+        for i, (onset, gain) in enumerate(zip(self.onsets, self.gains, strict=True)):
+            if self.tock_waveforms is None:
+                _add_clicks(block, first, onset, gain, self.waveforms[i])
                 continue
-            index = onset[lo:hi, None] + np.arange(click.size)[None, :] - first
-            inside = (index >= 0) & (index < stop - first)
-            for channel in (0, 1):
-                values = gain[lo:hi, channel, None] * click
-                np.add.at(block[:, channel], index[inside], values[inside])
+            tock = self.is_tock[i]
+            _add_clicks(block, first, onset[~tock], gain[~tock], self.waveforms[i])
+            _add_clicks(block, first, onset[tock], gain[tock], self.tock_waveforms[i])
         return block
 
     def write(self, path: Path | str) -> Path:
@@ -117,6 +131,21 @@ class ClickTrack:
                 pcm = np.round(np.clip(block, -1.0, 1.0) * 32767).astype("<i2")
                 out.writeframes(pcm.tobytes())
         return path
+
+
+def _add_clicks(block, first: int, onset, gain, click) -> None:
+    """Add to ``block`` (audio from sample ``first`` on) the clicks that start at
+    ``onset`` (K,) with gains ``gain`` (K, 2) and sound in it."""
+    stop = first + block.shape[0]
+    # The clicks that sound in [first, stop): onsets from first − len + 1 on.
+    lo, hi = np.searchsorted(onset, [first - click.size + 1, stop])
+    if lo == hi:
+        return
+    index = onset[lo:hi, None] + np.arange(click.size)[None, :] - first
+    inside = (index >= 0) & (index < stop - first)
+    for channel in (0, 1):
+        values = gain[lo:hi, channel, None] * click
+        np.add.at(block[:, channel], index[inside], values[inside])
 
 
 def crossing_times(run: RecordedRun) -> list[np.ndarray]:
@@ -186,14 +215,20 @@ def click_track(
     start: float | None = None,
     end: float | None = None,
     sample_rate: int = 44100,
+    tick_sound: str = "click",
 ) -> ClickTrack:
     """The clicks of a recorded run between ``start`` and ``end`` (s).
 
-    The audio lasts round((end − start)/speedup · sample_rate) samples. Refused: a
-    ``speedup`` that brings a metronome's ticks closer than one click (they would merge
-    into a tone), a window shorter than one tick of the slowest metronome, and audio
-    longer than `MAX_AUDIO_SECONDS`.
+    The audio lasts round((end − start)/speedup · sample_rate) samples. ``tick_sound``
+    is one of `TICK_SOUNDS` (see the module docstring). Refused: a ``speedup`` that
+    brings a metronome's ticks closer than one click (they would merge into a tone), a
+    window shorter than one tick of the slowest metronome, and audio longer than
+    `MAX_AUDIO_SECONDS`.
     """
+    if tick_sound not in TICK_SOUNDS:
+        raise ParameterError(
+            f"`tick_sound` must be one of {', '.join(map(repr, TICK_SOUNDS))}, got {tick_sound!r}."
+        )
     if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
         raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
     if (
@@ -216,7 +251,7 @@ def click_track(
     budget.check()
     gain = 0.9 / run.n
     pitches = np.linspace(*PITCH_RANGE, run.n) if run.n > 1 else [PITCH_RANGE[0]]
-    audio_times, onsets, gains, waveforms = [], [], [], []
+    audio_times, onsets, gains, waveforms, is_tock = [], [], [], [], []
     for i, times in enumerate(crossing_times(run)):
         times = times[(times >= start) & (times < end)]
         tau = (times - start) / speedup
@@ -225,9 +260,24 @@ def click_track(
         left, right = pan_gains(np.cos(run.rim_angles[i] + run.phi_at(times)))
         gains.append(gain * np.column_stack([left, right]))
         waveforms.append(click_waveform(pitches[i], sample_rate))
+        if tick_sound == "realistic":
+            is_tock.append(run.theta_dot_at(times)[:, i] < 0)
+    tock_waveforms = None
+    if tick_sound == "realistic":
+        from .ticks import voices
+
+        sounds = voices(run.n)
+        waveforms = [v.waveform(sample_rate) for v in sounds]
+        tock_waveforms = [v.waveform(sample_rate, tock=True) for v in sounds]
+        peak = max(np.abs(w).max() for w in waveforms + tock_waveforms)
+        # How many ticks of one metronome can sound at once: a tick lasts longer
+        # than the time to the next one when sped up.
+        shortest = min((np.diff(k).min() for k in onsets if k.size > 1), default=np.inf)
+        overlap = math.ceil(max(w.size for w in waveforms) / max(shortest, 1))
+        gains = [g / (peak * overlap) for g in gains]
     return ClickTrack(
         int(sample_rate), n_samples, audio_times, onsets, gains, waveforms, start, end,
-        float(speedup),
+        float(speedup), tock_waveforms, is_tock or None,
     )  # fmt: skip
 
 
@@ -272,7 +322,8 @@ def check_length(
 def write_wav(ds, path: Path | str, *, run: int = 0, **options) -> ClickTrack:
     """Write the click track of run ``run`` of ``ds`` to a WAV file.
 
-    ``options`` are those of `click_track` (speedup, start, end, sample_rate).
+    ``options`` are those of `click_track` (speedup, start, end, sample_rate,
+    tick_sound).
     Returns the track, whose ``click_times`` say when each click sounds.
     """
     track = click_track(RecordedRun.from_dataset(ds, run), **options)

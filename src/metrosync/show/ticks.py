@@ -1,0 +1,241 @@
+"""A metronome's tick as a real one sounds: several impacts ringing through the
+resonances of its case.
+
+Measured on real metronomes (44.1 kHz recordings), a tick is a main impact followed
+by one to three secondary impacts 15–35 ms later at 40–70 % of its amplitude (the
+escapement's pallet bouncing), the whole ringing for about 80 ms through a few
+resonances of the case. The tick and the tock of one metronome are struck by different
+pallets, so they differ in sound and in loudness; two metronomes of different makes
+differ in spectrum more than in loudness.
+
+A `Voice` holds those traits of one metronome, frozen, and is drawn reproducibly from
+a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
+`Voice.waveform` renders one tick or one tock:
+
+- each impact is a broadband transient (exponentially decaying noise, 0.4 ms) plus
+  the voice's resonances, damped sinusoids of frequencies ``resonances`` (Hz) and
+  amplitudes ``weights``; the slowest decays 60 dB in ``ring`` seconds, the others
+  faster (``decays``, fractions of it);
+- impact j ≥ 1 is the same sound, ``sub_gains[j-1]`` times as loud, starting
+  ``sub_delays[j-1]`` s after the main impact;
+- the tock rings at the resonances times ``tock_shift`` (a different pallet excites
+  the case differently) and is ``tock_gain`` (< 1) times as loud as the tick, so the
+  tick is the louder, as `metrosync.audio.metronome` names them;
+- the first sample is the onset of the main impact (it is 0 there and rises within
+  0.3 ms);
+- loudness is energy: the RMS of the tick over its first `LOUDNESS_WINDOW` (50 ms:
+  the impacts) is ``level · REFERENCE_RMS``. Peaks then differ between voices with
+  their crest factor (3 to 11 for drawn voices, so a drawn tick's peak stays below 1).
+
+The waveform is a pure function of the voice and the sample rate. The noise of the
+transient comes from the voice's own ``seed``, so a voice sounds the same every time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+
+#: Ranges the traits of a drawn voice come from (see `Voice.draw`).
+SUB_DELAY_RANGE = (0.015, 0.035)  # s after the main impact
+SUB_GAIN_RANGE = (0.4, 0.7)  # fraction of the main impact
+RING_RANGE = (0.07, 0.09)  # s for the slowest resonance to fall by 60 dB
+RESONANCE_RANGE = (800.0, 4500.0)  # Hz, the main resonance
+TOCK_GAIN_RANGE = (0.6, 0.85)
+TOCK_SHIFT_RANGE = (0.06, 0.15)  # |tock_shift − 1|
+LEVEL_RANGE = (0.85, 1.0)  # ±0.7 dB: makes differ in spectrum, hardly in loudness
+#: Length of the broadband transient of an impact (decay time), s.
+TRANSIENT_DECAY = 0.0004
+#: Rise time of an impact, s: the waveform starts at 0.
+ATTACK = 0.00008
+#: The tick's loudness is its RMS over this first part, s, ...
+LOUDNESS_WINDOW = 0.05
+#: ... which is ``level`` times this.
+REFERENCE_RMS = 0.09
+#: Most voices `voices` draws at once.
+MAX_VOICES = 10000
+#: Highest resonance drawn, Hz.
+MAX_RESONANCE = 9000.0
+
+
+@dataclass(frozen=True)
+class Voice:
+    """The sound of one metronome.
+
+    resonances : (M,) frequencies of its case's resonances, Hz, the first the main one.
+    weights : (M,) their relative amplitudes (the first 1).
+    decays : (M,) their decay times as fractions of the slowest's (the first 1).
+    ring : time for the slowest resonance to fall by 60 dB, s.
+    sub_delays : (J,) delays of the secondary impacts after the main one, s,
+        increasing, J in 1..3.
+    sub_gains : (J,) their amplitudes relative to the main impact.
+    tock_shift : factor on the resonances for the tock (≠ 1).
+    tock_gain : loudness of the tock relative to the tick (< 1).
+    level : loudness of the tick (its RMS over `LOUDNESS_WINDOW` is
+        ``level · REFERENCE_RMS``), in (0, 1].
+    transient : weight of the broadband transient of each impact, relative to the
+        resonances.
+    seed : seed of the transient's noise.
+    """
+
+    resonances: tuple[float, ...]
+    weights: tuple[float, ...]
+    decays: tuple[float, ...]
+    ring: float
+    sub_delays: tuple[float, ...]
+    sub_gains: tuple[float, ...]
+    tock_shift: float
+    tock_gain: float
+    level: float = 1.0
+    transient: float = 0.6
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        m = len(self.resonances)
+        if m < 1 or len(self.weights) != m or len(self.decays) != m:
+            raise ParameterError(
+                f"`resonances`, `weights` and `decays` must have the same length ≥ 1, got "
+                f"{len(self.resonances)}, {len(self.weights)} and {len(self.decays)}."
+            )
+        if not all(0 < f < MAX_RESONANCE * 1.5 for f in self.resonances):
+            raise ParameterError(
+                f"`resonances` must lie in (0, {MAX_RESONANCE * 1.5:g}) Hz, got "
+                f"{self.resonances!r}."
+            )
+        if not all(0 < d <= 1 for d in self.decays):
+            raise ParameterError(f"`decays` must lie in (0, 1], got {self.decays!r}.")
+        if not (0.005 <= self.ring <= 1.0):
+            raise ParameterError(f"`ring` must be in [0.005, 1] s, got {self.ring!r}.")
+        if len(self.sub_delays) != len(self.sub_gains):
+            raise ParameterError(
+                f"`sub_delays` and `sub_gains` must have the same length, got "
+                f"{len(self.sub_delays)} and {len(self.sub_gains)}."
+            )
+        if any(d <= 0 for d in self.sub_delays) or list(self.sub_delays) != sorted(self.sub_delays):
+            raise ParameterError(
+                f"`sub_delays` must be positive and increasing, s, got {self.sub_delays!r}."
+            )
+        if not all(0 < g <= 1 for g in self.sub_gains):
+            raise ParameterError(f"`sub_gains` must lie in (0, 1], got {self.sub_gains!r}.")
+        if not (0 < self.tock_shift and self.tock_shift != 1):
+            raise ParameterError(
+                f"`tock_shift` must be > 0 and ≠ 1 (tick and tock differ), got {self.tock_shift!r}."
+            )
+        if not (0 < self.tock_gain <= 1):
+            raise ParameterError(f"`tock_gain` must be in (0, 1], got {self.tock_gain!r}.")
+        if not (0 < self.level <= 1):
+            raise ParameterError(f"`level` must be in (0, 1], got {self.level!r}.")
+
+    @classmethod
+    def draw(cls, seed: int = 0, *, main_resonance: float | None = None) -> Voice:
+        """A voice drawn from the ranges of this module (`SUB_DELAY_RANGE`, …).
+
+        seed : the same seed gives the same voice.
+        main_resonance : the main resonance, Hz (default: drawn log-uniformly in
+            `RESONANCE_RANGE`).
+        """
+        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+            raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
+        rng = np.random.default_rng([25, int(seed)])
+        low, high = np.log(RESONANCE_RANGE)
+        f0 = float(np.exp(rng.uniform(low, high))) if main_resonance is None else main_resonance
+        extra = int(rng.integers(2, 4))
+        ratios = np.sort(rng.uniform(1.35, 3.2, extra))
+        resonances = [f0] + [f for f in f0 * ratios if f < MAX_RESONANCE]
+        weights = [1.0] + list(rng.uniform(0.3, 0.8, len(resonances) - 1))
+        decays = [1.0] + list(rng.uniform(0.35, 0.8, len(resonances) - 1))
+        n_sub = int(rng.integers(1, 4))
+        # Secondary impacts at least 4 ms apart, so each is an impact of its own.
+        while True:
+            sub_delays = np.sort(rng.uniform(*SUB_DELAY_RANGE, n_sub))
+            if n_sub == 1 or np.diff(sub_delays).min() >= 0.004:
+                break
+        sign = rng.choice([-1.0, 1.0])
+        return cls(
+            resonances=tuple(float(f) for f in resonances),
+            weights=tuple(float(w) for w in weights),
+            decays=tuple(float(d) for d in decays),
+            ring=float(rng.uniform(*RING_RANGE)),
+            sub_delays=tuple(float(d) for d in sub_delays),
+            sub_gains=tuple(float(g) for g in rng.uniform(*SUB_GAIN_RANGE, n_sub)),
+            tock_shift=float(1.0 + sign * rng.uniform(*TOCK_SHIFT_RANGE)),
+            tock_gain=float(rng.uniform(*TOCK_GAIN_RANGE)),
+            level=float(rng.uniform(*LEVEL_RANGE)),
+            seed=int(seed),
+        )
+
+    @property
+    def duration(self) -> float:
+        """Length of the waveform, s: the last impact plus the ring."""
+        return (self.sub_delays[-1] if self.sub_delays else 0.0) + self.ring
+
+    def impact(self, sample_rate: int, *, tock: bool = False) -> np.ndarray:
+        """(L,) one impact (no secondary ones), peak 1, L = ring · sample_rate."""
+        _check_rate(sample_rate)
+        t = np.arange(int(round(self.ring * sample_rate))) / sample_rate
+        shift = self.tock_shift if tock else 1.0
+        slowest = self.ring / math.log(1000.0)  # amplitude time constant for −60 dB
+        rng = np.random.default_rng([25, self.seed, int(tock)])
+        y = np.zeros_like(t)
+        for f, w, d in zip(self.resonances, self.weights, self.decays, strict=True):
+            phase = rng.uniform(0, 2 * np.pi)
+            if f * shift >= 0.45 * sample_rate:
+                continue  # above what the sample rate holds
+            y += w * np.exp(-t / (d * slowest)) * np.sin(2 * np.pi * f * shift * t + phase)
+        y /= max(np.abs(y).max(), 1e-12)
+        y += self.transient * rng.normal(0.0, 1.0, t.size) * np.exp(-t / TRANSIENT_DECAY)
+        y *= 1.0 - np.exp(-t / ATTACK)
+        return y / np.abs(y).max()
+
+    def waveform(self, sample_rate: int, *, tock: bool = False) -> np.ndarray:
+        """(L,) a tick (or, with ``tock``, a tock): the main impact at sample 0, the
+        secondary impacts after it; RMS over `LOUDNESS_WINDOW` ``level · REFERENCE_RMS``
+        for the tick, ``tock_gain`` times that for the tock.
+        L = round(duration · sample_rate) + 1."""
+        one = self.impact(sample_rate, tock=tock)
+        out = np.zeros(int(round(self.duration * sample_rate)) + 1)
+        out[: one.size] += one
+        for delay, gain in zip(self.sub_delays, self.sub_gains, strict=True):
+            k = int(round(delay * sample_rate))
+            n = min(one.size, out.size - k)
+            out[k : k + n] += gain * one[:n]
+        rms = np.sqrt(np.mean(out[: int(round(LOUDNESS_WINDOW * sample_rate))] ** 2))
+        loudness = REFERENCE_RMS * self.level * (self.tock_gain if tock else 1.0)
+        return out * (loudness / rms)
+
+
+def voices(n: int, seed: int = 0) -> list[Voice]:
+    """``n`` voices that differ from each other: their main resonances are drawn in
+    ``n`` separate bands spanning `RESONANCE_RANGE` (log-spaced, in shuffled order),
+    so no two sound alike (the more voices, the closer their bands). The same
+    (n, seed) gives the same voices."""
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= MAX_VOICES:
+        raise ParameterError(f"`n` must be an integer in [1, {MAX_VOICES}], got {n!r}.")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
+    rng = np.random.default_rng([26, int(seed), int(n)])
+    edges = np.exp(np.linspace(*np.log(RESONANCE_RANGE), n + 1))
+    order = rng.permutation(n)
+    out = []
+    for i in range(n):
+        lo, hi = edges[order[i]], edges[order[i] + 1]
+        # The middle 60 % of each band: neighbours stay apart.
+        f0 = float(np.exp(rng.uniform(np.log(lo) * 0.8 + np.log(hi) * 0.2,
+                                      np.log(lo) * 0.2 + np.log(hi) * 0.8)))  # fmt: skip
+        out.append(Voice.draw(int(seed) * MAX_VOICES + i, main_resonance=f0))
+    return out
+
+
+def _check_rate(sample_rate) -> None:
+    if (
+        isinstance(sample_rate, bool)
+        or not isinstance(sample_rate, int | np.integer)
+        or not (8000 <= sample_rate <= 192000)
+    ):
+        raise ParameterError(
+            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
+        )
