@@ -26,3 +26,8 @@ def test_panels(tmp_path, trains, pans, panels):
     assert (tmp_path / "r.png").stat().st_size > 10_000
     t, lo, hi = _columns(ds, MAX_COLUMNS)
     assert t.size <= MAX_COLUMNS and lo.min() == ds.wave_min.min() and hi.max() == ds.wave_max.max()
+    # the ticks in the waveform panel: one colour per metronome (grey: none)
+    marks = [line for line in fig.axes[0].lines if line.get_marker() == "|"]
+    colours = {line.get_color() for line in marks}
+    assert colours == {colour(m) for m in set(ds.tick_metronome.values.tolist())}
+    assert {colour(m) for m in range(len(trains))} <= colours

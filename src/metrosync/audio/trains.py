@@ -164,8 +164,8 @@ def _nearest(times: np.ndarray, pool: np.ndarray, target: float) -> tuple[int, f
 
 def _walk(t: np.ndarray, p: int, d: float, beats: int = 6) -> tuple[int, float, float]:
     """(hits, mean error (s) where a swing predicted, beat) of a short walk from t[p]
-    with a first beat d: once a full swing has been heard, each tick is predicted one swing after the tick
-    two beats back; the beat returned is half the last swing heard."""
+    with a first beat d: once a full swing has been heard, each tick is predicted one
+    swing after the tick two beats back; the beat returned is half the last swing."""
     when = [t[p]]
     hits, err, last, swing = 0, 0.0, 0, 2 * d
     for n in range(1, beats + 1):
