@@ -61,6 +61,8 @@ MASKED_TOLERANCE = 4e-3
 MAX_MISSING = 6
 MIN_COVERAGE = 0.5
 LOCKED_SPREAD = 0.04
+#: Largest spread (s) of the lag of a train that is part of another's ticks.
+PART_LAG_SPREAD = 0.3e-3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
 
@@ -318,12 +320,18 @@ def drop_shared(trains: list[Train], voice: list[int]) -> tuple[list[Train], lis
             [v for v, k in zip(voice, keep, strict=True) if k])  # fmt: skip
 
 
-def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int]):
+def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strength=None):
     """Trains that are part of another's ticks, folded into it: (trains, voices,
-    indices of the folded ticks). A train is part of another when its period is a
-    multiple (2 or more) of the other's and its ticks keep a fixed lag, within
-    `MAX_TICK_LENGTH`, to the other's: a later impact of a real tick that sounds
-    different every few ticks, or the pre-echo a lossy coder smears ahead of a click."""
+    indices of the folded ticks).
+
+    A train B is part of a train A when B's ticks keep a fixed lag (spread below
+    `PART_LAG_SPREAD`), within `MAX_TICK_LENGTH`, to A's, and either B's period is a
+    multiple (2 or more) of A's (a sound ahead of or after every few ticks: the
+    pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
+    A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
+    different from the first. Two metronomes locked a few milliseconds apart keep a
+    lag that wanders by more than that, as each one's beat jitters.
+    """
     keep = [True] * len(trains)
     folded = []
     for b, tb in enumerate(trains):
@@ -332,18 +340,31 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int]):
                 continue
             ratio = tb.period / ta.period
             k = round(ratio)
-            if k < 2 or abs(ratio - k) > 0.01 * k:
+            if k < 1 or abs(ratio - k) > 0.01 * k:
                 continue
             t_a, t_b = times[ta.index], times[tb.index]
             j = np.clip(np.searchsorted(t_a, t_b), 1, t_a.size - 1)
             lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
                            t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
-            if abs(np.median(lag)) < MAX_TICK_LENGTH and np.std(lag) < LAG_BIN * 1.5:
-                keep[b] = False
-                folded.append(tb.index[~tb.masked])
-                break
+            middle = float(np.median(lag))
+            if abs(middle) >= MAX_TICK_LENGTH or _robust_spread(lag) >= PART_LAG_SPREAD:
+                continue
+            if k == 1:
+                if middle <= 0 or strength is None:
+                    continue
+                if np.mean(strength[tb.index]) >= np.mean(strength[ta.index]) - 1.0:
+                    continue
+            keep[b] = False
+            folded.append(tb.index[~tb.masked])
+            break
     return ([t for t, k in zip(trains, keep, strict=True) if k],
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
+
+
+def _robust_spread(x: np.ndarray) -> float:
+    """1.4826 × the median absolute deviation: a standard deviation that a few odd
+    values (a masked tick) do not inflate."""
+    return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
 
 def join_tick_and_tock(times: np.ndarray, trains: list[Train], voice: list[int]):

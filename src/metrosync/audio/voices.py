@@ -5,10 +5,12 @@ impact onset (K,) and returns `Features`; `cluster_voices(features)` groups the
 impacts into voices and returns `Voices`, whose ``labels`` (K,) are 0..V−1, or −1 for
 an impact that sounds like none of them (two ticks at once, a bump, a stray sound).
 
-Features. The first `FEATURE_LENGTH` of sound after the onset (channels averaged,
-tapered) is cut into `BANDS` bands spaced evenly in log frequency from `LOW_EDGE` to
-16 kHz (or 0.45 × the rate); the feature is each band's level in dB minus the mean
-over the bands: the spectral shape, whatever the loudness. Two metronomes of
+Features. The power spectrum of the first `FEATURE_LENGTH` of sound after the onset
+(tapered), less that of as long just before it (the ringing of an earlier tick, which
+goes on), is cut into `BANDS` bands spaced evenly in log frequency from `LOW_EDGE` to
+16 kHz (or 0.45 × the rate); the feature is each band's level in dB (at least
+`BAND_RANGE` below the loudest band: fainter bands hold noise) minus the mean over the
+bands: the spectral shape, whatever the loudness. Two metronomes of
 different makes differ there more than in loudness, and a microphone, a room or a
 phone's filter colours every tick alike. The loudness itself (dB, weighted by
 `LEVEL_WEIGHT`) and, with several channels, each channel's level minus their mean
@@ -47,6 +49,8 @@ BANDS = 16
 LOW_EDGE = 500.0
 HIGH_EDGE = 16000.0
 LEVEL_WEIGHT = 0.5
+#: Band levels are counted down to this far (dB) below the loudest band.
+BAND_RANGE = 30.0
 MAX_VOICES = 8
 RESTARTS = 4
 MIN_SEPARATION = 4.0
@@ -117,18 +121,25 @@ def impact_features(recording: Recording, times: np.ndarray, *, chunk: int = 409
     nfft = fft.next_fast_len(max(1024, 2 * length))
     taper = signal.windows.tukey(length, 0.3).astype(np.float32)
     bands = _bands(rate, nfft)
-    starts = np.round(np.asarray(times) * rate).astype(np.int64) - lead
+    # the same length before the onset too: what was already sounding is taken off
+    starts = np.round(np.asarray(times) * rate).astype(np.int64) - lead - length
     k, c = starts.size, recording.channels
     shape = np.empty((k, BANDS))
     level = np.empty(k)
     channel = np.zeros((k, c))
     if k == 0:
         return Features(shape, level, channel)
-    for first, seg in _segments(recording, starts, length, chunk):
+    for first, seg in _segments(recording, starts, 2 * length, chunk):
         sl = slice(first, first + seg.shape[0])
-        spectra = np.abs(fft.rfft(seg * taper[None, :, None], n=nfft, axis=1)) ** 2
-        per_channel = np.einsum("bf,nfc->nbc", bands, spectra) + 1e-14
+        power = []
+        for part in (seg[:, :length], seg[:, length:]):
+            spectra = np.abs(fft.rfft(part * taper[None, :, None], n=nfft, axis=1)) ** 2
+            power.append(np.einsum("bf,nfc->nbc", bands, spectra))
+        before, after = power
+        per_channel = np.maximum(after - before, 1e-3 * after) + 1e-14
         mixed = 10 * np.log10(per_channel.mean(axis=2))
+        # bands far below the loudest hold noise and the rounding of the onset
+        mixed = np.maximum(mixed, mixed.max(axis=1, keepdims=True) - BAND_RANGE)
         level[sl] = 10 * np.log10(per_channel.sum(axis=1).mean(axis=1))
         shape[sl] = mixed - mixed.mean(axis=1, keepdims=True)
         if c > 1:
