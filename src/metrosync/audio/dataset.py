@@ -204,6 +204,7 @@ def analyze_audio(
         band=list(scan.band),
         sensitivity=sensitivity,
         refractory=refractory,
+        resolution=max(refractory, det.RESOLUTION),
         order_window=acoustic.window,
         order_step=acoustic.step,
         cluster_gap=cluster_gap,

@@ -46,6 +46,9 @@ from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY
 HOP = 0.5e-3
 AHEAD = 1.0e-3
 PAST = 4.0e-3
+#: A tick that starts less than this after another is hidden in the detection curve
+#: (it sees the other's power as its own background), s.
+RESOLUTION = PAST + AHEAD
 THRESHOLD_SPAN = 2.0
 MIN_RISE = 6.0
 #: Samples at or above this magnitude count as clipped.

@@ -30,6 +30,8 @@ from .voices import MIN_SEPARATION, Voices, cluster_voices, impact_features
 
 #: Share of a voice's ticks that its trains must hold for the voice to stand.
 CARRIED = 0.5
+#: Largest share of a train's ticks taken from other voices.
+MOST_BORROWED = 0.25
 
 
 @dataclass(frozen=True)
@@ -139,7 +141,11 @@ def _trains(times, strength, voices: Voices, beat_range):
 
 def _all_voices_carry(head, voices: Voices, found, groups) -> bool:
     """Each voice has at least `CARRIED` of its ticks in trains of its own, or in trains
-    of other voices as ticks that hid theirs (a voice of ticks that fall together)."""
+    of other voices as ticks that hid theirs (a voice of ticks that fall together), and
+    no train borrows more than `MOST_BORROWED` of its ticks from other voices (a voice
+    split in two by chance leaves each half with holes that the other fills)."""
+    if any(t.masked.mean() > MOST_BORROWED for t in found):
+        return False
     for v in range(voices.count):
         mine = head & (voices.labels == v)
         if not mine.any():  # folded into another voice's ticks

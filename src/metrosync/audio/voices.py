@@ -53,7 +53,7 @@ LEVEL_WEIGHT = 0.5
 BAND_RANGE = 30.0
 MAX_VOICES = 8
 RESTARTS = 4
-MIN_SEPARATION = 4.0
+MIN_SEPARATION = 5.0
 MIN_SHARE = 0.02
 OUTLIER = 4.0
 #: Smallest spread a voice is credited with, dB: identical clicks vary by less, and
