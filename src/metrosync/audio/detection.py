@@ -25,11 +25,12 @@ below the noise of 16-bit sound (−100 dBFS) do not count.
 Onset times. Around each tick the waveform (channels averaged) is band-passed again
 with the same filter run forwards and backwards (no delay), and its envelope taken
 (Hilbert). The onset is the instant, interpolated between samples, at which the
-envelope first rises, within `RISE_WINDOW` before the tick's peak, through halfway
-between the background before the tick and the peak, a quarter of the way (a tick's resonances can beat
-and dip after its first impact; the first rise is its onset): for a click that starts abruptly it is the click's first sample within a
+envelope first rises, within `RISE_WINDOW` before the tick's peak, through
+`ONSET_FRACTION` (a quarter) of the way from the background before the tick to the
+peak (a tick's resonances can beat and dip after its first impact; the first rise is
+its onset): for a click that starts abruptly it is the click's first sample within a
 few tens of microseconds, and echoes, which come later, do not move it. The strength
-of a tick is its envelope peak (dBFS), also per channel, which stereo attribution uses.
+of a tick is its envelope peak (dBFS), also per channel.
 """
 
 from __future__ import annotations
