@@ -43,6 +43,7 @@ from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
+from .recovery import recover
 from .separation import separate, sureness, tick_length_words
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
@@ -117,6 +118,7 @@ def analyze_audio(
     where = np.full(impacts.time.size, -1, dtype=np.int64)
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
+    ticks, trains, recovered = recover(recording, scan, ticks, trains)
     if trains:
         period = 60.0 / heard
     else:
@@ -149,7 +151,7 @@ def analyze_audio(
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
-    label = sep.labels()[heads]
+    label = _labels(k, trains)
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)
@@ -199,6 +201,7 @@ def analyze_audio(
         metronomes=n,
         metronomes_source=source,
         impacts=int(impacts.time.size),
+        ticks_recovered=recovered,
         tick_structure=tick_length_words(sep),
         ticks_per_beat=per_beat,
         band=list(scan.band),
@@ -240,6 +243,18 @@ def _pendulum_phases(kept: list, dt: float) -> xr.Dataset:
     coords = {"time": ("time", grid, {"units": "s", "long_name": "time in the recording"})}
     attrs = {"r_eq": r_eq, "sigma_bpm": ph.frequency_spread(freq)}
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _labels(k: int, trains: list[Train]) -> np.ndarray:
+    """(K,) the metronome of each tick: the one train that holds it (−1: none, or two
+    trains share it, their ticks fell together)."""
+    claims = np.zeros(k, dtype=np.int64)
+    for t in trains:
+        claims[t.index] += 1
+    out = np.full(k, -1, dtype=np.int8)
+    for m, t in enumerate(trains):
+        out[t.index[claims[t.index] == 1]] = m
+    return out
 
 
 def _on_ticks(train: Train, where: np.ndarray) -> Train:

@@ -27,8 +27,9 @@ with the same filter run forwards and backwards (no delay), and its envelope tak
 (Hilbert). The onset is the instant, interpolated between samples, at which the
 envelope first rises, within `RISE_WINDOW` before the tick's peak, through
 `ONSET_FRACTION` (a quarter) of the way from the background before the tick to the
-peak (a tick's resonances can beat and dip after its first impact; the first rise is
-its onset): for a click that starts abruptly it is the click's first sample within a
+peak, and `NOISE_CLEARANCE` robust spreads above that background (at most halfway):
+a tick's resonances can beat and dip after its first impact, whose onset is wanted.
+For a click that starts abruptly it is the click's first sample within a
 few tens of microseconds, and echoes, which come later, do not move it. The strength
 of a tick is its envelope peak (dBFS), also per channel.
 """
@@ -61,6 +62,9 @@ DISPLAY_HOPS = 10
 ONSET_FRACTION = 0.25
 #: The onset is sought this far before the envelope's peak, s.
 RISE_WINDOW = 2.5e-3
+#: ... and at least this many robust spreads of the envelope before the tick above its
+#: median (at most halfway up).
+NOISE_CLEARANCE = 6.0
 #: Half-width of the waveform window timed around each tick, s.
 REFINE_HALF = 6e-3
 #: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
@@ -289,8 +293,12 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
     ip = lo + np.argmax(env[:, lo:hi], axis=1)
     rows = np.arange(env.shape[0])
     peak = env[rows, ip]
-    background = np.median(env[:, : half - 2 * hop], axis=1)
-    level = background + ONSET_FRACTION * (peak - background)
+    before = env[:, : half - 2 * hop]
+    background = np.median(before, axis=1)
+    noise = 1.4826 * np.median(np.abs(before - background[:, None]), axis=1)
+    # a quarter of the way up, and clear of the noise before the tick
+    clear = np.minimum(background + NOISE_CLEARANCE * noise, 0.5 * (peak + background))
+    level = np.maximum(background + ONSET_FRACTION * (peak - background), clear)
     # the first rise through the level within `RISE_WINDOW` before the peak: a tick's
     # resonances can beat and dip after its first impact, whose onset is wanted
     cols = np.arange(env.shape[1])

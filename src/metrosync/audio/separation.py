@@ -135,7 +135,7 @@ def _trains(times, strength, voices: Voices, beat_range):
     found, of_voice, folded = tr.fold_parts(times, found, of_voice, strength)
     for index in folded:
         head[index] = False
-    found, groups = tr.join_tick_and_tock(times, found, of_voice)
+    found, groups = tr.join_fragments(times, found, of_voice)
     return head, gaps, found, groups
 
 

@@ -8,8 +8,9 @@ Contract:
   from a seed through the whole recording.
 * `trains_of_voice(times, own, period)` → the `Train` s of one voice: one per
   metronome that sounds like it, told apart by their tempo and phase.
-* `join_tick_and_tock(trains)`: two trains of different voices that are the tick and
-  the tock of one metronome become one.
+* `join_fragments(times, trains, voices)`: trains that are pieces of one metronome's
+  beat (its tick and its tock when they sound different, or every third tick heard in
+  one voice and the rest in another) become one.
 
 A tick is one event. A real tick is a main impact and one to three more 15–35 ms
 later, ringing for tens of milliseconds. How far a tick reaches is read from the
@@ -35,12 +36,15 @@ Two metronomes of one sound. The train found first takes its ticks; from what is
 the next train is sought, and so on: two metronomes 4 BPM apart share a sound but not a
 beat. A train with fewer than `MIN_COVERAGE` of its beats heard is not a metronome.
 
-Tick and tock. A metronome whose tick and tock sound different is heard as two voices,
-each ticking once per swing; they are one metronome when their trains have the same
-period (within 1 %) and one falls at a fixed point (circular spread below
-`LOCKED_SPREAD` of a period) between 25 and 75 % of the other's period. (Two
-metronomes locked a quarter of a swing apart would be taken for one; synchronized
-metronomes tick together, near 0 %.)
+Pieces of one metronome. A metronome whose tick and tock sound different is heard as
+two voices, each ticking once per swing; ringing and overlaps can split its ticks
+among voices in other patterns too. Two trains are one metronome when both periods
+are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %), and
+the second's ticks fall on the first's grid of beats T (circular spread below
+2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp), almost
+never (10 %) within 0.3 T of the first's own ticks. (Two metronomes locked a whole
+number of beats apart at whole-number ratios of tempo would be taken for one;
+synchronized metronomes tick together, on each other's ticks.)
 """
 
 from __future__ import annotations
@@ -61,6 +65,8 @@ MASKED_TOLERANCE = 4e-3
 MAX_MISSING = 6
 MIN_COVERAGE = 0.5
 LOCKED_SPREAD = 0.04
+#: Largest multiple of a metronome's beat that a piece of its train may tick at.
+MAX_FRAGMENT = 6
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
@@ -367,47 +373,64 @@ def _robust_spread(x: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
 
-def join_tick_and_tock(times: np.ndarray, trains: list[Train], voice: list[int]):
-    """Pairs of trains that are one metronome's tick and tock (of different voices, or
-    of one voice whose ticks were followed every other beat), joined: (trains, voices
-    of each (tuple))."""
+def join_fragments(times: np.ndarray, trains: list[Train], voice: list[int]):
+    """Trains that are pieces of one metronome's beat, joined: (trains, voices of each
+    (tuple)). See the module docstring."""
     trains, groups = list(trains), [(v,) for v in voice]
     joined = True
     while joined:
         joined = False
         for a in range(len(trains)):
-            for b in range(a + 1, len(trains)):
-                ta, tb = trains[a], trains[b]
-                if abs(ta.period / tb.period - 1) > 0.01 or ta.period / 2 < BEAT_RANGE[0]:
+            for b in range(len(trains)):
+                if a == b:
                     continue
-                t0 = times[ta.index]
-                tb_times = times[tb.index]
-                inside = (tb_times > t0[0]) & (tb_times < t0[-1])
-                if inside.sum() < 4:
+                beat = _common_beat(times, trains[a], trains[b])
+                if beat is None:
                     continue
-                k = np.searchsorted(t0, tb_times[inside]) - 1
-                frac = (tb_times[inside] - t0[k]) / ta.period
-                z = np.exp(2j * np.pi * frac).mean()
-                spread = math.sqrt(max(0.0, -2 * math.log(max(abs(z), 1e-12)))) / (2 * np.pi)
-                where = (np.angle(z) / (2 * np.pi)) % 1.0
-                if spread < LOCKED_SPREAD and 0.25 <= where <= 0.75:
-                    trains[a] = _merge(times, ta, tb)
-                    groups[a] = groups[a] + groups[b]
-                    del trains[b], groups[b]
-                    joined = True
-                    break
+                trains[a] = _merge(times, trains[a], trains[b], beat)
+                groups[a] = groups[a] + groups[b]
+                del trains[b], groups[b]
+                joined = True
+                break
             if joined:
                 break
     return trains, groups
 
 
-def _merge(times, ta: Train, tb: Train) -> Train:
+def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
+    """The beat T of which both trains' periods are whole multiples (up to
+    `MAX_FRAGMENT`) and on whose grid, laid from train a, b's ticks fall at a fixed
+    place between a's ticks; None if there is none."""
+    t_a, t_b = times[ta.index], times[tb.index]
+    inside = (t_b > t_a[0]) & (t_b < t_a[-1])
+    if inside.sum() < 4:
+        return None
+    for ka in range(1, MAX_FRAGMENT + 1):
+        beat = ta.period / ka
+        kb = round(tb.period / beat)
+        if beat < BEAT_RANGE[0] or kb < 1 or ka * kb == 1:
+            continue
+        if abs(tb.period / (kb * beat) - 1) > 0.01:
+            continue
+        k = np.searchsorted(t_a, t_b[inside]) - 1
+        gap_before = t_b[inside] - t_a[k]
+        gap_after = t_a[np.minimum(k + 1, t_a.size - 1)] - t_b[inside]
+        if np.mean(np.minimum(gap_before, gap_after) < 0.3 * beat) > 0.1:
+            continue  # on a's own ticks: two metronomes ticking together
+        z = np.exp(2j * np.pi * gap_before / beat).mean()
+        spread = math.sqrt(max(0.0, -2 * math.log(max(abs(z), 1e-12)))) / (2 * np.pi)
+        off_grid = abs(np.angle(z) / (2 * np.pi))
+        if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
+            return beat
+    return None
+
+
+def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
     index = np.concatenate([ta.index, tb.index])
     masked = np.concatenate([ta.masked, tb.masked])
     order = np.argsort(times[index], kind="stable")
     index, masked = index[order], masked[order]
-    half = 0.5 * ta.period
     t = times[index]
-    steps = np.maximum(1, np.rint(np.diff(t) / half)).astype(np.int64)
+    steps = np.maximum(1, np.rint(np.diff(t) / beat)).astype(np.int64)
     beat = np.concatenate([[0], np.cumsum(steps)])
     return Train(index, beat, float((t[-1] - t[0]) / beat[-1]), masked)

@@ -51,7 +51,7 @@ HIGH_EDGE = 16000.0
 LEVEL_WEIGHT = 0.5
 #: Band levels are counted down to this far (dB) below the loudest band.
 BAND_RANGE = 30.0
-MAX_VOICES = 8
+MAX_VOICES = 16
 RESTARTS = 4
 MIN_SEPARATION = 5.0
 MIN_SHARE = 0.02
