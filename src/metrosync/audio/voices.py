@@ -32,12 +32,10 @@ two metronomes of one make are one voice (`trains` sorts that out).
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import fft, signal
-from scipy.cluster.vq import kmeans2
 
 from .detection import _segments
 from .reader import Recording
@@ -60,7 +58,7 @@ OUTLIER = 4.0
 #: must not make voices of their rounding.
 SPREAD_FLOOR = 1.0
 #: Impacts clustered at most (a random sample; the rest go to the nearest centre).
-SAMPLE = 6000
+SAMPLE = 4000
 
 
 @dataclass(frozen=True)
@@ -193,16 +191,47 @@ def _assign(x: np.ndarray, centres: np.ndarray, sep: float, tried: dict) -> Voic
     return Voices(out, int(centres.shape[0]), float(sep), dict(tried))
 
 
-def _kmeans(x: np.ndarray, v: int, rng) -> tuple[np.ndarray, np.ndarray]:
+def _kmeans(x: np.ndarray, v: int, rng, iterations: int = 30):
+    """(centres (v, D), labels (K,)): Lloyd's k-means from k-means++ seeds, the best of
+    `RESTARTS`."""
     best, best_cost = None, math.inf
+    norms = np.einsum("ij,ij->i", x, x)
     for _ in range(RESTARTS):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # "one of the clusters is empty": judged below
-            centres, labels = kmeans2(x, v, minit="++", iter=30, seed=rng)
+        centres = _plus_plus(x, norms, v, rng)
+        labels = np.zeros(x.shape[0], dtype=np.int64)
+        for _ in range(iterations):
+            new = np.argmin(_distances2(x, norms, centres), axis=1)
+            if _ > 0 and np.array_equal(new, labels):
+                break
+            labels = new
+            for j in range(v):
+                mine = labels == j
+                if mine.any():  # an empty cluster keeps its centre; judged by its size
+                    centres[j] = x[mine].mean(axis=0)
         cost = float(np.sum((x - centres[labels]) ** 2))
         if cost < best_cost:
             best, best_cost = (centres, labels), cost
     return best
+
+
+def _distances2(x: np.ndarray, norms: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(K, v) squared distances. einsum, not a matrix product: these products are too
+    small for BLAS, whose threads only cost time on a busy machine."""
+    cross = np.einsum("kd,vd->kv", x, centres)
+    return norms[:, None] - 2 * cross + np.einsum("vd,vd->v", centres, centres)[None, :]
+
+
+def _plus_plus(x: np.ndarray, norms: np.ndarray, v: int, rng) -> np.ndarray:
+    """k-means++ seeds: each next centre drawn with probability ∝ squared distance."""
+    centres = [x[rng.integers(x.shape[0])]]
+    d2 = _distances2(x, norms, centres[0][None, :])[:, 0]
+    for _ in range(1, v):
+        p = np.maximum(d2, 0)
+        total = p.sum()
+        pick = rng.choice(x.shape[0], p=p / total) if total > 0 else rng.integers(x.shape[0])
+        centres.append(x[pick])
+        d2 = np.minimum(d2, _distances2(x, norms, x[pick][None, :])[:, 0])
+    return np.array(centres, dtype=float)
 
 
 def _min_separation(x: np.ndarray, labels: np.ndarray, centres: np.ndarray) -> float:
