@@ -99,16 +99,18 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     order = np.argsort(loud)[::-1]
     found = [found[i] for i in order]
     groups = [groups[i] for i in order]
-    distinct = len({g for gs in groups for g in gs})
-    per_voice = len(found) > len({gs[0] for gs in groups})
+    sets = [frozenset(g) for g in groups]
+    shared = sum(a & b != frozenset() for i, a in enumerate(sets) for b in sets[i + 1 :])
+    pairs = len(sets) * (len(sets) - 1) // 2
     if len(found) == 1:
         method = "one metronome"
-    elif distinct > 1 and per_voice:
-        method = "sound and tempo"
-    elif distinct > 1:
+    elif shared == 0:
         method = "sound"
-    else:
+    elif shared == pairs and len(set(sets)) == 1:
         method = "tempo"
+    else:
+        method = "sound and tempo"
+    distinct = len(set().union(*sets))
     placed = np.zeros(times.size, dtype=bool)
     for t in found:
         placed[t.index] = True
@@ -163,8 +165,9 @@ def _all_voices_carry(head, voices: Voices, found, groups) -> bool:
 
 
 def tick_length_words(sep: Separation) -> str:
-    """The ticks' structure in words, e.g. "a tick reaches 32 ms (several impacts)"."""
-    g = sep.gaps[np.isfinite(sep.gaps)] if sep.gaps.size else np.zeros(0)
-    if not g.size or g.max() <= 0:
-        return "one impact per tick"
-    return f"a tick's impacts span up to {1e3 * g.max():.0f} ms, counted as one tick"
+    """The ticks' structure in words, e.g. "grouped into 120 ticks (2.0 impacts each)"."""
+    ticks = int(sep.head.sum())
+    per = sep.head.size / max(ticks, 1)
+    if per < 1.05:
+        return f"{ticks} ticks, one impact each"
+    return f"grouped into {ticks} ticks ({per:.1f} impacts each, a tick counted once)"

@@ -23,7 +23,7 @@ def summary_text(ds) -> str:
         f"{a['sample_rate']} Hz, {a['duration']:.1f} s)",
         f"  ticks: {k}, beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
         f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",
-        f"  {a['impacts']} impacts heard; {a['tick_structure']}"
+        f"  impacts heard: {a['impacts']}, {a['tick_structure']}"
         + (
             f"; {a['ticks_recovered']} ticks hidden by others found again where their "
             f"metronome's beat put them"
