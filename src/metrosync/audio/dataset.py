@@ -57,7 +57,7 @@ GRID_DT = 0.1
 
 
 def analyze_audio(
-    path: str | Path,
+    path: str | Path | list[str | Path],
     *,
     bpm: float | None = None,
     metronomes: int | None = None,
@@ -72,7 +72,9 @@ def analyze_audio(
 
     Parameters
     ----------
-    path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`).
+    path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`), mono or with a
+        channel per microphone; or a list of files recorded together, one per
+        microphone, aligned by their cross-correlation (`metrosync.audio.together`).
     bpm : the metronomes' setting, BPM; default: found from the ticks.
     metronomes : how many metronomes sound; default: the ticks per beat in the windows
         where they were least together (95th percentile), rounded.
@@ -89,7 +91,15 @@ def analyze_audio(
     xarray.Dataset, described in the module docstring.
     """
     _check_options(bpm, metronomes, sensitivity, refractory, order_window, cluster_gap)
-    recording = open_recording(path)
+    if isinstance(path, list | tuple):
+        if len(path) == 1:
+            recording = open_recording(path[0])
+        else:
+            from .together import record_together
+
+            recording = record_together(path, band=band)
+    else:
+        recording = open_recording(path)
     rate = recording.sample_rate
     from ..progress import progress_bar
 
@@ -185,6 +195,8 @@ def analyze_audio(
     ds.attrs.update(pendulums.attrs)
     ds.attrs.update(
         path=str(recording.path),
+        paths=list(getattr(recording, "names", ())) or [str(recording.path)],
+        offsets=(np.asarray(getattr(recording, "offsets", [0])) / rate).tolist(),
         sample_rate=rate,
         channels=recording.channels,
         duration=recording.duration,
