@@ -32,6 +32,8 @@ from .voices import MIN_SEPARATION, Voices, cluster_voices, impact_features
 CARRIED = 0.5
 #: Largest share of a train's ticks taken from other voices.
 MOST_BORROWED = 0.25
+#: Smallest share of its beats a metronome's train holds.
+MIN_JOINED_COVERAGE = 0.55
 
 
 @dataclass(frozen=True)
@@ -145,8 +147,9 @@ def _all_voices_carry(head, voices: Voices, found, groups) -> bool:
     """Each voice has at least `CARRIED` of its ticks in trains of its own, or in trains
     of other voices as ticks that hid theirs (a voice of ticks that fall together), and
     no train borrows more than `MOST_BORROWED` of its ticks from other voices (a voice
-    split in two by chance leaves each half with holes that the other fills)."""
-    if any(t.masked.mean() > MOST_BORROWED for t in found):
+    split in two by chance leaves each half with holes that the other fills) or, joined
+    from pieces, has fewer than `MIN_JOINED_COVERAGE` of its beats."""
+    if any(t.masked.mean() > MOST_BORROWED or t.coverage < MIN_JOINED_COVERAGE for t in found):
         return False
     for v in range(voices.count):
         mine = head & (voices.labels == v)

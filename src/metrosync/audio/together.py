@@ -11,12 +11,15 @@ Alignment. Each file's detection curve (`detection.scan`: the rise of its band p
 every 0.5 ms) is clipped at 0 dB and cross-correlated with the first file's (FFT);
 the lag of the highest peak within `MAX_OFFSET` is the coarse offset. It is refined to
 a sample by cross-correlating the band-passed waveforms over `REFINE_SPAN` around the
-loudest stretch, within ±2 hops of it. The files must share a sample rate. Frames of
-a file before its start or after its end read as silence.
+loudest stretch, within ±2 hops of it. Files whose curves correlate less than
+`MIN_LIKENESS` at the best offset draw a warning: they hardly sound recorded together.
+The files must share a sample rate. Frames of a file before its start or after its
+end read as silence.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +32,9 @@ from .reader import BLOCK_FRAMES, AudioFileError, Recording, open_recording
 
 #: Largest start difference searched, s.
 MAX_OFFSET = 60.0
+#: Below this correlation of the detection curves at the best offset, the files are
+#: said not to match.
+MIN_LIKENESS = 0.2
 #: Stretch of waveform used to refine the offset to a sample, s.
 REFINE_SPAN = 10.0
 
@@ -102,7 +108,18 @@ def _offset(first: Recording, scan0, other: Recording, scan1) -> int:
     values = np.concatenate([corr[: a.size], corr[n - b.size + 1 :]])
     most = round(MAX_OFFSET / (hop / first.sample_rate))
     values[np.abs(lags) > most] = -np.inf
-    coarse = int(lags[int(np.argmax(values))]) * hop  # first's frame = other's frame + coarse
+    best = int(np.argmax(values))
+    coarse = int(lags[best]) * hop  # first's frame = other's frame + coarse
+    likeness = float(values[best] / np.sqrt(np.sum(a * a) * np.sum(b * b)))
+    if likeness < MIN_LIKENESS:
+        warnings.warn(
+            f"{str(other.path)!r} and {str(first.path)!r} hardly match at any offset "
+            f"(correlation {likeness:.2f} at best): were they recorded at the same time, "
+            f"of the same metronomes? The analysis goes on with the best offset, "
+            f"{coarse / first.sample_rate:.3f} s.",
+            UserWarning,
+            stacklevel=3,
+        )
     # refine on the waveforms around the first file's loudest stretch
     span = round(REFINE_SPAN * first.sample_rate)
     centre = int(np.argmax(scan0.level)) * hop

@@ -42,7 +42,9 @@ among voices in other patterns too. Two trains are one metronome when both perio
 are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %), and
 the second's ticks fall on the first's grid of beats T (circular spread below
 2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp), almost
-never (10 %) within 0.3 T of the first's own ticks. (Two metronomes locked a whole
+never (10 %) within 0.3 T of the first's own ticks; or when one takes up the other's
+beat (the same period within 1 %, its first tick a whole number of beats, at most
+`MAX_BRIDGED`, within 15 %, after the other's last). (Two metronomes locked a whole
 number of beats apart at whole-number ratios of tempo would be taken for one;
 synchronized metronomes tick together, on each other's ticks.)
 """
@@ -67,6 +69,8 @@ MIN_COVERAGE = 0.5
 LOCKED_SPREAD = 0.04
 #: Largest multiple of a metronome's beat that a piece of its train may tick at.
 MAX_FRAGMENT = 6
+#: Most beats between a train's end and a train that takes up its beat.
+MAX_BRIDGED = 64
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
@@ -386,6 +390,8 @@ def join_fragments(times: np.ndarray, trains: list[Train], voice: list[int]):
                     continue
                 beat = _common_beat(times, trains[a], trains[b])
                 if beat is None:
+                    beat = _continues(times, trains[a], trains[b])
+                if beat is None:
                     continue
                 trains[a] = _merge(times, trains[a], trains[b], beat)
                 groups[a] = groups[a] + groups[b]
@@ -423,6 +429,19 @@ def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
         if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
             return beat
     return None
+
+
+def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
+    """The beat, when train b takes up train a's beat after a ended: one metronome
+    followed again after ticks of another hid it for more than `MAX_MISSING` beats."""
+    if abs(tb.period / ta.period - 1) > 0.01:
+        return None
+    end, start = times[ta.index[-1]], times[tb.index[0]]
+    beat = 0.5 * (ta.period + tb.period)
+    beats = (start - end) / beat
+    if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > 0.15:
+        return None
+    return beat
 
 
 def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
