@@ -110,3 +110,20 @@ def test_follow_with_a_recording_warns(capsys, pair_recording):
     code, _, err = run(capsys, "analyze", str(path), "--follow")
     assert code == 0
     assert "a recording ignores --follow" in err
+
+
+def test_three_of_our_own_clicks_in_a_mixture_are_three(capsys, tmp_path):
+    """`listen` three metronomes falling into step, then `analyze` it: three metronomes
+    near their 184.6 BPM, with or without the setting given, and no warning."""
+    wav = tmp_path / "t30.wav"
+    code, _, err = run(capsys, "listen", "--n", "3", "--sigma", "0.75", "--seed", "1",
+                       "--duration", "30", "--out", str(wav))  # fmt: skip
+    assert code == 0, err
+    for extra in ([], ["--bpm", "184.6"]):
+        code, out, err = run(capsys, "analyze", str(wav), *extra)
+        assert code == 0 and "warning" not in err, err
+        assert "metronomes: 3 (told apart by sound)" in out
+        bpms = [float(line.split(":")[1].split("±")[0]) for line in out.splitlines()
+                if line.startswith("  metronome ") and "BPM" in line]  # fmt: skip
+        assert len(bpms) == 3 and all(abs(b - 184.6) < 0.5 for b in bpms)
+        assert "= 184." in out
