@@ -35,7 +35,7 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import AnalysisError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
 from . import detection as det
@@ -52,6 +52,8 @@ from .trains import Train
 #: Default refractory time, s: impacts closer than this are heard as one. The impacts of
 #: one tick are grouped afterwards, from the recording's own tick structure.
 REFRACTORY = 3e-3
+#: Below this attribution confidence the ensemble's beat is found from the ticks alone.
+MIN_CONFIDENCE = 0.5
 #: Spacing of the r(t) grid, s (as the light gate's default).
 GRID_DT = 0.1
 
@@ -130,7 +132,14 @@ def analyze_audio(
     trains = [_on_ticks(t, where) for t in sep.trains]
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     if trains:
-        period = 60.0 / heard
+        # the ensemble's beat from all the ticks, near the metronomes' own tempi: where
+        # the trains went wrong (a very noisy recording) the ticks still set it
+        # (given a setting, or when unsure of the trains, as without them)
+        try:
+            sure = sep.confidence >= MIN_CONFIDENCE and bpm is None
+            period = beat_period(ticks.time, heard if sure else bpm)
+        except AnalysisError:
+            period = 60.0 / heard
     else:
         heard = 60.0 / beat_period(ticks.time)
         period = beat_period(ticks.time, bpm)
@@ -205,8 +214,8 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="the median of the metronomes' own tempi"
-        if trains
+        tempo_source="from the ticks, near the median of the metronomes' own tempi"
+        if trains and sep.confidence >= MIN_CONFIDENCE and bpm is None
         else "given (bpm)"
         if bpm is not None
         else "found from the ticks",
