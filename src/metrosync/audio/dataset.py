@@ -132,17 +132,20 @@ def analyze_audio(
     trains = [_on_ticks(t, where) for t in sep.trains]
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     if trains:
-        # the ensemble's beat from all the ticks, near the metronomes' own tempi: where
-        # the trains went wrong (a very noisy recording) the ticks still set it
-        # (given a setting, or when unsure of the trains, as without them)
-        try:
-            sure = sep.confidence >= MIN_CONFIDENCE and bpm is None
-            period = beat_period(ticks.time, heard if sure else bpm)
-        except AnalysisError:
-            period = 60.0 / heard
+        # the median of the metronomes' tempi; where the trains may have gone wrong (a
+        # very noisy recording), from all the ticks, as without trains
+        period, tempo_source = 60.0 / heard, "the median of the metronomes' own tempi"
+        near = bpm is not None and abs(heard / bpm - 1) <= HINT_RANGE
+        if sep.confidence < MIN_CONFIDENCE or near:
+            try:
+                period = beat_period(ticks.time, bpm if near else None)
+                tempo_source = "given (bpm)" if near else "found from the ticks"
+            except AnalysisError:
+                pass
     else:
         heard = 60.0 / beat_period(ticks.time)
         period = beat_period(ticks.time, bpm)
+        tempo_source = "given (bpm)" if bpm is not None else "found from the ticks"
     if bpm is not None:
         _check_bpm(bpm, heard)
     span = ticks.time[-1] - ticks.time[0]
@@ -214,11 +217,7 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="from the ticks, near the median of the metronomes' own tempi"
-        if trains and sep.confidence >= MIN_CONFIDENCE and bpm is None
-        else "given (bpm)"
-        if bpm is not None
-        else "found from the ticks",
+        tempo_source=tempo_source,
         metronomes=n,
         metronomes_source=source,
         impacts=int(impacts.time.size),
