@@ -7,13 +7,15 @@ Entry point::
                    impairments=Impairments(), duration=None, seed=0) -> Recording
 
 trains : sequence of `TickTrain`, one per metronome (1 to 8):
-    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None)`` — the onsets (s, at the
-    metronome) of each tick's FIRST impact, which ticks are tocks, the metronome's
-    sound (`metrosync.show.ticks.Voice`), its loudness, and optional per-tick level
-    factors (K,). Build them with
+    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)`` —
+    the onsets (s, at the metronome) of each tick's FIRST impact, which ticks are
+    tocks, the metronome's sound (`metrosync.show.ticks.Voice`), its loudness,
+    optional per-tick level factors (K,), and how much (s, std) the secondary impacts
+    of each tick wander about the voice's delays. Build them with
 
     - ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
-      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0)``:
+      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
+      bounce_jitter_s=0)``:
       a free-running metronome; ``bpm`` ticks per minute (tick and tock each count),
       the first tick at ``phase`` beats (0 ≤ phase < 1), beats alternating
       (1 ± limp/2)·T (limp = (long − short)/mean beat, a fraction, as
@@ -25,6 +27,14 @@ trains : sequence of `TickTrain`, one per metronome (1 to 8):
       of a run of `metrosync.simulate(..., trajectories=True)`: every crossing of θ_i
       through its escapement angle, upward a tick, downward a tock (audio time 0 at
       ``start``);
+    - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
+      phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
+      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
+      bounce_jitter_s=0, same_make=False)``: n metronomes drawn from the seed,
+      free-running (tempos at least ``min_bpm_gap`` apart) or ``locked`` (one tempo,
+      phases within ``phase_spread`` beats), distinct voices unless ``same_make``
+      (siblings of one voice, `Voice.sibling`) or ``same_voice`` (one voice): for
+      tests over many recordings;
     - ``metrosync.show.ticks.voices(n, seed)``: n voices that differ from each other.
       A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
       ``voice=`` from `voices` to metronomes that should sound different, the same
@@ -46,9 +56,10 @@ impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
     2. background noise at ``snr_db``: ``noise`` ("pink" or "white") Gaussian noise
        whose power is ``snr_db`` dB below the mean power of the signal so far (whole
        recording, each microphone);
-    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 25–90 Hz
-       sinusoid, 40–120 ms, peak 0.5–2 times the signal's peak) at uniform random
-       times, each on one random microphone;
+    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
+       sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
+       height; peak 0.5–2 times the signal's peak) at uniform random times, each on
+       one random microphone;
     4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
        and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
        high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay
@@ -67,6 +78,9 @@ impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
 duration : length, s (default: the last tick + 1 s). A tick at or after the end is
     refused.
 
+Layout: the trains are in `corpus_trains`, the impairments in `corpus_impairments`,
+the recording here; import everything from here (``from corpus import ...``).
+
 Returns `Recording`:
     samples : float32, (S,) for one microphone, (S, C) for several, in [−1, 1].
     sample_rate : Hz.
@@ -77,74 +91,44 @@ Returns `Recording`:
         onsets at microphone c.
     applied : what the impairments drew (band corners, bump times and microphones, …).
     ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
+    ``Recording.files(starts, clock_ppm)`` splits several microphones into one mono
+    recording each, as from phones started ``starts`` s late whose clocks run fast by
+    ``clock_ppm``, with the truth of each.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy import fft as sp_fft
+from corpus_impairments import COMPRESSOR_BLOCK, OUTPUT_PEAK, Impairments, impair
+from corpus_trains import (
+    BOUNCE_VARIANTS,
+    MAX_TRAINS,
+    TickTrain,
+    check_seed,
+    random_trains,
+    simulated_trains,
+    steady_train,
+)
 from scipy import signal
 
 from metrosync.errors import ParameterError
 from metrosync.show.ticks import Voice
 
+__all__ = [
+    "BOUNCE_VARIANTS", "COMPRESSOR_BLOCK", "MAX_MICROPHONES", "MAX_TRAINS", "OUTPUT_PEAK",
+    "Impairments", "Microphone", "Recording", "TickTrain", "TrainTruth", "make_recording",
+    "random_trains", "simulated_trains", "steady_train",
+]  # fmt: skip
+
 SPEED_OF_SOUND = 343.0  # m/s
 DISK_RADIUS = 0.27  # m, as in the experiment
-OUTPUT_PEAK = 0.9
-MAX_TRAINS = 8
 MAX_MICROPHONES = 8
-#: Samples per level measurement of the compressor.
-COMPRESSOR_BLOCK = 16
-
-
-@dataclass(frozen=True, eq=False)
-class TickTrain:
-    """The ticks of one metronome.
-
-    times : (K,) increasing onsets of each tick's first impact at the metronome, s, ≥ 0.
-    is_tock : (K,) True where the tick is a tock.
-    voice : the metronome's sound.
-    gain : its loudness (the tick's peak is ``gain · voice.level`` before impairments).
-    levels : (K,) optional factor on each tick's loudness.
-    """
-
-    times: np.ndarray
-    is_tock: np.ndarray
-    voice: Voice
-    gain: float = 1.0
-    levels: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        times = np.asarray(self.times, dtype=float)
-        is_tock = np.asarray(self.is_tock, dtype=bool)
-        if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(times < 0):
-            raise ParameterError(
-                f"`times` must be a 1-D array of finite times ≥ 0 s, got {times!r}."
-            )
-        if np.any(np.diff(times) <= 0):
-            raise ParameterError("`times` must be strictly increasing.")
-        if is_tock.shape != times.shape:
-            raise ParameterError(
-                f"`is_tock` must have the shape of `times` {times.shape}, got {is_tock.shape}."
-            )
-        if not isinstance(self.voice, Voice):
-            raise ParameterError(f"`voice` must be a Voice, got {self.voice!r}.")
-        if not (math.isfinite(self.gain) and self.gain > 0):
-            raise ParameterError(f"`gain` must be a number > 0, got {self.gain!r}.")
-        object.__setattr__(self, "times", times)
-        object.__setattr__(self, "is_tock", is_tock)
-        if self.levels is not None:
-            levels = np.asarray(self.levels, dtype=float)
-            if levels.shape != times.shape or np.any(levels <= 0):
-                raise ParameterError(
-                    f"`levels` must be {times.shape} positive factors, got {levels!r}."
-                )
-            object.__setattr__(self, "levels", levels)
 
 
 @dataclass(frozen=True)
@@ -164,78 +148,6 @@ class Microphone:
             raise ParameterError(f"`gains` must be ≥ 0, got {self.gains!r}.")
         if not all(math.isfinite(d) and 0 <= d <= 0.1 for d in self.delays):
             raise ParameterError(f"`delays` must be in [0, 0.1] s, got {self.delays!r}.")
-
-
-@dataclass(frozen=True)
-class Impairments:
-    """What the room, the phone and the hand do to the sound; all off by default.
-
-    See the module docstring for each step and its order.
-    """
-
-    reverb_rt60: float | None = None
-    reverb_drr_db: float = 6.0
-    snr_db: float | None = None
-    noise: str = "pink"
-    bumps: int = 0
-    phone_band: bool | tuple[float, float] = False
-    compression: bool = False
-    compression_threshold_db: float = -24.0
-    compression_ratio: float = 4.0
-    compression_attack_s: float = 0.003
-    compression_release_s: float = 0.1
-    clipping: float | None = None
-    resample_from: int | None = None
-    quantize_bits: int | None = None
-
-    def __post_init__(self) -> None:
-        if self.reverb_rt60 is not None and not (0.05 <= self.reverb_rt60 <= 3.0):
-            raise ParameterError(
-                f"`reverb_rt60` must be in [0.05, 3] s or None, got {self.reverb_rt60!r}."
-            )
-        if self.snr_db is not None and not (-20 <= self.snr_db <= 120):
-            raise ParameterError(f"`snr_db` must be in [-20, 120] dB or None, got {self.snr_db!r}.")
-        if self.noise not in ("pink", "white"):
-            raise ParameterError(f"`noise` must be 'pink' or 'white', got {self.noise!r}.")
-        if isinstance(self.bumps, bool) or not isinstance(self.bumps, int) or self.bumps < 0:
-            raise ParameterError(f"`bumps` must be an integer ≥ 0, got {self.bumps!r}.")
-        if not isinstance(self.phone_band, bool):
-            low, high = self.phone_band
-            if not (10 <= low < high):
-                raise ParameterError(
-                    f"`phone_band` must be True, False or (low, high) Hz with "
-                    f"10 ≤ low < high, got {self.phone_band!r}."
-                )
-        if not self.compression_ratio >= 1:
-            raise ParameterError(
-                f"`compression_ratio` must be ≥ 1, got {self.compression_ratio!r}."
-            )
-        if not (self.compression_attack_s > 0 and self.compression_release_s > 0):
-            raise ParameterError("`compression_attack_s` and `compression_release_s` must be > 0.")
-        if self.clipping is not None and not (0 < self.clipping < 1):
-            raise ParameterError(
-                f"`clipping` must be in (0, 1) (the fraction of the peak that reaches full "
-                f"scale) or None, got {self.clipping!r}."
-            )
-        if self.resample_from is not None and not (8000 <= self.resample_from <= 192000):
-            raise ParameterError(
-                f"`resample_from` must be a rate in [8000, 192000] Hz or None, got "
-                f"{self.resample_from!r}."
-            )
-        if self.quantize_bits is not None and self.quantize_bits not in (8, 16, 24):
-            raise ParameterError(
-                f"`quantize_bits` must be 8, 16, 24 or None, got {self.quantize_bits!r}."
-            )
-
-    @classmethod
-    def phone(cls, **changes) -> Impairments:
-        """A phone on a table in a room, everything on: RT60 0.4 s, noise at 30 dB,
-        two bumps, the phone's band, compression, 48 kHz resampled, 16 bits (no
-        clipping: add ``clipping=0.8`` for a recording made too loud)."""
-        base = dict(reverb_rt60=0.4, snr_db=30.0, bumps=2, phone_band=True,
-                    compression=True, resample_from=48000, quantize_bits=16)  # fmt: skip
-        base.update(changes)
-        return cls(**base)
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,96 +188,56 @@ class Recording:
     def channels(self) -> int:
         return 1 if self.samples.ndim == 1 else self.samples.shape[1]
 
+    def files(
+        self, starts: Sequence[float] | None = None, clock_ppm: Sequence[float] | None = None
+    ) -> list[Recording]:
+        """One mono recording per microphone, as if each were a phone of its own
+        started ``starts[c]`` s (≥ 0, default 0) after the first: its samples from
+        there on, its truth the onsets at that microphone minus its start (ticks
+        before the start left out; ``gains``, ``delays`` of that microphone).
+
+        clock_ppm : (C,) how fast each phone's clock runs, parts per million (default
+            0; phones differ by tens): a phone whose clock is fast by ε·10⁶ ppm takes
+            (1 + ε) times as many samples per second as it says, so its file is
+            resampled (FFT) to (1 + ε) times as many samples and its truth times
+            are (t − start)·(1 + ε). Over a minute, 20 ppm moves the ticks by 1.2 ms.
+        """
+        starts = [0.0] * self.channels if starts is None else [float(s) for s in starts]
+        if len(starts) != self.channels or not all(0 <= s < self.duration for s in starts):
+            raise ParameterError(
+                f"`starts` must hold {self.channels} times in [0, {self.duration:g}) s, got "
+                f"{starts!r}."
+            )
+        ppm = [0.0] * self.channels if clock_ppm is None else [float(p) for p in clock_ppm]
+        if len(ppm) != self.channels or not all(abs(p) <= 1000 for p in ppm):
+            raise ParameterError(
+                f"`clock_ppm` must hold {self.channels} values in [-1000, 1000] ppm, got "
+                f"{clock_ppm!r}."
+            )
+        samples = self.samples.reshape(self.samples.shape[0], -1)
+        out = []
+        for c, start in enumerate(starts):
+            k = int(round(start * self.sample_rate))
+            stretch = 1.0 + ppm[c] * 1e-6
+            x = samples[k:, c]
+            if stretch != 1.0:
+                x = signal.resample(x, int(round(x.size * stretch))).astype(np.float32)
+                x = np.clip(x, -1.0, 1.0)
+            truth = []
+            for t in self.truth:
+                times = t.arrivals(c) - k / self.sample_rate
+                keep = times >= 0
+                truth.append(TrainTruth(times[keep] * stretch, t.is_tock[keep], t.voice,
+                                        t.gains[c : c + 1], t.delays[c : c + 1]))  # fmt: skip
+            applied = dict(self.applied, start=k / self.sample_rate, clock_ppm=ppm[c])
+            out.append(Recording(x.copy(), self.sample_rate, truth, applied))
+        return out
+
     def write(self, path: Path | str, subtype: str = "PCM_16") -> Path:
         import soundfile as sf
 
         sf.write(str(path), self.samples, self.sample_rate, subtype=subtype)
         return Path(path)
-
-
-# --- tick trains ---------------------------------------------------------------------
-
-
-def steady_train(
-    bpm: float,
-    duration: float,
-    *,
-    phase: float = 0.0,
-    limp: float = 0.0,
-    drift_bpm_per_min: float = 0.0,
-    jitter_s: float = 0.0,
-    level_jitter_db: float = 0.0,
-    tock_first: bool = False,
-    voice: Voice | None = None,
-    gain: float = 1.0,
-    seed: int = 0,
-) -> TickTrain:
-    """A free-running metronome (see the module docstring); ticks in [0, duration)."""
-    if not (math.isfinite(bpm) and 10 <= bpm <= 600):
-        raise ParameterError(f"`bpm` must be in [10, 600] ticks per minute, got {bpm!r}.")
-    if not (math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"`duration` must be > 0 s, got {duration!r}.")
-    if not (0 <= phase < 1):
-        raise ParameterError(f"`phase` must be in [0, 1) beats, got {phase!r}.")
-    if not (0 <= limp < 0.5):
-        raise ParameterError(f"`limp` must be in [0, 0.5) of a beat, got {limp!r}.")
-    if not (math.isfinite(drift_bpm_per_min) and abs(drift_bpm_per_min) <= 0.5 * bpm):
-        raise ParameterError(
-            f"`drift_bpm_per_min` must be within ±bpm/2, got {drift_bpm_per_min!r}."
-        )
-    if not (0 <= jitter_s < 0.1 * 60 / bpm) or not (0 <= level_jitter_db <= 12):
-        raise ParameterError(
-            f"`jitter_s` must be in [0, a tenth of a beat) and `level_jitter_db` in [0, 12], "
-            f"got {jitter_s!r} and {level_jitter_db!r}."
-        )
-    rng = np.random.default_rng([27, int(seed)])
-    # Beats counted since t = 0: n(t) = b t + c t² with b = bpm/60 and c = drift/7200
-    # (the tempo bpm + drift·t/60); tick k (unlimped) falls where n = k + phase.
-    b, c = bpm / 60.0, drift_bpm_per_min / 7200.0
-    last = b * duration + c * duration**2
-    beats = np.arange(0, math.ceil(max(last, 0.0)) + 2) + phase
-    if c == 0:
-        t = beats / b
-    else:
-        disc = np.maximum(b * b + 4 * c * beats, 0.0)
-        t = 2 * beats / (b + np.sqrt(disc))  # the root that tends to n/b as c → 0
-    period = 1.0 / (b + 2 * c * t)
-    k = np.arange(t.size)
-    t = t + np.where(k % 2 == 1, limp / 2, 0.0) * period  # long beat first
-    if jitter_s:
-        t = t + rng.normal(0.0, jitter_s, t.size)
-    is_tock = (k % 2 == 1) != tock_first
-    keep = (t >= 0) & (t < duration)
-    t, is_tock = t[keep], is_tock[keep]
-    levels = None
-    if level_jitter_db:
-        levels = 10 ** (rng.normal(0.0, level_jitter_db, t.size) / 20)
-    return TickTrain(t, is_tock, Voice.draw(seed) if voice is None else voice, gain, levels)
-
-
-def simulated_trains(
-    ds, *, run: int = 0, voices: Sequence[Voice] | None = None, start=None, end=None
-) -> list[TickTrain]:
-    """The ticks of run ``run`` of a simulated dataset (with trajectories), one train
-    per metronome: upward crossings of the escapement angle are ticks, downward ones
-    tocks; times from ``start`` (default: the first record) to ``end``."""
-    from metrosync.show.recording import RecordedRun
-    from metrosync.show.sound import crossing_times
-    from metrosync.show.ticks import voices as draw_voices
-
-    recorded = RecordedRun.from_dataset(ds, run)
-    start, end = recorded.window(start, end)
-    voices = draw_voices(recorded.n) if voices is None else list(voices)
-    if len(voices) != recorded.n:
-        raise ParameterError(
-            f"`voices` must hold one voice per metronome ({recorded.n}), got {len(voices)}."
-        )
-    trains = []
-    for i, times in enumerate(crossing_times(recorded)):
-        times = times[(times >= start) & (times < end)]
-        downward = recorded.theta_dot_at(times)[:, i] < 0
-        trains.append(TickTrain(times - start, downward, voices[i]))
-    return trains
 
 
 # --- the recording -------------------------------------------------------------------
@@ -388,13 +260,17 @@ def make_recording(
         )
     if (
         isinstance(sample_rate, bool)
-        or not isinstance(sample_rate, int)
+        or not isinstance(sample_rate, int | np.integer)
         or not (8000 <= sample_rate <= 192000)
     ):
         raise ParameterError(
             f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
         )
-    rng = np.random.default_rng([28, int(seed)])
+    if not isinstance(impairments, Impairments):
+        raise ParameterError(
+            f"`impairments` must be an Impairments (e.g. Impairments.phone()), got {impairments!r}."
+        )
+    rng = np.random.default_rng([28, check_seed(seed)])
     mics = _microphones(microphones, len(trains), rng)
     last = max((float(t.times[-1]) for t in trains if t.times.size), default=0.0)
     if duration is None:
@@ -408,23 +284,23 @@ def make_recording(
     n = int(round(duration * rate))
     gains = np.array([m.gains for m in mics]).T  # (N, C)
     shifts = np.round(np.array([m.delays for m in mics]).T * rate).astype(np.int64)
-    x = np.zeros((n, len(mics)))
+    x = np.zeros((n, len(mics)), dtype=np.float32)
     for i, train in enumerate(trains):
-        dry = _render_train(train, rate, n)
+        dry = _render_train(train, rate, n, np.random.default_rng([30, seed, i]))
         for c in range(len(mics)):
             s = shifts[i, c]
             x[s:, c] += gains[i, c] * dry[: n - s]
     applied: dict = {}
-    x = _impair(x, rate, impairments, rng, applied)
+    x = impair(x, rate, impairments, rng, applied)
     if rate != sample_rate:
         g = math.gcd(rate, sample_rate)
-        x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0)
+        x = signal.resample_poly(x, sample_rate // g, rate // g, axis=0).astype(np.float32)
         size = int(round(duration * sample_rate))
         x = np.pad(x[:size], ((0, max(0, size - x.shape[0])), (0, 0)))
     if impairments.quantize_bits:
         full = 2 ** (impairments.quantize_bits - 1)
-        x = np.clip(np.round(x * full), -full, full - 1) / full
-    x = np.clip(x, -1.0, 1.0).astype(np.float32)
+        x = np.clip(np.round(x * full), -full, full - 1) * np.float32(1 / full)
+    x = np.clip(x, -1.0, 1.0).astype(np.float32, copy=False)
     truth = [
         TrainTruth(
             t.times + shifts[i, 0] / rate,
@@ -435,7 +311,7 @@ def make_recording(
         )  # fmt: skip
         for i, t in enumerate(trains)
     ]
-    return Recording(x[:, 0] if len(mics) == 1 else x, sample_rate, truth, applied)
+    return Recording(x[:, 0] if len(mics) == 1 else x, int(sample_rate), truth, applied)
 
 
 def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
@@ -474,125 +350,39 @@ def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
     return mics
 
 
-def _render_train(train: TickTrain, rate: int, n: int) -> np.ndarray:
+def _render_train(train: TickTrain, rate: int, n: int, rng) -> np.ndarray:
     """(n,) the train's ticks and tocks at the metronome, each placed at its nearest
-    sample."""
-    out = np.zeros(n)
+    sample; with bounce jitter, each tick one of `BOUNCE_VARIANTS` variants drawn
+    from ``rng``."""
+    out = np.zeros(n, dtype=np.float32)
     onsets = np.round(train.times * rate).astype(np.int64)
     levels = train.gain * (np.ones(onsets.size) if train.levels is None else train.levels)
+    variants = 1 if train.bounce_jitter_s == 0 or not train.voice.sub_delays else BOUNCE_VARIANTS
+    pick = rng.integers(variants, size=onsets.size)
     for tock in (False, True):
-        which = train.is_tock == tock
-        if not which.any():
-            continue
-        wave = train.voice.waveform(rate, tock=tock)
-        index = onsets[which, None] + np.arange(wave.size)[None, :]
-        values = levels[which, None] * wave[None, :]
-        inside = index < n
-        # np.add.at: the ticks of a fast train may overlap.
-        np.add.at(out, index[inside], values[inside])
+        for v in range(variants):
+            which = (train.is_tock == tock) & (pick == v)
+            if not which.any():
+                continue
+            voice = (
+                train.voice if variants == 1 else _bounced(train.voice, train.bounce_jitter_s, rng)
+            )
+            wave = voice.waveform(rate, tock=tock)
+            index = onsets[which, None] + np.arange(wave.size)[None, :]
+            values = levels[which, None] * wave[None, :]
+            inside = index < n
+            if np.all(np.diff(onsets[which]) >= wave.size):
+                out[index[inside]] += values[inside]  # no two overlap: each index once
+            else:
+                np.add.at(out, index[inside], values[inside])
     return out
 
 
-def _impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> np.ndarray:
-    n, channels = x.shape
-    if imp.reverb_rt60 is not None:
-        applied["reverb_rt60"] = imp.reverb_rt60
-        for c in range(channels):
-            x[:, c] = signal.oaconvolve(x[:, c], _room_response(imp, rate, rng))[:n]
-    if imp.snr_db is not None:
-        power = np.mean(x**2, axis=0)
-        noise = _noise(n, channels, imp.noise, rng)
-        x = x + noise * np.sqrt(power / 10 ** (imp.snr_db / 10))[None, :]
-        applied["snr_db"] = imp.snr_db
-    if imp.bumps:
-        peak = np.abs(x).max()
-        bumps = []
-        for _ in range(imp.bumps):
-            t0, c = rng.uniform(0, n / rate), int(rng.integers(channels))
-            length = rng.uniform(0.04, 0.12)
-            t = np.arange(int(length * rate)) / rate
-            f = rng.uniform(25, 90)
-            thump = np.sin(2 * np.pi * f * t) * np.exp(-t / (length / 4)) * (1 - np.exp(-t / 0.002))
-            thump *= rng.uniform(0.5, 2.0) * peak / np.abs(thump).max()
-            k = int(t0 * rate)
-            m = min(thump.size, n - k)
-            x[k : k + m, c] += thump[:m]
-            bumps.append((float(k / rate), c))
-        applied["bumps"] = sorted(bumps)
-    if imp.phone_band is not False:
-        if imp.phone_band is True:
-            low, high = float(rng.uniform(100, 300)), float(rng.uniform(4000, 8000))
-        else:
-            low, high = map(float, imp.phone_band)
-        high = min(high, 0.45 * rate)
-        sos = np.concatenate(
-            [
-                signal.butter(2, low, "highpass", fs=rate, output="sos"),
-                signal.butter(4, high, "lowpass", fs=rate, output="sos"),
-            ]
-        )
-        x = signal.sosfilt(sos, x, axis=0)
-        applied["phone_band"] = (low, high)
-    if imp.compression:
-        x = _compress(x, rate, imp)
-        applied["compression"] = (imp.compression_threshold_db, imp.compression_ratio)
-    peak = max(np.abs(x).max(), 1e-12)
-    if imp.clipping is not None:
-        x = np.clip(x / (peak * imp.clipping), -1.0, 1.0)
-        applied["clipping"] = imp.clipping
-    else:
-        x = x * (OUTPUT_PEAK / peak)
-    return x
-
-
-def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
-    """The direct sound (1) and a noise tail that falls 60 dB in rt60 (cut at −90 dB)."""
-    rt60 = imp.reverb_rt60
-    t = np.arange(int(1.5 * rt60 * rate)) / rate
-    tail = rng.normal(0.0, 1.0, t.size) * 10 ** (-3 * t / rt60)
-    tail[: int(0.002 * rate)] = 0.0
-    tail *= np.sqrt(10 ** (-imp.reverb_drr_db / 10) / np.sum(tail**2))
-    tail[0] = 1.0
-    return tail
-
-
-def _noise(n: int, channels: int, color: str, rng) -> np.ndarray:
-    """(n, channels) unit-power Gaussian noise, white or pink (1/f power above 20 Hz)."""
-    white = rng.standard_normal((n, channels), dtype=np.float32)
-    if color == "white":
-        return white
-    size = sp_fft.next_fast_len(n, real=True)
-    spectrum = sp_fft.rfft(white, size, axis=0)
-    f = sp_fft.rfftfreq(size)
-    spectrum /= np.sqrt(np.maximum(f, 20.0 / 44100)).astype(np.float32)[:, None]
-    pink = sp_fft.irfft(spectrum, size, axis=0)[:n]
-    return pink / pink.std(axis=0)
-
-
-def _compress(x: np.ndarray, rate: int, imp: Impairments) -> np.ndarray:
-    """Feed-forward compression, each channel: level (dB) = the peak envelope (instant
-    attack, exponential release) smoothed by the attack time constant; computed on
-    blocks of `COMPRESSOR_BLOCK` samples (0.36 ms at 44.1 kHz, ten times shorter than
-    the attack) and interpolated."""
-    n = x.shape[0]
-    blocks = -(-n // COMPRESSOR_BLOCK)
-    padded = np.zeros((blocks * COMPRESSOR_BLOCK, x.shape[1]))
-    padded[:n] = np.abs(x)
-    block_peak = padded.reshape(blocks, COMPRESSOR_BLOCK, -1).max(axis=1)
-    level_db = 20 * np.log10(block_peak / max(block_peak.max(), 1e-12) + 1e-9)
-    # Peak hold with exponential release, vectorised: the decaying maximum
-    # max_m (L[m] − (k − m)·r) is the running maximum of L[m] + m·r, minus k·r.
-    step = COMPRESSOR_BLOCK / rate
-    r = 8.685889638 * step / imp.compression_release_s  # dB per block (e-fold per release)
-    ramp = np.arange(blocks)[:, None] * r
-    held = np.maximum.accumulate(level_db + ramp, axis=0) - ramp
-    a = math.exp(-step / imp.compression_attack_s)
-    b, den = [1 - a], [1, -a]
-    zi = signal.lfilter_zi(b, den)[:, None] * held[:1]
-    smooth = signal.lfilter(b, den, held, axis=0, zi=zi)[0]
-    over = np.maximum(smooth - imp.compression_threshold_db, 0.0)
-    gain_db = -(1 - 1 / imp.compression_ratio) * over
-    centres = (np.arange(blocks) + 0.5) * COMPRESSOR_BLOCK
-    samples = np.arange(n)
-    gain = np.column_stack([np.interp(samples, centres, gain_db[:, c]) for c in range(x.shape[1])])
-    return x * 10 ** (gain / 20)
+def _bounced(voice: Voice, jitter: float, rng) -> Voice:
+    """The voice with its secondary-impact delays moved by Gaussian ``jitter`` (s),
+    kept at least 5 ms after the main impact and 2 ms after each other."""
+    moved = np.sort(np.asarray(voice.sub_delays) + rng.normal(0.0, jitter, len(voice.sub_delays)))
+    delays = []
+    for d in moved:
+        delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
+    return dataclasses.replace(voice, sub_delays=tuple(delays))

@@ -10,6 +10,7 @@ from corpus import (
     Microphone,
     TickTrain,
     make_recording,
+    random_trains,
     simulated_trains,
     steady_train,
 )
@@ -93,6 +94,42 @@ def test_given_microphones_set_gains_and_delays():
     np.testing.assert_allclose(rec.truth[0].arrivals(1), rec.truth[0].times + 0.01)
 
 
+def test_microphones_split_into_phones_started_at_different_times(four):
+    rec = make_recording(four, microphones=2, seed=5)
+    files = rec.files([0.0, 1.25])
+    assert [f.channels for f in files] == [1, 1]
+    assert files[1].samples.size == rec.samples.shape[0] - round(1.25 * 44100)
+    np.testing.assert_array_equal(files[1].samples, rec.samples[round(1.25 * 44100) :, 1])
+    for i, truth in enumerate(files[1].truth):
+        want = rec.truth[i].arrivals(1) - 1.25
+        np.testing.assert_allclose(truth.times, want[want >= 0])
+        assert truth.gains[0] == rec.truth[i].gains[1]
+    # (The file may open in the ring of a tick struck before it started: from 0.2 s.)
+    late = [(i, k) for i, k in isolated(files[1].truth) if files[1].truth[i].times[k] > 0.2]
+    errors = [first_rise(files[1].samples, files[1].truth[i].times[k], 44100)
+              - files[1].truth[i].times[k] for i, k in late]  # fmt: skip
+    assert len(errors) > 20 and np.max(np.abs(errors)) <= 1e-4
+    with pytest.raises(ParameterError, match="`starts`"):
+        rec.files([0.0])
+
+
+def test_phones_whose_clocks_run_fast_stretch_their_files_and_truth():
+    trains = random_trains(2, 40.0, seed=3)
+    rec = make_recording(trains, microphones=2, seed=4)
+    same = rec.files([0.5, 0.5])[1]
+    fast = rec.files([0.5, 0.5], clock_ppm=[0.0, 50.0])[1]
+    assert fast.samples.size == round(same.samples.size * (1 + 50e-6))
+    for a, b in zip(same.truth, fast.truth, strict=True):
+        np.testing.assert_allclose(b.times, a.times * (1 + 50e-6))
+    assert fast.truth[0].times[-1] - same.truth[0].times[-1] > 0.0018  # 2 ms at the end
+    late = [(i, k) for i, k in isolated(fast.truth) if fast.truth[i].times[k] > 0.2]
+    errors = [first_rise(fast.samples, fast.truth[i].times[k], 44100)
+              - fast.truth[i].times[k] for i, k in late]  # fmt: skip
+    assert len(errors) > 20 and np.max(np.abs(errors)) <= 1e-4
+    with pytest.raises(ParameterError, match="`clock_ppm`"):
+        rec.files(clock_ppm=[0.0])
+
+
 def test_the_same_seed_gives_the_same_recording(four):
     a = make_recording(four, impairments=Impairments.phone(), seed=2)
     b = make_recording(four, impairments=Impairments.phone(), seed=2)
@@ -136,6 +173,12 @@ def test_simulated_trains_tick_at_the_crossings_upward_and_tock_downward():
         (lambda: make_recording([steady_train(100, 2)], microphones=0), "`microphones`"),
         (lambda: make_recording([steady_train(100, 2)], duration=1.0), "`duration`"),
         (lambda: make_recording([steady_train(100, 2)], sample_rate=100), "`sample_rate`"),
+        (lambda: make_recording([steady_train(100, 2)], seed=-1), "`seed`"),
+        (lambda: make_recording([steady_train(100, 2)], impairments=True), "`impairments`"),
+        (lambda: steady_train(100, 2, seed=1.5), "`seed`"),
+        (lambda: random_trains(3, 10, bpm_range=(100, 101), min_bpm_gap=2), "`bpm_range`"),
+        (lambda: random_trains(9, 10), "`n`"),
+        (lambda: steady_train(100, 2, bounce_jitter_s=0.1), "`bounce_jitter_s`"),
     ],
 )
 def test_bad_arguments_are_named(call, name):
@@ -173,6 +216,60 @@ def test_jitter_and_level_jitter_are_seeded_and_of_the_size_asked():
     displacement = a.times - steady_train(120, 120.0).times[: a.times.size]
     assert displacement.std() == pytest.approx(0.001, rel=0.15)
     assert np.std(20 * np.log10(a.levels)) == pytest.approx(1.0, rel=0.15)
+
+
+def test_random_free_running_trains_keep_their_tempos_apart_and_voices_distinct():
+    for seed in range(20):
+        trains = random_trains(4, 30.0, seed=seed, min_bpm_gap=4.0)
+        bpm = [120 / (t.times[2] - t.times[0]) for t in trains]  # one full swing
+        assert np.diff(np.sort(bpm)).min() > 3.5
+        assert all(85 < b < 205 for b in bpm)
+        assert len({t.voice for t in trains}) == 4
+    assert [t.times.size for t in random_trains(3, 30.0, seed=5)] == [
+        t.times.size for t in random_trains(3, 30.0, seed=5)
+    ]
+
+
+def test_random_trains_of_one_make_sound_alike():
+    trains = random_trains(3, 10.0, seed=4, same_make=True)
+    base = Voice.draw(4)
+    assert [t.voice for t in trains] == [base.sibling(i) for i in range(3)]
+    assert len({t.voice for t in trains}) == 3
+
+
+def test_random_locked_trains_share_a_tempo_and_stay_in_step():
+    trains = random_trains(3, 60.0, seed=2, locked=True, phase_spread=0.05, same_voice=True)
+    assert len({t.voice for t in trains}) == 1
+    counts = {t.times.size for t in trains}
+    assert max(counts) - min(counts) <= 1
+    k = min(counts)
+    spread = np.ptp([t.times[:k] for t in trains], axis=0)
+    period = np.median(np.diff(trains[0].times))
+    # In step: within the phase spread plus the limp's half and the jitter.
+    assert spread.max() < (0.05 + 0.02) * period + 0.002
+
+
+def test_bounce_jitter_moves_the_secondary_impacts_not_the_first():
+    voice = Voice.draw(0)  # one secondary impact
+    assert len(voice.sub_delays) == 1
+    train = steady_train(60, 40.0, voice=voice, bounce_jitter_s=0.001)
+    rec = make_recording([train], seed=3)
+    x = rec.samples.astype(float)
+    sos = signal.butter(8, 12000, "highpass", fs=44100, output="sos")
+    high = np.abs(signal.sosfiltfilt(sos, x))
+    bounces, starts = [], []
+    for t in rec.truth[0].times:
+        k = int(round(t * 44100))
+        starts.append(first_rise(rec.samples, t, 44100) - t)
+        main = np.argmax(high[k : k + int(0.002 * 44100)])
+        window = high[k + int(0.005 * 44100) : k + int(0.05 * 44100)]
+        bounces.append((np.argmax(window) + int(0.005 * 44100) - main) / 44100)
+    assert np.max(np.abs(starts)) <= 1e-4
+    assert np.std(bounces) == pytest.approx(0.001, rel=0.35)
+    # The mean of 16 variants: within three of its standard errors (0.25 ms).
+    assert np.mean(bounces) == pytest.approx(voice.sub_delays[0], abs=0.00075)
+    plain = make_recording([steady_train(60, 40.0, voice=voice)], seed=3).samples
+    assert not np.array_equal(plain, rec.samples)
 
 
 # --- impairments ---------------------------------------------------------------------
@@ -272,11 +369,20 @@ def test_bumps_are_low_thumps_at_the_times_reported(four):
     bumps = rec.applied["bumps"]
     assert len(bumps) == 3 and all(c == 0 for _, c in bumps)
     sos = signal.butter(4, 120, "lowpass", fs=44100, output="sos")
-    low = np.abs(signal.sosfiltfilt(sos, rec.samples.astype(float)))
-    quiet = np.abs(signal.sosfiltfilt(sos, make_recording(four).samples.astype(float))).max()
+    low = np.abs(signal.sosfilt(sos, rec.samples.astype(float)))
+    quiet = np.abs(signal.sosfilt(sos, make_recording(four).samples.astype(float))).max()
     for t, _ in bumps:
         k = int(t * 44100)
         assert low[k : k + int(0.05 * 44100)].max() > 3 * quiet
+    # Through a phone's band the thump is weaker, but loud beside the ticks still.
+    phone = Impairments(bumps=3, phone_band=(300.0, 4000.0))
+    rec = make_recording(four, impairments=phone, seed=7)
+    x = np.abs(rec.samples)
+    during = np.zeros(x.size, bool)
+    for t, _ in rec.applied["bumps"]:
+        during[int(t * 44100) : int((t + 0.15) * 44100)] = True
+    for t, _ in rec.applied["bumps"]:
+        assert x[int(t * 44100) : int((t + 0.15) * 44100)].max() > 0.25 * x[~during].max()
     # On several microphones, each bump on one of them.
     rec = make_recording(four, microphones=2, impairments=Impairments(bumps=6), seed=7)
     assert {c for _, c in rec.applied["bumps"]} == {0, 1}
@@ -307,7 +413,9 @@ def test_the_phone_set_keeps_the_onsets_within_half_a_millisecond(four):
 
 
 @pytest.mark.slow
-def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_two_seconds():
+def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_a_second():
+    """CPU time of this process (all its threads), so that other jobs on the machine
+    do not count; about 0.2 s on the 2-core development machine."""
     import time
 
     group = voices(4, seed=2)
@@ -316,7 +424,7 @@ def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_two_secon
     make_recording([steady_train(100, 2.0)])  # warm the imports
     best = np.inf
     for _ in range(2):
-        start = time.perf_counter()
+        start = time.process_time()
         make_recording(trains, impairments=Impairments.phone(clipping=0.8), seed=1)
-        best = min(best, time.perf_counter() - start)
-    assert best < 2.0
+        best = min(best, time.process_time() - start)
+    assert best < 1.0

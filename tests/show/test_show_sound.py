@@ -248,3 +248,22 @@ def test_the_cli_offers_the_tick_sounds_the_library_knows():
     from metrosync.show.sound import TICK_SOUNDS
 
     assert offered == TICK_SOUNDS
+
+
+def test_the_overlap_bound_holds_for_any_train_at_least_that_far_apart(rng):
+    from metrosync.show.sound import _overlap_peak
+    from metrosync.show.ticks import Voice
+
+    wave = Voice.draw(2).waveform(44100)
+    for spacing in (200, 700, 3000, 10000):
+        bound = _overlap_peak(wave, spacing)
+        worst = 0.0
+        for _ in range(20):
+            starts = np.cumsum(spacing + rng.integers(0, spacing // 2 + 1, 40))
+            out = np.zeros(starts[-1] + wave.size)
+            for k in starts:
+                out[k : k + wave.size] += wave
+            worst = max(worst, np.abs(out).max())
+        assert worst <= bound
+        assert bound < 4 * worst  # not so loose that the file is needlessly quiet
+    assert _overlap_peak(wave, np.inf) == _overlap_peak(wave, 10**6) == np.abs(wave).max()

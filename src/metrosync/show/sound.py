@@ -25,8 +25,9 @@ cosine burst, and ``"realistic"``, the tick of a real metronome
 of about 80 ms through resonances of its own (metronome i gets voice i of
 ``ticks.voices(N)``). A realistic tick starts at the crossing; an upward crossing
 sounds a tick, a downward one the tock, which sounds different and softer. Its gain
-is 0.9/N over the loudest peak of the voices and over how many of one metronome's
-ticks can sound at once (they overlap when sped up), so the file never clips either.
+is 0.9/N over a bound on one metronome's loudest sum (its ticks overlap when sped up:
+the k-th latest began at least k times the shortest interval ago and adds at most its
+waveform's largest value from then on), so the file never clips either.
 
 The audio is rendered and written in blocks of `BLOCK_SAMPLES`, so memory does not
 depend on its length. Refused before any sample is made: a speed-up that brings a
@@ -77,7 +78,7 @@ class ClickTrack:
     tock_waveforms : N arrays, the tock of each metronome, or None when tick and tock
         sound alike (then ``waveforms`` sounds at every crossing).
     is_tock : N (K_i,) bool arrays, which clicks are tocks (downward crossings), or
-        None with ``tock_waveforms``.
+        None when ``tock_waveforms`` is.
     """
 
     sample_rate: int
@@ -269,16 +270,25 @@ def click_track(
         sounds = voices(run.n)
         waveforms = [v.waveform(sample_rate) for v in sounds]
         tock_waveforms = [v.waveform(sample_rate, tock=True) for v in sounds]
-        peak = max(np.abs(w).max() for w in waveforms + tock_waveforms)
-        # How many ticks of one metronome can sound at once: a tick lasts longer
-        # than the time to the next one when sped up.
+        # When sped up, a tick still rings as the next ones start.
         shortest = min((np.diff(k).min() for k in onsets if k.size > 1), default=np.inf)
-        overlap = math.ceil(max(w.size for w in waveforms) / max(shortest, 1))
-        gains = [g / (peak * overlap) for g in gains]
+        loudest = max(_overlap_peak(w, shortest) for w in waveforms + tock_waveforms)
+        gains = [g / loudest for g in gains]
     return ClickTrack(
         int(sample_rate), n_samples, audio_times, onsets, gains, waveforms, start, end,
         float(speedup), tock_waveforms, is_tock or None,
     )  # fmt: skip
+
+
+def _overlap_peak(wave: np.ndarray, spacing: float) -> float:
+    """A bound on |sum of copies of ``wave``| when they start at least ``spacing``
+    samples apart: the k-th latest copy began ≥ k·spacing samples ago, so it adds at
+    most the largest |wave| from there on."""
+    tail = np.maximum.accumulate(np.abs(wave)[::-1])[::-1]
+    if not np.isfinite(spacing):
+        return float(tail[0])
+    step = max(int(spacing), 1)
+    return float(tail[::step].sum())
 
 
 def _milliseconds(seconds: float) -> str:

@@ -9,7 +9,8 @@ pallets, so they differ in sound and in loudness; two metronomes of different ma
 differ in spectrum more than in loudness.
 
 A `Voice` holds those traits of one metronome, frozen, and is drawn reproducibly from
-a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
+a seed (`Voice.draw`, or `voices` for several that differ from each other;
+`Voice.sibling` for another metronome of the same make, alike but not identical). Its
 `Voice.waveform` renders one tick or one tock:
 
 - each impact is a broadband transient (exponentially decaying noise, 0.4 ms) plus
@@ -17,7 +18,9 @@ a seed (`Voice.draw`, or `voices` for several that differ from each other). Its
   amplitudes ``weights``; the slowest decays 60 dB in ``ring`` seconds, the others
   faster (``decays``, fractions of it);
 - impact j ≥ 1 is the same sound, ``sub_gains[j-1]`` times as loud, starting
-  ``sub_delays[j-1]`` s after the main impact;
+  ``sub_delays[j-1]`` s after the main impact. As heard, the ring of the earlier
+  impacts adds in or out of phase: the waveform's peak at a secondary impact is
+  0.39–0.78 of the main one's for 90 % of drawn voices (median 0.57);
 - the tock rings at the resonances times ``tock_shift`` (a different pallet excites
   the case differently) and is ``tock_gain`` (< 1) times as loud as the tick, so the
   tick is the louder, as `metrosync.audio.metronome` names them;
@@ -33,6 +36,7 @@ transient comes from the voice's own ``seed``, so a voice sounds the same every 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -47,7 +51,7 @@ RING_RANGE = (0.07, 0.09)  # s for the slowest resonance to fall by 60 dB
 RESONANCE_RANGE = (800.0, 4500.0)  # Hz, the main resonance
 TOCK_GAIN_RANGE = (0.6, 0.85)
 TOCK_SHIFT_RANGE = (0.06, 0.15)  # |tock_shift − 1|
-LEVEL_RANGE = (0.85, 1.0)  # ±0.7 dB: makes differ in spectrum, hardly in loudness
+LEVEL_RANGE = (0.85, 1.0)  # 1.4 dB: makes differ in spectrum, hardly in loudness
 #: Length of the broadband transient of an impact (decay time), s.
 TRANSIENT_DECAY = 0.0004
 #: Rise time of an impact, s: the waveform starts at 0.
@@ -166,6 +170,32 @@ class Voice:
             tock_gain=float(rng.uniform(*TOCK_GAIN_RANGE)),
             level=float(rng.uniform(*LEVEL_RANGE)),
             seed=int(seed),
+        )
+
+    def sibling(self, seed: int, *, spread: float = 0.02) -> Voice:
+        """Another metronome of the same make: resonances moved by a relative
+        Gaussian ``spread`` (default 2 %), secondary impacts by ``spread`` × 50 ms
+        (1 ms) and their heights by ``spread`` × 2.5 (5 %), loudness within ``spread``
+        × 25 (0.5 dB); the same tock traits. Drawn from ``seed``.
+        """
+        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+            raise ParameterError(f"`seed` must be an integer ≥ 0, got {seed!r}.")
+        if not (0 <= spread <= 0.1):
+            raise ParameterError(f"`spread` must be in [0, 0.1], got {spread!r}.")
+        rng = np.random.default_rng([31, self.seed, int(seed)])
+        m, j = len(self.resonances), len(self.sub_delays)
+        resonances = np.asarray(self.resonances) * (1 + rng.normal(0.0, spread, m))
+        delays = np.asarray(self.sub_delays) + rng.normal(0.0, 50 * spread * 1e-3, j)
+        delays = np.maximum.accumulate(np.maximum(np.sort(delays), 0.005))
+        gains = np.clip(np.asarray(self.sub_gains) + rng.normal(0.0, 2.5 * spread, j), 0.05, 1)
+        level_db = rng.normal(0.0, 25 * spread)
+        return dataclasses.replace(
+            self,
+            resonances=tuple(float(f) for f in np.clip(resonances, 50.0, MAX_RESONANCE * 1.4)),
+            sub_delays=tuple(float(d) for d in delays + 1e-4 * np.arange(j)),
+            sub_gains=tuple(float(g) for g in gains),
+            level=float(np.clip(self.level * 10 ** (level_db / 20), 0.05, 1.0)),
+            seed=int(self.seed) * MAX_VOICES + int(seed) + 1,
         )
 
     @property
