@@ -1,27 +1,34 @@
 """`analyze_audio`: a recording of metronomes → ticks, tempo, beat and synchrony.
 
-Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file in
-blocks (`reader`), finds and times the ticks (`detection`), finds the beat (`tempo`),
-and measures: one metronome's tempo, jitter and beat (`metronome`); the acoustic
-order parameter and clusters of an ensemble (`order`); and for two metronomes that
-can be told apart, each one's ticks and their phase difference (`attribution`). It
-returns an `xarray.Dataset`:
+Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file
+(or files recorded together, `together`) in blocks (`reader`), finds every impact
+(`detection`), groups them into ticks and tells the metronomes apart by sound and
+tempo (`separation`), finds ticks another hid (`recovery`), and measures: each
+metronome's tempo, jitter and beat (`metronome`); its phases, r and frequency as the
+light gate's (`observables.crossings`); the phase of each in metronome 0's beat
+(`attribution`); and the acoustic order parameter and clusters of the ensemble,
+which need no identities (`order`). It returns an `xarray.Dataset`:
 
-    tick_time, tick_strength, tick_rise   (tick)        onsets (s), loudness (dBFS),
+    tick_time, tick_strength, tick_rise   (tick)        onsets (s, a tick's first
+                                                         impact), loudness (dBFS),
                                                          detection curve there (dB)
     tick_channel_strength                 (tick, channel)  loudness per channel, dBFS
     tick_metronome, tick_is_tock, tick_interval, phase_difference   (tick)
-                                          who ticked (−1 unknown), tick or tock (−1
-                                          unknown), beat to its next tick (s), phase
-                                          in metronome 0's beat (rad)
+                                          who ticked (−1 unknown or two at once), tick
+                                          or tock (−1 unknown), beat to its next tick
+                                          (s), phase in metronome 0's beat (rad)
     detection, threshold, level           (frame)       the detection curve and its
                                                          threshold (dB), power (dBFS)
     wave_min, wave_max                    (wave)        the waveform, for plots
     r_acoustic, r_floor, r_excess, ticks_per_beat, clusters, beat_period   (window)
     bpm, bpm_error, jitter, asymmetry, asymmetry_error, long_beat, ticks   (metronome)
-                                          for one metronome, or each of two told apart
+    frequency_bpm, period_jitter          (metronome)   as the light gate's dataset
+    r                                     (time)        as the light gate's (each
+                                                         metronome's tick one way)
 
-with the summary (``attrs["summary"]``), the settings, and the tempo found.
+with the summary (``attrs["summary"]``), ``r_eq`` and ``sigma_bpm`` (as the light
+gate's), how the metronomes were told apart and how sure (``attribution``,
+``attribution_confidence``), the settings, and the tempo found.
 """
 
 from __future__ import annotations
