@@ -102,15 +102,22 @@ def test_a_tick_of_several_impacts_is_one_tick(tmp_path, seed):
 
 @pytest.mark.slow
 def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
-    """Twenty phone recordings, one to four metronomes of different makes at tempi drawn
-    in 100-200 BPM, each slightly limping and speeding up."""
-    right, rows = [], []
+    """Twenty-four phone recordings, one to four metronomes of different makes at tempi
+    drawn in 100-200 BPM, each slightly limping and speeding up. A recording where a
+    metronome's ticks are hidden behind another's more often than not (two at nearly
+    one tempo, ticking together all along) is beyond one microphone and not counted;
+    at least 22 of the 24 must be hearable."""
+    right, rows, hearable_ones = [], [], 0
     for n in (1, 2, 3, 4):
-        for seed in range(5):
+        for seed in range(6):
             ds, truth = recording(tmp_path, n, seed)
+            if min(hearable(truth, k).mean() for k in range(n)) < 0.5:
+                continue
+            hearable_ones += 1
             right.append(ds.attrs["metronomes"] == n)
             if right[-1]:
                 rows.append(scores(ds, truth))
+    assert hearable_ones >= 22
     assert np.mean(right) >= 0.95
     table = np.concatenate(rows)
     recall, precision, timing, bpm = table.T

@@ -54,7 +54,7 @@ from .recovery import recover
 from .separation import separate, sureness, tick_length_words
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
-from .trains import Train
+from .trains import Train, off_the_beat
 
 #: Default refractory time, s: impacts closer than this are heard as one. The impacts of
 #: one tick are grouped afterwards, from the recording's own tick structure.
@@ -186,14 +186,18 @@ def analyze_audio(
     phase = np.full(k, np.nan)
     stats, kept = [], []
     for m, t in enumerate(trains):
-        s = beat_statistics(ticks.time[t.index], t.period, ticks.strength[t.index])
+        # a metronome's timing from its own ticks: one it took from another (that hid
+        # its own) is that other's onset
+        own = t.index[~t.masked]
+        own = own[~off_the_beat(ticks.time[own], t.beat[~t.masked])]
+        s = beat_statistics(ticks.time[own], t.period, ticks.strength[own])
         stats.append(s)
-        mine = label[t.index] == m
-        is_tock[t.index[mine]] = s.is_tock[mine]
-        gaps = np.full(t.index.size, np.nan)
-        gaps[:-1] = _beats(ticks.time[t.index], s.beat_number)
-        interval[t.index[mine]] = gaps[mine]
-        kept.append(ph.kept_from_half_periods(ticks.time[t.index], s.beat_number,
+        mine = label[own] == m
+        is_tock[own[mine]] = s.is_tock[mine]
+        gaps = np.full(own.size, np.nan)
+        gaps[:-1] = _beats(ticks.time[own], s.beat_number)
+        interval[own[mine]] = gaps[mine]
+        kept.append(ph.kept_from_half_periods(ticks.time[own], s.beat_number,
                                               parity=1 if s.is_tock[0] else 0))  # fmt: skip
         if m > 0:
             mine = np.flatnonzero(label == m)

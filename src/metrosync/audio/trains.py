@@ -73,6 +73,8 @@ MAX_FRAGMENT = 6
 MAX_BRIDGED = 64
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
+#: A tick farther than this from its train's beat is not its metronome's, s.
+OFF_BEAT = 3e-3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
 
@@ -369,6 +371,25 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             break
     return ([t for t, k in zip(trains, keep, strict=True) if k],
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
+
+
+def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
+    """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
+    (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
+    to each kind of beat (tick, tock: a limp) apart; a later impact taken for a tick
+    where the first was hidden, at the ends of a train, would bias its tempo."""
+    times = np.asarray(times, dtype=float)
+    out = np.zeros(times.size, dtype=bool)
+    for parity in (0, 1):
+        sel = np.flatnonzero(beat % 2 == parity)
+        if sel.size < 6:
+            continue
+        n = beat[sel].astype(float)
+        fit = np.polyval(np.polyfit(n, times[sel], 2), n)
+        residual = times[sel] - fit
+        limit = max(OFF_BEAT, 5 * _robust_spread(residual))
+        out[sel] = np.abs(residual - np.median(residual)) > limit
+    return out
 
 
 def _robust_spread(x: np.ndarray) -> float:
