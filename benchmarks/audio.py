@@ -13,7 +13,7 @@
    four metronomes of different makes (112, 138, 161 and 187 BPM, speeding up by 0.05
    BPM a minute) heard through a phone (reverberation, noise, bumps, band limits,
    compression), timed as `metrosync analyze FILE.wav` in a fresh process; and over
-   twenty 40 s recordings of one to four metronomes at tempi drawn in 100-200 BPM, how
+   24 40 s recordings of one to four metronomes at tempi drawn in 100-200 BPM, how
    often the number of metronomes is right, and each metronome's recall (ticks no
    other hid), precision, timing and tempo error.
 
@@ -144,7 +144,7 @@ def corpus_recording(n, seed, folder, duration=40.0, bpms=None, drift=0.1):
 def realistic(folder: Path) -> None:
     import warnings
 
-    from test_audio_separation import scores
+    from test_audio_separation import hearable, scores
 
     # made in a child process: Linux carries a parent's peak memory into the children it
     # forks, and the command's own peak memory is measured below
@@ -164,24 +164,29 @@ def realistic(folder: Path) -> None:
     print(f"10 min, 4 real-sounding metronomes through a phone: metrosync analyze "
           f"{wall:.1f} s wall (fresh process), peak memory {peak / 1024:.0f} MiB")  # fmt: skip
     print("  " + "\n  ".join(found))
-    right, rows = [], []
+    right, rows, heard = [], [], []
     for n in (1, 2, 3, 4):
-        for seed in range(5):
+        for seed in range(6):
             p, truth = corpus_recording(n, seed, folder)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ds = analyze_audio(p)
             right.append(ds.attrs["metronomes"] == n)
-            if right[-1]:
-                rows.append(scores(ds, truth))
-    table = np.concatenate(rows)
-    print(
-        f"20 recordings of 1-4 metronomes (40 s): number right in {np.mean(right):.0%}; "
-        f"per metronome (where right): recall median {np.median(table[:, 0]):.3f} min "
-        f"{table[:, 0].min():.3f}, precision median {np.median(table[:, 1]):.3f} min "
-        f"{table[:, 1].min():.3f}, timing max {1e3 * table[:, 2].max():.2f} ms, "
-        f"BPM error max {table[:, 3].max():.3f}"
-    )
+            # a metronome hidden behind another most of the time: beyond one microphone
+            heard.append(min(hearable(truth, k).mean() for k in range(n)) >= 0.5)
+            rows.append(scores(ds, truth) if right[-1] else None)
+    right, heard = np.array(right), np.array(heard)
+    for name, use in (("all", np.ones(right.size, bool)), ("hearable", heard)):
+        table = np.concatenate([r for r, u in zip(rows, use, strict=True) if u and r is not None])
+        print(
+            f"{use.sum()} recordings ({name}) of 1-4 metronomes (40 s): number right in "
+            f"{np.mean(right[use]):.1%}; per metronome (where right): recall median "
+            f"{np.median(table[:, 0]):.3f} min {table[:, 0].min():.3f}, share >= 0.99 "
+            f"{np.mean(table[:, 0] >= 0.99):.2f}; precision median "
+            f"{np.median(table[:, 1]):.3f} min {table[:, 1].min():.3f}, share >= 0.99 "
+            f"{np.mean(table[:, 1] >= 0.99):.2f}; timing max {1e3 * table[:, 2].max():.2f} "
+            f"ms; BPM error max {table[:, 3].max():.3f}"
+        )
 
 
 def main() -> None:
