@@ -13,10 +13,10 @@ from metrosync.audio.reader import open_recording
 
 def scored(path, trains, **options):
     """Recall and precision over the ticks the detector can resolve (no tick of another
-    metronome within its refractory time), and the timing errors."""
+    metronome within its resolution), and the timing errors."""
     ds = analyze_audio(path, **options)
     found = ds.tick_time.values
-    times, alone = synth.resolvable(trains, ds.attrs["refractory"])
+    times, alone = synth.resolvable(trains, ds.attrs["resolution"])
     recall, _, errors = synth.match(times[alone], found)
     # a detection is right when it lies within 1 ms of any tick (merged ones included)
     _, precision, _ = synth.match(times, found)

@@ -29,7 +29,7 @@ def merged(times, gap):
 def r_from_crossings(ds, crossings, *, merge):
     truth = np.sort(np.concatenate(crossings))
     if merge:
-        truth = merged(truth, ds.attrs["refractory"])
+        truth = merged(truth, ds.attrs["resolution"])
     o = acoustic_order(truth, beat_period(truth), window=ds.attrs["order_window"],
                        centres=ds.window.values, metronomes=ds.attrs["metronomes"])  # fmt: skip
     return o.r
@@ -49,7 +49,7 @@ def analysed(request, listen_run, tmp_path_factory):
 def test_clicks_found_within_a_millisecond(analysed):
     ds, crossings = analysed
     found = ds.tick_time.values
-    times, alone = synth.resolvable(crossings, ds.attrs["refractory"])
+    times, alone = synth.resolvable(crossings, ds.attrs["resolution"])
     recall, _, errors = synth.match(times[alone], found)
     _, precision, _ = synth.match(times, found)
     assert recall >= 0.99 and precision >= 0.99

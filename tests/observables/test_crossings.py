@@ -36,3 +36,16 @@ def test_frequency_jitter_and_sigma():
 def test_common_grid_is_the_intersection_on_multiples_of_dt():
     grid = ph.common_grid([(0.33, 10.0), (1.01, 9.55)], 0.1)
     assert np.isclose(grid[0], 1.1) and np.isclose(grid[-1], 9.5)
+
+
+def test_passes_both_ways_keep_one_direction_and_count_missed_periods():
+    """A sound hears a tick each way: ticks numbered in half periods, with one missed."""
+    times = np.arange(10) * 0.3125
+    half = np.arange(10)
+    keep = half != 4  # a tick of the kept direction missed
+    kept, cycles = ph.kept_from_half_periods(times[keep], half[keep])
+    assert np.allclose(kept, times[[0, 2, 6, 8]])
+    assert cycles.tolist() == [1, 2, 1]
+    assert np.isclose(ph.mean_frequency_bpm(kept, cycles), 192.0)
+    tocks, _ = ph.kept_from_half_periods(times, half, parity=1)
+    assert np.allclose(tocks, times[1::2])

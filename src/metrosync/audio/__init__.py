@@ -2,8 +2,12 @@
 
 One entry point, `analyze_audio(path)`; the steps are modules of their own:
 `reader` (files, in blocks), `detection` (tick onsets), `tempo` (the beat period),
-`metronome` (one metronome's tempo, jitter and beat), `order` (the acoustic order
-parameter and clusters), `attribution` (two metronomes told apart), `plots`.
+`voices` (each impact's sound, clustered), `trains` (impacts grouped into ticks,
+ticks followed as one train per metronome), `separation` (the two together: the
+metronomes told apart), `recovery` (ticks another hid, found again), `together`
+(several microphones aligned), `metronome` (one metronome's tempo, jitter and beat),
+`order` (the acoustic order parameter and clusters), `attribution` (the phase of one
+metronome in another's beat), `plots`.
 `analyze_audio` is imported on first use (it needs scipy and xarray), so that the
 reader's checks stay quick to import.
 """

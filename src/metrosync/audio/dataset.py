@@ -1,27 +1,34 @@
 """`analyze_audio`: a recording of metronomes → ticks, tempo, beat and synchrony.
 
-Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file in
-blocks (`reader`), finds and times the ticks (`detection`), finds the beat (`tempo`),
-and measures: one metronome's tempo, jitter and beat (`metronome`); the acoustic
-order parameter and clusters of an ensemble (`order`); and for two metronomes that
-can be told apart, each one's ticks and their phase difference (`attribution`). It
-returns an `xarray.Dataset`:
+Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file
+(or files recorded together, `together`) in blocks (`reader`), finds every impact
+(`detection`), groups them into ticks and tells the metronomes apart by sound and
+tempo (`separation`), finds ticks another hid (`recovery`), and measures: each
+metronome's tempo, jitter and beat (`metronome`); its phases, r and frequency as the
+light gate's (`observables.crossings`); the phase of each in metronome 0's beat
+(`attribution`); and the acoustic order parameter and clusters of the ensemble,
+which need no identities (`order`). It returns an `xarray.Dataset`:
 
-    tick_time, tick_strength, tick_rise   (tick)        onsets (s), loudness (dBFS),
+    tick_time, tick_strength, tick_rise   (tick)        onsets (s, a tick's first
+                                                         impact), loudness (dBFS),
                                                          detection curve there (dB)
     tick_channel_strength                 (tick, channel)  loudness per channel, dBFS
     tick_metronome, tick_is_tock, tick_interval, phase_difference   (tick)
-                                          who ticked (−1 unknown), tick or tock (−1
-                                          unknown), beat to its next tick (s), phase
-                                          in metronome 0's beat (rad)
+                                          who ticked (−1 unknown or two at once), tick
+                                          or tock (−1 unknown), beat to its next tick
+                                          (s), phase in metronome 0's beat (rad)
     detection, threshold, level           (frame)       the detection curve and its
                                                          threshold (dB), power (dBFS)
     wave_min, wave_max                    (wave)        the waveform, for plots
     r_acoustic, r_floor, r_excess, ticks_per_beat, clusters, beat_period   (window)
     bpm, bpm_error, jitter, asymmetry, asymmetry_error, long_beat, ticks   (metronome)
-                                          for one metronome, or each of two told apart
+    frequency_bpm, period_jitter          (metronome)   as the light gate's dataset
+    r                                     (time)        as the light gate's (each
+                                                         metronome's tick one way)
 
-with the summary (``attrs["summary"]``), the settings, and the tempo found.
+with the summary (``attrs["summary"]``), ``r_eq`` and ``sigma_bpm`` (as the light
+gate's), how the metronomes were told apart and how sure (``attribution``,
+``attribution_confidence``), the settings, and the tempo found.
 """
 
 from __future__ import annotations
@@ -36,22 +43,31 @@ import xarray as xr
 
 from .._version import __version__
 from .._words import plural
-from ..errors import ParameterError
+from ..errors import AnalysisError, ParameterError
+from ..observables import crossings as ph
+from ..observables.order import equilibrium_order
 from . import detection as det
-from .attribution import attribute_pair
+from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
+from .recovery import recover
+from .separation import separate, sureness, tick_length_words
 from .summary import summary_text
-from .tempo import beat_period
+from .tempo import HINT_RANGE, MIN_TICKS, beat_period
+from .trains import Train, off_the_beat
 
-#: Default refractory time, as a fraction of the beat, and its bounds (s).
-REFRACTORY_BEATS = 1 / 32
-REFRACTORY_RANGE = (3e-3, 30e-3)
+#: Default refractory time, s: impacts closer than this are heard as one. The impacts of
+#: one tick are grouped afterwards, from the recording's own tick structure.
+REFRACTORY = 3e-3
+#: Below this attribution confidence the ensemble's beat is found from the ticks alone.
+MIN_CONFIDENCE = 0.5
+#: Spacing of the r(t) grid, s (as the light gate's default).
+GRID_DT = 0.1
 
 
 def analyze_audio(
-    path: str | Path,
+    path: str | Path | list[str | Path],
     *,
     bpm: float | None = None,
     metronomes: int | None = None,
@@ -66,7 +82,9 @@ def analyze_audio(
 
     Parameters
     ----------
-    path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`).
+    path : a WAV, FLAC, Ogg or MP3 file (see `metrosync.audio.reader`), mono or with a
+        channel per microphone; or a list of files recorded together, one per
+        microphone, aligned by their cross-correlation (`metrosync.audio.together`).
     bpm : the metronomes' setting, BPM; default: found from the ticks.
     metronomes : how many metronomes sound; default: the ticks per beat in the windows
         where they were least together (95th percentile), rounded.
@@ -84,7 +102,15 @@ def analyze_audio(
     xarray.Dataset, described in the module docstring.
     """
     _check_options(bpm, metronomes, sensitivity, refractory, order_window, cluster_gap)
-    recording = open_recording(path)
+    if isinstance(path, list | tuple):
+        if len(path) == 1:
+            recording = open_recording(path[0])
+        else:
+            from .together import record_together
+
+            recording = record_together(path, band=band)
+    else:
+        recording = open_recording(path)
     rate = recording.sample_rate
     from ..progress import progress_bar
 
@@ -92,61 +118,93 @@ def analyze_audio(
                       desc="reading") as bar:  # fmt: skip
         scan = det.scan(recording, band=band, sensitivity=sensitivity, progress=bar)
     hop_s = scan.hop / rate
-    candidates = det.pick_ticks(scan, round(REFRACTORY_RANGE[0] / hop_s))
-    rough = beat_period(candidates * hop_s, bpm)
     if refractory is None:
-        refractory = float(np.clip(REFRACTORY_BEATS * rough, *REFRACTORY_RANGE))
+        refractory = REFRACTORY
     hops = det.pick_ticks(scan, max(1, round(refractory / hop_s)))
-    ticks = det.refine(recording, scan, hops)
-    order = np.argsort(ticks.time, kind="stable")
-    ticks = det.Ticks(ticks.time[order], ticks.strength[order],
-                      ticks.channel_strength[order], ticks.rise[order])  # fmt: skip
-    period = beat_period(ticks.time, bpm)
-    if bpm is not None:
+    impacts = det.refine(recording, scan, hops)
+    order = np.argsort(impacts.time, kind="stable")
+    impacts = det.Ticks(impacts.time[order], impacts.strength[order],
+                        impacts.channel_strength[order], impacts.rise[order])  # fmt: skip
+    if impacts.time.size < MIN_TICKS:
+        beat_period(impacts.time)  # raises the error that says what to try
+    sep = separate(recording, impacts)
+    heard = _median_bpm(sep)
+    if bpm is not None and not (heard and abs(heard / bpm - 1) <= HINT_RANGE):
+        hinted = separate(recording, impacts, bpm=bpm)
+        near = _median_bpm(hinted)
+        if near and abs(near / bpm - 1) <= HINT_RANGE:
+            sep, heard = hinted, near
+    heads = np.flatnonzero(sep.head)
+    ticks = det.Ticks(*(getattr(impacts, f)[heads] for f in det.Ticks.__dataclass_fields__))
+    where = np.full(impacts.time.size, -1, dtype=np.int64)
+    where[heads] = np.arange(heads.size)
+    trains = [_on_ticks(t, where) for t in sep.trains]
+    ticks, trains, recovered = recover(recording, scan, ticks, trains)
+    if trains:
+        # the median of the metronomes' tempi; where the trains may have gone wrong (a
+        # very noisy recording), from all the ticks, as without trains
+        period, tempo_source = 60.0 / heard, "the median of the metronomes' own tempi"
+        near = bpm is not None and abs(heard / bpm - 1) <= HINT_RANGE
+        if sep.confidence < MIN_CONFIDENCE or near:
+            try:
+                period = beat_period(ticks.time, bpm if near else None)
+                tempo_source = "given (bpm)" if near else "found from the ticks"
+            except AnalysisError:
+                pass
+    else:
         heard = 60.0 / beat_period(ticks.time)
-        if abs(heard * period / 60.0 - 1) > 0.15:
-            warnings.warn(
-                f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
-                f"analysis keeps near your setting, at {60 / period:.1f} BPM. Check the "
-                f"setting, or leave `bpm` out.",
-                UserWarning,
-                stacklevel=2,
-            )
+        period = beat_period(ticks.time, bpm)
+        tempo_source = "given (bpm)" if bpm is not None else "found from the ticks"
+    if bpm is not None:
+        _check_bpm(bpm, heard)
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
     # Synchronized metronomes tick as one; the windows where they were least together
     # count them best.
-    busiest = np.nanpercentile(acoustic.ticks_per_beat, 95)
-    n = int(metronomes) if metronomes is not None else max(1, round(busiest))
+    busiest = max(1, round(float(np.nanpercentile(acoustic.ticks_per_beat, 95))))
+    note = sep.note
+    if metronomes is not None:
+        n = int(metronomes)
+        source = "given"
+    elif trains:
+        n = len(trains)
+        source = "one tick train" if n == 1 else f"told apart by {sep.method}"
+    else:
+        n = busiest
+        source = "most ticks per beat in a window (95th percentile), rounded"
+    if trains and n != len(trains):
+        note = (f"{len(trains)} metronome(s) told apart, {n} expected"
+                + (f"; {note}" if note else ""))  # fmt: skip
+    elif trains and busiest > len(trains):
+        note = (f"up to {busiest} ticks per beat are heard but only {len(trains)} metronome(s) "
+                f"told apart; the others sound alike and keep the same tempo")  # fmt: skip
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
-    label = np.full(k, -1, dtype=np.int8)
+    label = _labels(k, trains)
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)
-    stats, attribution, why = [], None, ""
-    if n == 1:
-        s = beat_statistics(ticks.time, period, ticks.strength)
+    stats, kept = [], []
+    for m, t in enumerate(trains):
+        # a metronome's timing from its own ticks: one it took from another (that hid
+        # its own) is that other's onset
+        own = t.index[~t.masked]
+        own = own[~off_the_beat(ticks.time[own], t.beat[~t.masked])]
+        s = beat_statistics(ticks.time[own], t.period, ticks.strength[own])
         stats.append(s)
-        label[:] = 0
-        is_tock[:] = s.is_tock
-        interval[:-1] = _beats(ticks.time, s.beat_number)
-    elif n == 2:
-        attribution, why = attribute_pair(ticks.time, ticks.strength,
-                                          ticks.channel_strength, period)  # fmt: skip
-        if attribution is not None:
-            label = attribution.labels
-            phase = attribution.phase_difference
-            for g in (0, 1):
-                mine = np.flatnonzero(label == g)
-                s = beat_statistics(ticks.time[mine], period, ticks.strength[mine])
-                stats.append(s)
-                is_tock[mine] = s.is_tock
-                interval[mine[:-1]] = _beats(ticks.time[mine], s.beat_number)
-    else:
-        why = "telling metronomes apart is done for two"
+        mine = label[own] == m
+        is_tock[own[mine]] = s.is_tock[mine]
+        gaps = np.full(own.size, np.nan)
+        gaps[:-1] = _beats(ticks.time[own], s.beat_number)
+        interval[own[mine]] = gaps[mine]
+        kept.append(ph.kept_from_half_periods(ticks.time[own], s.beat_number,
+                                              parity=1 if s.is_tock[0] else 0))  # fmt: skip
+        if m > 0:
+            mine = np.flatnonzero(label == m)
+            phase[mine] = phase_difference(ticks.time[trains[0].index], ticks.time[mine],
+                                           trains[0].period)  # fmt: skip
     wanted = WINDOW_BEATS * period if order_window is None else order_window
     if span < wanted:
         warnings.warn(
@@ -157,8 +215,13 @@ def analyze_audio(
             stacklevel=2,
         )
     ds = _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase)
+    pendulums = _pendulum_phases(kept, GRID_DT)
+    ds = ds.merge(pendulums)
+    ds.attrs.update(pendulums.attrs)
     ds.attrs.update(
         path=str(recording.path),
+        paths=list(getattr(recording, "names", ())) or [str(recording.path)],
+        offsets=(np.asarray(getattr(recording, "offsets", [0])) / rate).tolist(),
         sample_rate=rate,
         channels=recording.channels,
         duration=recording.duration,
@@ -167,24 +230,84 @@ def analyze_audio(
         clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
-        tempo_source="given (bpm)" if bpm is not None else "found from the ticks",
+        tempo_source=tempo_source,
         metronomes=n,
-        metronomes_source="given"
-        if metronomes is not None
-        else "most ticks per beat in a window (95th percentile), rounded",
+        metronomes_source=source,
+        impacts=int(impacts.time.size),
+        ticks_recovered=recovered,
+        tick_structure=tick_length_words(sep),
         ticks_per_beat=per_beat,
         band=list(scan.band),
         sensitivity=sensitivity,
         refractory=refractory,
+        resolution=max(refractory, det.RESOLUTION),
         order_window=acoustic.window,
         order_step=acoustic.step,
         cluster_gap=cluster_gap,
-        attribution=attribution.method if attribution is not None else "none",
-        attribution_note=why,
+        attribution=sep.method if len(trains) > 1 else "none",
+        attribution_confidence=sep.confidence if trains else 0.0,
+        attribution_sureness=sureness(sep.confidence) if trains else "",
+        attribution_note=note,
         metrosync_version=__version__,
     )
     ds.attrs["summary"] = summary_text(ds)
     return ds
+
+
+def _pendulum_phases(kept: list, dt: float) -> xr.Dataset:
+    """frequency_bpm, period_jitter (metronome) and r (time), as the light gate has them,
+    through `observables.crossings`; the ticks of each metronome are its passes."""
+    if not kept:
+        return xr.Dataset(attrs={"r_eq": math.nan, "sigma_bpm": math.nan})
+    freq = np.array([ph.mean_frequency_bpm(k, c) for k, c in kept])
+    jitter = np.array([ph.period_jitter(k, c) for k, c in kept])
+    spans = [(float(k[0]), float(k[-1])) for k, _ in kept if len(k) >= 2]
+    grid = ph.common_grid(spans, dt) if len(spans) == len(kept) else np.empty(0)
+    r = ph.order_on_grid(kept, grid) if grid.size else np.empty(0)
+    r_eq = float(equilibrium_order(r, grid, 0.25 * (grid[-1] - grid[0]))) if grid.size else math.nan
+    data = {
+        "frequency_bpm": (("metronome",), freq, {"units": "BPM", "long_name": "mean frequency "
+                          "(two beats per period), as the light gate's"}),
+        "period_jitter": (("metronome",), jitter,
+                          {"units": "s", "long_name": "std of single periods (tick to tick)"}),
+        "r": (("time",), r, {"long_name": "order parameter of the pendulums from the ticks "
+                             "(each metronome's tick taken as the same direction)"}),
+    }  # fmt: skip
+    coords = {"time": ("time", grid, {"units": "s", "long_name": "time in the recording"})}
+    attrs = {"r_eq": r_eq, "sigma_bpm": ph.frequency_spread(freq)}
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _labels(k: int, trains: list[Train]) -> np.ndarray:
+    """(K,) the metronome of each tick: the one train that holds it (−1: none, or two
+    trains share it, their ticks fell together)."""
+    claims = np.zeros(k, dtype=np.int64)
+    for t in trains:
+        claims[t.index] += 1
+    out = np.full(k, -1, dtype=np.int8)
+    for m, t in enumerate(trains):
+        out[t.index[claims[t.index] == 1]] = m
+    return out
+
+
+def _on_ticks(train: Train, where: np.ndarray) -> Train:
+    """The train with indices into the ticks instead of the impacts."""
+    return replace(train, index=where[train.index])
+
+
+def _median_bpm(sep) -> float:
+    """The median of the metronomes' tempi, BPM (0 when none was found)."""
+    return float(np.median([60.0 / t.period for t in sep.trains])) if sep.trains else 0.0
+
+
+def _check_bpm(bpm: float, heard: float) -> None:
+    if abs(heard / bpm - 1) > HINT_RANGE:
+        warnings.warn(
+            f"the ticks sound like {heard:.1f} BPM, not near `bpm` {bpm:g}; the "
+            f"analysis keeps the tempo it heard. Check the setting, or leave `bpm` out.",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def _beats(times: np.ndarray, number: np.ndarray) -> np.ndarray:

@@ -25,10 +25,13 @@ below the noise of 16-bit sound (−100 dBFS) do not count.
 Onset times. Around each tick the waveform (channels averaged) is band-passed again
 with the same filter run forwards and backwards (no delay), and its envelope taken
 (Hilbert). The onset is the instant, interpolated between samples, at which the
-envelope last rises through halfway between the background before the tick and the
-tick's peak: for a click that starts abruptly it is the click's first sample within a
+envelope first rises, within `RISE_WINDOW` before the tick's peak, through
+`ONSET_FRACTION` (a quarter) of the way from the background before the tick to the
+peak, and `NOISE_CLEARANCE` robust spreads above that background (at most halfway):
+a tick's resonances can beat and dip after its first impact, whose onset is wanted.
+For a click that starts abruptly it is the click's first sample within a
 few tens of microseconds, and echoes, which come later, do not move it. The strength
-of a tick is its envelope peak (dBFS), also per channel, which stereo attribution uses.
+of a tick is its envelope peak (dBFS), also per channel.
 """
 
 from __future__ import annotations
@@ -46,12 +49,23 @@ from .settings import DEFAULT_BAND, DEFAULT_SENSITIVITY, DEFAULT_TOP
 HOP = 0.5e-3
 AHEAD = 1.0e-3
 PAST = 4.0e-3
+#: A tick that starts less than this after another is hidden in the detection curve
+#: (it sees the other's power as its own background), s.
+RESOLUTION = PAST + AHEAD
 THRESHOLD_SPAN = 2.0
 MIN_RISE = 6.0
 #: Samples at or above this magnitude count as clipped.
 CLIP_LEVEL = 0.999
 #: Width of one column of the plotted waveform, in hops.
 DISPLAY_HOPS = 10
+#: The onset is where the envelope rises through this fraction of the way from the
+#: background to the tick's peak.
+ONSET_FRACTION = 0.25
+#: The onset is sought this far before the envelope's peak, s.
+RISE_WINDOW = 2.5e-3
+#: ... and at least this many robust spreads of the envelope before the tick above its
+#: median (at most halfway up).
+NOISE_CLEARANCE = 6.0
 #: Half-width of the waveform window timed around each tick, s.
 REFINE_HALF = 6e-3
 #: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
@@ -290,13 +304,19 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
     ip = lo + np.argmax(env[:, lo:hi], axis=1)
     rows = np.arange(env.shape[0])
     peak = env[rows, ip]
-    background = np.median(env[:, : half - 2 * hop], axis=1)
-    level = background + 0.5 * (peak - background)
-    below = env < level[:, None]
-    below[:, 0] = True
-    # the last sample below the level before the peak: the envelope rises through it next
+    before = env[:, : half - 2 * hop]
+    background = np.median(before, axis=1)
+    noise = 1.4826 * np.median(np.abs(before - background[:, None]), axis=1)
+    # a quarter of the way up, and clear of the noise before the tick
+    clear = np.minimum(background + NOISE_CLEARANCE * noise, 0.5 * (peak + background))
+    level = np.maximum(background + ONSET_FRACTION * (peak - background), clear)
+    # the first rise through the level within `RISE_WINDOW` before the peak: a tick's
+    # resonances can beat and dip after its first impact, whose onset is wanted
     cols = np.arange(env.shape[1])
-    j = np.max(np.where(below & (cols[None, :] < ip[:, None]), cols[None, :], 0), axis=1)
+    reach = round(RISE_WINDOW * half / REFINE_HALF)
+    near = (cols[None, :] >= np.maximum(ip - reach, 1)[:, None]) & (cols[None, :] <= ip[:, None])
+    first = np.argmax((env >= level[:, None]) & near, axis=1)
+    j = np.maximum(first - 1, 0)
     e0, e1 = env[rows, j], env[rows, np.minimum(j + 1, env.shape[1] - 1)]
     frac = np.clip((level - e0) / np.where(e1 > e0, e1 - e0, 1.0), 0.0, 1.0)
     if segments.shape[2] > 1:

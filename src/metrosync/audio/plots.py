@@ -1,10 +1,12 @@
 """Plot of an `analyze_audio` result: waveform and ticks, beats, acoustic order.
 
-Panels, on one time axis: the waveform (channel mix) with every detected tick; the
-beat of each tick (time to the same metronome's next tick), ticks and tocks in two
-colours, so that a metronome out of beat shows two lines; the acoustic order
-parameter R with its floor for independent metronomes and the distinct ticks per
-beat; and, when two metronomes were told apart, the phase of 1's ticks in 0's beat.
+Panels, on one time axis: the waveform (channel mix) with every detected tick,
+coloured by the metronome it was given to (grey: none, or two at once); the beat of
+each tick (time to the same metronome's next tick) in its metronome's colour, ticks
+and tocks as two markers, so that a metronome out of beat shows two lines; the
+acoustic order parameter R with its floor for independent metronomes and the distinct
+ticks per beat; and, when metronomes were told apart, each one's ticks' phase in
+metronome 0's beat.
 """
 
 from __future__ import annotations
@@ -16,7 +18,9 @@ import numpy as np
 from .._words import plural
 from ..plots import finish_figure, new_figure
 
-TICK_COLOURS = ("C0", "C3")
+#: Colour of metronome m: METRONOME_COLOURS[m % 10]; ticks of none are grey.
+METRONOME_COLOURS = tuple(f"C{i}" for i in range(10))
+UNATTRIBUTED = "0.6"
 #: Columns of the drawn waveform, at most (a screen's width; more only slows drawing).
 MAX_COLUMNS = 3000
 MARKERS = ("o", "s")
@@ -41,11 +45,16 @@ def plot_audio(ds, path: Path | str | None = None):
     ax = axes[0]
     ax.fill_between(*_columns(ds, MAX_COLUMNS), color="0.35", lw=0)
     height = 10 ** (ds.tick_strength.values / 20)
-    ax.plot(t, height, "|", color="C2", ms=6, label=f"{plural(t.size, 'tick')} detected")
+    for m in sorted(set(label.tolist())):
+        sel = label == m
+        name = f"metronome {m}" if m >= 0 else "not attributed"
+        ax.plot(t[sel], height[sel], "|", ms=6, color=colour(m),
+                label=f"{name}: {plural(int(sel.sum()), 'tick')}")  # fmt: skip
     ax.set_ylabel("waveform")
     ax.legend(loc="upper right", fontsize="small")
+    sure = f", attribution {a['attribution_sureness']}" if a.get("attribution_sureness") else ""
     ax.set_title(
-        f"{Path(a['path']).name}: {a['bpm_ensemble']:.2f} BPM, {a['metronomes']} metronome(s)"
+        f"{Path(a['path']).name}: {a['bpm_ensemble']:.2f} BPM, {a['metronomes']} metronome(s){sure}"
     )
 
     ax = axes[1]
@@ -55,8 +64,8 @@ def plot_audio(ds, path: Path | str | None = None):
             for kind, name in ((0, "tick→tock"), (1, "tock→tick")):
                 sel = (label == m) & (tock == kind) & np.isfinite(interval)
                 who = f"metronome {m}, " if ds.sizes.get("metronome", 1) > 1 else ""
-                ax.plot(t[sel], interval[sel], MARKERS[m % 2], ms=2.5,
-                        color=TICK_COLOURS[kind], label=f"{who}{name}")  # fmt: skip
+                ax.plot(t[sel], interval[sel], MARKERS[kind], ms=2.5, color=colour(m),
+                        label=f"{who}{name}")  # fmt: skip
         ax.set_ylabel("beat (ms)")
     else:
         ax.plot(ds.window.values, ds.beat_period.values * 1e3, color="C0",
@@ -78,13 +87,21 @@ def plot_audio(ds, path: Path | str | None = None):
 
     if with_phase:
         ax = axes[3]
-        ok = np.isfinite(phase)
-        ax.plot(t[ok], np.degrees(phase[ok]), ".", ms=2, color="C4")
+        for m in sorted(set(label[np.isfinite(phase)].tolist())):
+            ok = np.isfinite(phase) & (label == m)
+            ax.plot(t[ok], np.degrees(phase[ok]), ".", ms=2, color=colour(m),
+                    label=f"metronome {m}")  # fmt: skip
         ax.set_ylim(-180, 180)
         ax.set_yticks([-180, -90, 0, 90, 180])
-        ax.set_ylabel("phase of 1 in 0's beat (°)")
+        ax.set_ylabel("phase in 0's beat (°)")
+        ax.legend(loc="upper right", fontsize="small")
     axes[-1].set_xlabel("time in the recording (s)")
     return finish_figure(fig, path)
+
+
+def colour(metronome: int) -> str:
+    """The colour of a metronome's ticks (grey for −1: none)."""
+    return METRONOME_COLOURS[metronome % 10] if metronome >= 0 else UNATTRIBUTED
 
 
 def _columns(ds, most: int):

@@ -25,8 +25,14 @@ def summary_text(ds) -> str:
         f"{a['sample_rate']} Hz, {a['duration']:.1f} s)",
         f"  ticks: {k}, beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
         f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",
+        f"  impacts heard: {a['impacts']}, {a['tick_structure']}"
+        + (
+            f"; {a['ticks_recovered']} ticks hidden by others found again where their "
+            f"metronome's beat put them"
+            if a.get("ticks_recovered")
+            else ""
+        ),
         f"  metronomes: {n} ({a['metronomes_source']})"
-        + (f"; told apart by {a['attribution']}" if a["attribution"] != "none" else "")
         + (f"; not told apart ({a['attribution_note']})" if a["attribution_note"] else ""),
     ]
     if "metronome" in ds.dims:
@@ -41,17 +47,32 @@ def summary_text(ds) -> str:
                 )
             )
             lines.append(f"    {str(ds.beat_verdict.values[m])}")
+    if a.get("attribution_sureness"):
+        lines.insert(
+            4,
+            f"  attribution: {a['attribution_sureness']} (confidence "
+            f"{a['attribution_confidence']:.2f}: share of ticks in a train x share of beats "
+            f"heard x how far apart the sounds are)",
+        )
     phase = ds.phase_difference.values
-    if np.isfinite(phase).any():
-        last = phase[np.isfinite(phase)]
-        last = last[-max(1, last.size // 4) :]
+    label = ds.tick_metronome.values
+    for m in range(1, ds.sizes.get("metronome", 0)):
+        mine = phase[(label == m) & np.isfinite(phase)]
+        if not mine.size:
+            continue
+        last = mine[-max(1, mine.size // 4) :]
         z = np.exp(1j * last).mean()
         spread = np.degrees(np.sqrt(max(0.0, -2 * np.log(max(abs(z), 1e-12)))))
         state = "drifting: not locked" if spread > 60 else "locked"
         lines.append(
-            f"  phase difference of the ticks (1 in 0's beat), last quarter: "
+            f"  phase difference of the ticks ({m} in 0's beat), last quarter: "
             f"{np.degrees(np.angle(z)):.1f}° ± {spread:.1f}° ({state}; 0°: together; the "
             f"pendulums differ by half this, or half plus 180°)"
+        )
+    if ds.sizes.get("metronome", 0) > 1 and np.isfinite(a.get("r_eq", np.nan)):
+        lines.append(
+            f"  sigma = {a['sigma_bpm']:.4f} BPM; equilibrium r of the pendulums (last quarter, "
+            f"ticks as passes one way) {a['r_eq']:.3f}"
         )
     if n > 1 or k and "metronome" not in ds.dims:
         r0, r1 = _quarter_mean(ds.r_acoustic, False), _quarter_mean(ds.r_acoustic, True)

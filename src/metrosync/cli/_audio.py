@@ -28,6 +28,7 @@ AUDIO_OPTIONS = {
     "bpm": "--bpm", "metronomes": "--metronomes", "band": "--band",
     "sensitivity": "--sensitivity", "refractory": "--refractory",
     "order_window": "--order-window", "cluster_gap": "--cluster-gap",
+    "together": "--together",
 }  # fmt: skip
 
 
@@ -52,7 +53,7 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
         _lightgate_defaults={dest: parser.get_default(dest) for dest in LIGHTGATE_OPTIONS}
     )
     g = parser.add_argument_group(
-        "sound recordings (.wav, .flac, .ogg, .mp3: one file)",
+        "sound recordings (.wav, .flac, .ogg, .mp3: one file, or several with --together)",
         "Tick times, tempo, beat (tick/tock), and how together the ticks fall.",
     )
     g.add_argument(
@@ -100,6 +101,10 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--cluster-gap", type=float, default=CLUSTER_GAP, metavar="F",
                    help="ticks closer than this fraction of a beat sound as one")  # fmt: skip
+    g.add_argument("--together", action="store_true",
+                   help="the recordings were made at the same time by several microphones "
+                   "(one file each): align them and tell the metronomes apart by their "
+                   "level at each")  # fmt: skip
     parser.set_defaults(_audio_defaults={dest: parser.get_default(dest) for dest in AUDIO_OPTIONS})
     add_aliases(parser, **AUDIO_OPTIONS)
 
@@ -129,12 +134,18 @@ def audio_requested(args) -> bool:
 
 
 def run_audio(args) -> int:
-    """Analyse one recording, print the summary, write --out and --plot."""
-    if len(args.logs) != 1:
+    """Analyse one recording (or several made together), print the summary, write --out
+    and --plot."""
+    together = getattr(args, "together", False)
+    if len(args.logs) != 1 and not together:
         raise ParameterError(
             f"analyse one recording at a time; got {len(args.logs)}: "
-            f"{', '.join(str(p) for p in args.logs)}."
+            f"{', '.join(str(p) for p in args.logs)}. Recorded at the same time by "
+            f"several microphones? Add --together."
         )
+    if together and len(args.logs) == 1:
+        warnings.warn("--together with one recording: nothing to align.", UserWarning,
+                      stacklevel=2)  # fmt: skip
     ignored = _changed(args, args._lightgate_defaults, LIGHTGATE_OPTIONS)
     if ignored:
         warnings.warn(f"a recording ignores {', '.join(ignored)} (options for light-gate "
@@ -145,7 +156,7 @@ def run_audio(args) -> int:
     from ..audio.plots import plot_audio
 
     ds = analyze_audio(
-        args.logs[0],
+        list(args.logs) if together else args.logs[0],
         bpm=args.bpm,
         metronomes=args.metronomes,
         band=args.band,

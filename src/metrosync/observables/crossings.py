@@ -95,3 +95,21 @@ def channel_span(kept: np.ndarray, source: str, channel: int) -> tuple[float, fl
             f"a phase. Leave it out with `channels=` (CLI: --channels), or check its wiring."
         )
     return float(kept[0]), float(kept[-1])
+
+
+def kept_from_half_periods(
+    times: np.ndarray, half_period: np.ndarray, parity: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """(kept, cycles) from passes counted in half periods, both directions heard.
+
+    A sound (a tick each way) or a camera sees a pendulum pass the vertical twice per
+    period; the passes numbered ``half_period`` (P,) (integers, gaps where missed)
+    with the given ``parity`` go one way and are kept, as a light gate keeps one
+    direction. Returns kept (Q,) times and cycles (Q-1,) periods between them.
+    """
+    times = np.asarray(times, dtype=float)
+    half_period = np.asarray(half_period, dtype=np.int64)
+    keep = half_period % 2 == parity % 2
+    kept = times[keep]
+    cycles = np.diff(half_period[keep]) // 2
+    return kept, cycles

@@ -1,0 +1,476 @@
+"""From impacts to metronomes: impacts grouped into ticks, ticks followed as trains.
+
+Contract:
+
+* `group_impacts(times, voices)` → (first (K,) bool, gap (V,)): True for the impact
+  that starts a tick; the later impacts of one tick are folded into it.
+* `track(times, own, period)` → `Train`: one metronome's ticks, followed beat by beat
+  from a seed through the whole recording.
+* `trains_of_voice(times, own, period)` → the `Train` s of one voice: one per
+  metronome that sounds like it, told apart by their tempo and phase.
+* `join_fragments(times, trains, voices)`: trains that are pieces of one metronome's
+  beat (its tick and its tock when they sound different, or every third tick heard in
+  one voice and the rest in another) become one.
+
+A tick is one event. A real tick is a main impact and one to three more 15–35 ms
+later, ringing for tens of milliseconds. How far a tick reaches is read from the
+recording itself: among the impacts of one voice, the differences between each impact
+and the later ones up to `MAX_TICK_LENGTH` pile up, above the level unrelated
+impacts at the same rate would give, at the lags of the tick's own later impacts.
+The last lag bin where they do (at least `MIN_SHARE_LATE` of the impacts) bounds the
+tick: an impact of the same voice that follows a tick's first impact within that
+gap belongs to it. The tick's time is its first impact.
+
+Following a train. A seed tick's successor one beat later is the one whose multiples
+(2 to 6 beats on) are also heard; the train then goes on beat by beat: the next tick
+is predicted one full swing (two beats: a tick and a tock, so an uneven beat does not
+matter) after the tick two beats back, or one beat after the last tick, and the
+nearest tick of the voice within `SWING_TOLERANCE` (resp. `BEAT_TOLERANCE`) of the
+beat is taken. A beat where the voice has none takes the nearest impact of any voice
+within `MASKED_TOLERANCE`: one tick can hide another that falls on it. The beat is
+updated from each full swing, so that a metronome that slowly speeds up is followed.
+After `MAX_MISSING` beats without a tick the train is sought again from a new seed.
+Trains are followed backwards from the seed in the same way.
+
+Two metronomes of one sound. The train found first takes its ticks; from what is left
+the next train is sought, and so on: two metronomes 4 BPM apart share a sound but not a
+beat. A train with fewer than `MIN_COVERAGE` of its beats heard is not a metronome.
+
+Pieces of one metronome. A metronome whose tick and tock sound different is heard as
+two voices, each ticking once per swing; ringing and overlaps can split its ticks
+among voices in other patterns too. Two trains are one metronome when both periods
+are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %), and
+the second's ticks fall on the first's grid of beats T (circular spread below
+2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp), almost
+never (10 %) within 0.3 T of the first's own ticks; or when one takes up the other's
+beat (the same period within 1 %, its first tick a whole number of beats, at most
+`MAX_BRIDGED`, within 15 %, after the other's last). (Two metronomes locked a whole
+number of beats apart at whole-number ratios of tempo would be taken for one;
+synchronized metronomes tick together, on each other's ticks.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+MAX_TICK_LENGTH = 0.09
+LAG_BIN = 2e-3
+MIN_SHARE_LATE = 0.05
+#: A tick's onset is its first impact at most this much (dB) below its loudest.
+ONSET_DROP = 20.0
+SWING_TOLERANCE = 0.03
+BEAT_TOLERANCE = 0.10
+MASKED_TOLERANCE = 4e-3
+MAX_MISSING = 6
+MIN_COVERAGE = 0.5
+LOCKED_SPREAD = 0.04
+#: Largest multiple of a metronome's beat that a piece of its train may tick at.
+MAX_FRAGMENT = 6
+#: Most beats between a train's end and a train that takes up its beat.
+MAX_BRIDGED = 64
+#: Largest spread (s) of the lag of a train that is part of another's ticks.
+PART_LAG_SPREAD = 0.3e-3
+#: A tick farther than this from its train's beat is not its metronome's, s.
+OFF_BEAT = 3e-3
+#: Beats searched for a seed's successor, s (300 to 30 BPM).
+BEAT_RANGE = (0.2, 2.0)
+
+
+@dataclass(frozen=True)
+class Train:
+    """One metronome's ticks.
+
+    index : (M,) indices into the tick array, in time order.
+    beat : (M,) beat number of each (0 for the first; gaps where beats were missed).
+    period : mean beat, s.
+    masked : (M,) True where the tick was taken from another voice (hidden by it).
+    """
+
+    index: np.ndarray
+    beat: np.ndarray
+    period: float
+    masked: np.ndarray
+
+    @property
+    def coverage(self) -> float:
+        """Share of the beats from the first tick to the last that were heard."""
+        return self.index.size / (self.beat[-1] + 1) if self.index.size else 0.0
+
+
+def group_impacts(
+    times: np.ndarray, voices: np.ndarray, strength: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(first (K,) bool, gap (V,) s): see the module docstring. Impacts of no voice
+    (−1) that fall within a tick's gap are folded into it too. With ``strength`` (K,),
+    dB, a tick's onset is its first impact within `ONSET_DROP` of its loudest: a
+    faint sound just ahead of a tick (a lossy coder's pre-echo) does not time it."""
+    times = np.asarray(times, dtype=float)
+    k = times.size
+    first = np.ones(k, dtype=bool)
+    count = int(voices.max()) + 1 if k else 0
+    gaps = np.zeros(max(count, 0))
+    span = max(times[-1] - times[0], 1e-9) if k else 1.0
+    for v in range(count):
+        mine = np.flatnonzero(voices == v)
+        gap = tick_length(times[mine], span)
+        gaps[v] = gap
+        if gap <= 0:
+            continue
+        start = -np.inf
+        group: list[int] = []
+        for i in [*mine, -1]:
+            if i >= 0 and times[i] - start <= gap:
+                group.append(i)
+                continue
+            if strength is not None and len(group) > 1:
+                loud = strength[group]
+                onset = group[int(np.argmax(loud >= loud.max() - ONSET_DROP))]
+                first[group] = False
+                first[onset] = True
+            elif group:
+                first[group[1:]] = False
+            if i >= 0:
+                start, group = times[i], [i]
+    # strays right after a tick of any voice belong to that tick
+    if count and (voices < 0).any():
+        heads = np.flatnonzero(first & (voices >= 0))
+        for i in np.flatnonzero(voices < 0):
+            j = np.searchsorted(times[heads], times[i], side="right") - 1
+            if j >= 0 and times[i] - times[heads[j]] <= gaps[voices[heads[j]]]:
+                first[i] = False
+    return first, gaps
+
+
+def tick_length(times: np.ndarray, span: float) -> float:
+    """How far one tick of this voice reaches, s (0: one impact per tick)."""
+    k = times.size
+    if k < 8:
+        return 0.0
+    bins = np.arange(0.0, MAX_TICK_LENGTH + LAG_BIN, LAG_BIN)
+    ends = np.searchsorted(times, times + MAX_TICK_LENGTH, side="right")
+    lags = [times[i + 1 : ends[i]] - times[i] for i in range(k) if ends[i] > i + 1]
+    if not lags:
+        return 0.0
+    counts = np.histogram(np.concatenate(lags), bins)[0]
+    expected = k * (k / span) * LAG_BIN
+    excess = counts >= np.maximum(MIN_SHARE_LATE * k, expected + 4 * math.sqrt(expected) + 1)
+    if not excess.any():
+        return 0.0
+    return float(bins[np.flatnonzero(excess)[-1] + 1] + LAG_BIN)
+
+
+def _nearest(times: np.ndarray, pool: np.ndarray, target: float) -> tuple[int, float]:
+    """(index into times of the nearest of ``pool`` (sorted indices) to target, distance)."""
+    if pool.size == 0:
+        return -1, math.inf
+    j = np.searchsorted(times[pool], target)
+    best, dist = -1, math.inf
+    for c in (j - 1, j):
+        if 0 <= c < pool.size:
+            d = abs(times[pool[c]] - target)
+            if d < dist:
+                best, dist = int(pool[c]), d
+    return best, dist
+
+
+def _walk(t: np.ndarray, p: int, d: float, beats: int = 6) -> tuple[int, float, float]:
+    """(hits, mean error (s) where a swing predicted, beat) of a short walk from t[p]
+    with a first beat d: once a full swing has been heard, each tick is predicted one
+    swing after the tick two beats back; the beat returned is half the last swing."""
+    when = [t[p]]
+    hits, err, last, swing = 0, 0.0, 0, 2 * d
+    for n in range(1, beats + 1):
+        by_swing = n >= 3 and when[n - 2] is not None
+        if by_swing:
+            target, tol = when[n - 2] + swing, SWING_TOLERANCE * d
+        else:
+            target, tol = when[last] + (n - last) * 0.5 * swing, BEAT_TOLERANCE * d
+        j = int(np.clip(np.searchsorted(t, target), 1, t.size - 1))
+        c = j if abs(t[j] - target) < abs(t[j - 1] - target) else j - 1
+        e = abs(t[c] - target)
+        if e <= tol:
+            when.append(t[c])
+            hits += 1
+            err += e if by_swing else 0.0  # an uneven beat is not an error
+            last = n
+            if when[n - 2] is not None and n >= 2:
+                swing = t[c] - when[n - 2]
+        else:
+            when.append(None)
+    return hits, err / max(hits, 1), 0.5 * swing
+
+
+def _seed(times, own_idx, start: int, beat_range=BEAT_RANGE):
+    """(position in own_idx, beat) of the first tick from ``start`` on with a steady
+    successor one beat (in ``beat_range``, s) later, or None."""
+    t = times[own_idx]
+    lo, hi = beat_range
+    for p in range(start, own_idx.size):
+        cand = np.flatnonzero((t > t[p] + lo) & (t < t[p] + hi))[:64]
+        if cand.size == 0:
+            continue
+        walks = [_walk(t, p, t[c] - t[p]) for c in cand]
+        most = max(w[0] for w in walks)
+        if most < 5:
+            continue
+        best_err = min(w[1] for w in walks if w[0] == most)
+        # the shortest beat that walks as well: twice the beat walks too
+        fit = [w[2] for w in walks if w[0] == most and w[1] <= best_err + max(3e-3, 0.02 * w[2])]
+        return p, min(fit)
+    return None
+
+
+def _follow(times, own_idx, other_idx, seed_pos, beat, end_time):
+    """Follow forwards from own_idx[seed_pos]: dict beat number → (index, masked)."""
+    got = {0: (int(own_idx[seed_pos]), False)}
+    when = {0: times[own_idx[seed_pos]]}
+    last, n, period = 0, 1, beat
+    while n - last <= MAX_MISSING:
+        if n - 2 in when:
+            predicted, tol = when[n - 2] + 2 * period, SWING_TOLERANCE * period
+        else:
+            predicted = when[last] + (n - last) * period
+            tol = BEAT_TOLERANCE * period
+        if predicted > end_time + tol:
+            break
+        i, d = _nearest(times, own_idx, predicted)
+        masked = False
+        if d > tol:
+            i, d = _nearest(times, other_idx, predicted)
+            masked = True
+            if d > MASKED_TOLERANCE:
+                i = -1
+        if i >= 0:
+            got[n] = (i, masked)
+            when[n] = times[i]
+            if n - 2 in when and not masked:
+                swing = 0.5 * (when[n] - when[n - 2])
+                if abs(swing - period) < SWING_TOLERANCE * period:
+                    period += 0.2 * (swing - period)
+            last = n
+        n += 1
+    return got, period
+
+
+def track(times, own, *, others=None, start: int = 0, beat_range=BEAT_RANGE):
+    """The `Train` through one seed at or after own[start] (see the module docstring).
+
+    times : (K,) all tick times, sorted. own : (P,) sorted indices of the voice's ticks
+    not yet taken. others : sorted indices of ticks a masked beat may take.
+    Returns (Train or None, position in ``own`` after the seed).
+    """
+    times = np.asarray(times, dtype=float)
+    own = np.asarray(own, dtype=np.int64)
+    others = np.zeros(0, dtype=np.int64) if others is None else np.asarray(others, np.int64)
+    found = _seed(times, own, start, beat_range)
+    if found is None:
+        return None, own.size
+    pos, beat = found
+    end, begin = times[-1], times[0]
+    fwd, period_f = _follow(times, own, others, pos, beat, end)
+    # backwards: the same on mirrored time
+    mirror = -times[::-1]
+    rev = lambda idx: (times.size - 1 - idx)[::-1]  # noqa: E731
+    r_own, r_others = rev(own), rev(others)
+    r_pos = int(np.flatnonzero(r_own == times.size - 1 - own[pos])[0])
+    bwd, _ = _follow(mirror, r_own, r_others, r_pos, beat, -begin)
+    beats = {n: v for n, v in fwd.items()}
+    for n, (i, m) in bwd.items():
+        if n > 0:
+            beats[-n] = (times.size - 1 - i, m)
+    numbers = np.array(sorted(beats))
+    index = np.array([beats[n][0] for n in numbers], dtype=np.int64)
+    masked = np.array([beats[n][1] for n in numbers], dtype=bool)
+    keep = np.concatenate([[True], np.diff(index) > 0])  # one tick never serves two beats
+    numbers, index, masked = numbers[keep], index[keep], masked[keep]
+    numbers = numbers - numbers[0]
+    span = times[index[-1]] - times[index[0]]
+    mean_beat = span / numbers[-1] if numbers[-1] > 0 else period_f
+    return Train(index, numbers, float(mean_beat), masked), pos + 1
+
+
+def trains_of_voice(
+    times, own, *, others=None, min_ticks: int = 8, beat_range=BEAT_RANGE
+) -> list[Train]:
+    """Every metronome heard in one voice's ticks ``own`` (sorted indices into times),
+    its first beat sought in ``beat_range`` (s)."""
+    left = np.asarray(own, dtype=np.int64)
+    out: list[Train] = []
+    start = 0
+    while left.size >= min_ticks and start < left.size:
+        train, start = track(times, left, others=others, start=start, beat_range=beat_range)
+        if train is None:
+            break
+        if train.index.size < min_ticks or train.coverage < MIN_COVERAGE:
+            continue
+        out.append(train)
+        taken = train.index[~train.masked]
+        left = left[~np.isin(left, taken)]
+        others = np.union1d(others if others is not None else [], taken).astype(np.int64)
+        start = 0
+    return out
+
+
+def drop_shared(trains: list[Train], voice: list[int]) -> tuple[list[Train], list[int]]:
+    """Trains that are mostly masked ticks, their own or taken by other trains, are
+    dropped: two metronomes that tick together make a sound of their own, a voice that
+    is neither."""
+    own = [t.masked.mean() < 0.5 for t in trains]  # a train of borrowed ticks is none
+    trains = [t for t, k in zip(trains, own, strict=True) if k]
+    voice = [v for v, k in zip(voice, own, strict=True) if k]
+    keep = []
+    for a, t in enumerate(trains):
+        taken = np.zeros(t.index.size, dtype=bool)
+        for b, u in enumerate(trains):
+            if b != a:
+                taken |= np.isin(t.index, u.index[u.masked])
+        keep.append(taken.mean() < 0.5)
+    return ([t for t, k in zip(trains, keep, strict=True) if k],
+            [v for v, k in zip(voice, keep, strict=True) if k])  # fmt: skip
+
+
+def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strength=None):
+    """Trains that are part of another's ticks, folded into it: (trains, voices,
+    indices of the folded ticks).
+
+    A train B is part of a train A when B's ticks keep a fixed lag (spread below
+    `PART_LAG_SPREAD`), within `MAX_TICK_LENGTH`, to A's, and either B's period is a
+    multiple (2 or more) of A's (a sound ahead of or after every few ticks: the
+    pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
+    A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
+    different from the first. Two metronomes locked a few milliseconds apart keep a
+    lag that wanders by more than that, as each one's beat jitters.
+    """
+    keep = [True] * len(trains)
+    folded = []
+    for b, tb in enumerate(trains):
+        for a, ta in enumerate(trains):
+            if a == b or not keep[a]:
+                continue
+            ratio = tb.period / ta.period
+            k = round(ratio)
+            if k < 1 or abs(ratio - k) > 0.01 * k:
+                continue
+            t_a, t_b = times[ta.index], times[tb.index]
+            j = np.clip(np.searchsorted(t_a, t_b), 1, t_a.size - 1)
+            lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
+                           t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
+            middle = float(np.median(lag))
+            if abs(middle) >= MAX_TICK_LENGTH or _robust_spread(lag) >= PART_LAG_SPREAD:
+                continue
+            if k == 1:
+                if middle <= 0 or strength is None:
+                    continue
+                if np.mean(strength[tb.index]) >= np.mean(strength[ta.index]) - 1.0:
+                    continue
+            keep[b] = False
+            folded.append(tb.index[~tb.masked])
+            break
+    return ([t for t, k in zip(trains, keep, strict=True) if k],
+            [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
+
+
+def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
+    """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
+    (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
+    to each kind of beat (tick, tock: a limp) apart; a later impact taken for a tick
+    where the first was hidden, at the ends of a train, would bias its tempo."""
+    times = np.asarray(times, dtype=float)
+    out = np.zeros(times.size, dtype=bool)
+    for parity in (0, 1):
+        sel = np.flatnonzero(beat % 2 == parity)
+        if sel.size < 6:
+            continue
+        n = beat[sel].astype(float)
+        fit = np.polyval(np.polyfit(n, times[sel], 2), n)
+        residual = times[sel] - fit
+        limit = max(OFF_BEAT, 5 * _robust_spread(residual))
+        out[sel] = np.abs(residual - np.median(residual)) > limit
+    return out
+
+
+def _robust_spread(x: np.ndarray) -> float:
+    """1.4826 × the median absolute deviation: a standard deviation that a few odd
+    values (a masked tick) do not inflate."""
+    return float(1.4826 * np.median(np.abs(x - np.median(x))))
+
+
+def join_fragments(times: np.ndarray, trains: list[Train], voice: list[int]):
+    """Trains that are pieces of one metronome's beat, joined: (trains, voices of each
+    (tuple)). See the module docstring."""
+    trains, groups = list(trains), [(v,) for v in voice]
+    joined = True
+    while joined:
+        joined = False
+        for a in range(len(trains)):
+            for b in range(len(trains)):
+                if a == b:
+                    continue
+                beat = _common_beat(times, trains[a], trains[b])
+                if beat is None:
+                    beat = _continues(times, trains[a], trains[b])
+                if beat is None:
+                    continue
+                trains[a] = _merge(times, trains[a], trains[b], beat)
+                groups[a] = groups[a] + groups[b]
+                del trains[b], groups[b]
+                joined = True
+                break
+            if joined:
+                break
+    return trains, groups
+
+
+def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
+    """The beat T of which both trains' periods are whole multiples (up to
+    `MAX_FRAGMENT`) and on whose grid, laid from train a, b's ticks fall at a fixed
+    place between a's ticks; None if there is none."""
+    t_a, t_b = times[ta.index], times[tb.index]
+    inside = (t_b > t_a[0]) & (t_b < t_a[-1])
+    if inside.sum() < 4:
+        return None
+    for ka in range(1, MAX_FRAGMENT + 1):
+        beat = ta.period / ka
+        kb = round(tb.period / beat)
+        if beat < BEAT_RANGE[0] or kb < 1 or ka * kb == 1:
+            continue
+        if abs(tb.period / (kb * beat) - 1) > 0.01:
+            continue
+        k = np.searchsorted(t_a, t_b[inside]) - 1
+        gap_before = t_b[inside] - t_a[k]
+        gap_after = t_a[np.minimum(k + 1, t_a.size - 1)] - t_b[inside]
+        if np.mean(np.minimum(gap_before, gap_after) < 0.3 * beat) > 0.1:
+            continue  # on a's own ticks: two metronomes ticking together
+        z = np.exp(2j * np.pi * gap_before / beat).mean()
+        spread = math.sqrt(max(0.0, -2 * math.log(max(abs(z), 1e-12)))) / (2 * np.pi)
+        off_grid = abs(np.angle(z) / (2 * np.pi))
+        if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
+            return beat
+    return None
+
+
+def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
+    """The beat, when train b takes up train a's beat after a ended: one metronome
+    followed again after ticks of another hid it for more than `MAX_MISSING` beats."""
+    if abs(tb.period / ta.period - 1) > 0.01:
+        return None
+    end, start = times[ta.index[-1]], times[tb.index[0]]
+    beat = 0.5 * (ta.period + tb.period)
+    beats = (start - end) / beat
+    if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > 0.15:
+        return None
+    return beat
+
+
+def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
+    index = np.concatenate([ta.index, tb.index])
+    masked = np.concatenate([ta.masked, tb.masked])
+    order = np.argsort(times[index], kind="stable")
+    index, masked = index[order], masked[order]
+    t = times[index]
+    steps = np.maximum(1, np.rint(np.diff(t) / beat)).astype(np.int64)
+    beat = np.concatenate([[0], np.cumsum(steps)])
+    return Train(index, beat, float((t[-1] - t[0]) / beat[-1]), masked)
