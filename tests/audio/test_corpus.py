@@ -410,21 +410,3 @@ def test_the_phone_set_keeps_the_onsets_within_half_a_millisecond(four):
               - rec.truth[i].times[k] for i, k in isolated(rec.truth, gap=0.4)]  # fmt: skip
     assert len(errors) == 40
     assert np.max(np.abs(errors)) <= 5e-4
-
-
-@pytest.mark.slow
-def test_a_minute_of_four_metronomes_with_every_impairment_takes_under_a_second():
-    """CPU time of this process (all its threads), so that other jobs on the machine
-    do not count; about 0.2 s on the 2-core development machine."""
-    import time
-
-    group = voices(4, seed=2)
-    trains = [steady_train(bpm, 60.0, phase=0.1 * i, drift_bpm_per_min=0.5, voice=group[i],
-                           seed=i) for i, bpm in enumerate([96, 100, 104, 108])]  # fmt: skip
-    make_recording([steady_train(100, 2.0)])  # warm the imports
-    best = np.inf
-    for _ in range(2):
-        start = time.process_time()
-        make_recording(trains, impairments=Impairments.phone(clipping=0.8), seed=1)
-        best = min(best, time.process_time() - start)
-    assert best < 1.0
