@@ -6,7 +6,9 @@ plain Kuramoto oscillators) for several sizes N, fit the finite-size-scaling for
 
     r(x, N) = N^(−β/ν̄) · F((x − x_c) · N^(1/ν̄))
 
-with F a polynomial of degree ``degree`` (the master curve near the transition).
+with F a polynomial of degree ``degree`` in tanh(u/s), u the scaling variable and s
+a fitted scale: a master curve that may saturate on either side of the transition,
+so that a BPM grid wide enough for the smallest N still collapses at the largest.
 The fit is one weighted least-squares problem over all sizes at once, in the raw
 r, so each point keeps its own error; x_c, the polynomial's coefficients and,
 unless fixed, the exponents a = β/ν̄ and b = 1/ν̄ are its parameters. Statistical
@@ -30,6 +32,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import xarray as xr
 from scipy.optimize import least_squares
 
 from ..errors import ParameterError
@@ -39,6 +42,8 @@ KURAMOTO_EXPONENTS = (0.2, 0.4)
 #: Bounds of the exponents a = β/ν̄ and b = 1/ν̄ when they are fitted.
 A_BOUNDS = (0.0, 1.0)
 B_BOUNDS = (0.05, 2.0)
+#: Bounds of the fitted factor on the master curve's scale of u.
+W_BOUNDS = (0.05, 20.0)
 #: Smallest error a point may carry, so that a point with zero spread (all runs
 #: equal) does not dominate the fit.
 ERROR_FLOOR = 1e-4
@@ -59,9 +64,9 @@ class Collapse:
     fixed : bool
         True when the exponents were fixed rather than fitted.
     coefficients : ndarray (degree + 1,)
-        Master curve F(u) = Σ c_k (u/u_scale)^k.
+        Master curve F(u) = Σ c_k tanh(u/u_scale)^k.
     u_scale : float
-        Scale of the scaling variable in the polynomial (for conditioning).
+        Fitted scale of the scaling variable u in the master curve.
     chi2_dof : float
         χ² per degree of freedom of the fit.
     sizes : tuple of int
@@ -88,7 +93,8 @@ class Collapse:
 
     def master(self, u: np.ndarray) -> np.ndarray:
         """The fitted master curve F at scaling variable ``u`` = (x − x_c)·N^b."""
-        return np.polynomial.polynomial.polyval(np.asarray(u) / self.u_scale, self.coefficients)
+        t = np.tanh(np.asarray(u, dtype=float) / self.u_scale)
+        return np.polynomial.polynomial.polyval(t, self.coefficients)
 
 
 @dataclass(frozen=True)
@@ -195,30 +201,31 @@ def collapse(
     use = np.isfinite(r) & np.isfinite(r_err) & (xx >= lo) & (xx <= hi)
     xs, ns, rs = xx[use], nn[use], r[use]
     es = np.maximum(r_err[use], ERROR_FLOOR)
-    n_par = degree + 2 + (0 if exponents is not None else 2)
+    n_par = degree + 3 + (0 if exponents is not None else 2)
     if rs.size <= n_par:
         raise ParameterError(
             f"the collapse needs more than {n_par} points for `degree`={degree}, "
             f"got {rs.size} in `window` {(lo, hi)}: widen the window or lower the degree."
         )
     used_sizes = tuple(int(n) for n in sizes if np.any(ns == n))
-    # the polynomial variable u/u_scale stays of order 1 across the window
+    # tanh(u/u_scale) spans most of (−1, 1) across the window at the median N; the
+    # fitted factor w on u_scale lets the master curve saturate, or stay linear
     u_scale = 0.5 * (hi - lo) * float(np.median(ns)) ** b0
 
     def unpack(p):
         if exponents is None:
-            return p[0], p[1], p[2], p[3:]
-        return p[0], a0, b0, p[1:]
+            return p[0], p[1], p[2], p[3], p[4:]
+        return p[0], a0, b0, p[1], p[2:]
 
     def residual(p):
-        xc, a, b, c = unpack(p)
-        u = (xs - xc) * ns**b / u_scale
-        model = ns ** (-a) * np.polynomial.polynomial.polyval(u, c)
+        xc, a, b, log_w, c = unpack(p)
+        t = np.tanh((xs - xc) * ns**b / (u_scale * math.exp(log_w)))
+        model = ns ** (-a) * np.polynomial.polynomial.polyval(t, c)
         return (rs - model) / es
 
     def linear_start(xc):
         # the coefficients are linear given x_c and the exponents
-        u = (xs - xc) * ns**b0 / u_scale
+        u = np.tanh((xs - xc) * ns**b0 / u_scale)
         design = ns[:, None] ** (-a0) * u[:, None] ** np.arange(degree + 1)
         c, *_ = np.linalg.lstsq(design / es[:, None], rs / es, rcond=None)
         return c
@@ -227,9 +234,10 @@ def collapse(
     best = None
     for xc0 in starts:
         c0 = linear_start(float(xc0))
-        head = [float(xc0)] if exponents is not None else [float(xc0), a0, b0]
+        head = [float(xc0)] + ([] if exponents is not None else [a0, b0]) + [0.0]
         lower = [lo] + ([] if exponents is not None else [A_BOUNDS[0], B_BOUNDS[0]])
         upper = [hi] + ([] if exponents is not None else [A_BOUNDS[1], B_BOUNDS[1]])
+        lower, upper = lower + [math.log(W_BOUNDS[0])], upper + [math.log(W_BOUNDS[1])]
         p0 = np.concatenate([head, c0])
         bounds = (lower + [-np.inf] * c0.size, upper + [np.inf] * c0.size)
         p0[: len(lower)] = np.clip(p0[: len(lower)], lower, upper)
@@ -244,7 +252,7 @@ def collapse(
             err = np.sqrt(np.abs(np.diag(cov)))
         except np.linalg.LinAlgError:
             err = np.full(best.x.size, np.nan)
-    xc, a, b, c = unpack(best.x)
+    xc, a, b, log_w, c = unpack(best.x)
     a_err, b_err = (0.0, 0.0) if exponents is not None else (float(err[1]), float(err[2]))
     return Collapse(
         x_c=float(xc),
@@ -255,7 +263,7 @@ def collapse(
         b_err=b_err,
         fixed=exponents is not None,
         coefficients=np.asarray(c, dtype=float),
-        u_scale=u_scale,
+        u_scale=u_scale * math.exp(log_w),
         chi2_dof=float(chi2_dof),
         sizes=used_sizes,
         window=(lo, hi),
@@ -416,50 +424,86 @@ def finite_size_scaling(
     )
 
 
+def sweep_scaling(
+    sweep: xr.Dataset,
+    *,
+    exponents: str = "kuramoto",
+    n_boot: int = 50,
+    seed: int = 0,
+    degree: int = 4,
+) -> tuple[ScalingEstimate, xr.DataArray]:
+    """The collapse of a merged sweep's r_eq over ``n``, ``bpm`` and ``run``.
+
+    Parameters
+    ----------
+    sweep : a merged sweep as `metrosync.sweeps.critical.critical_frequency` takes it,
+        with at least 2 sizes N.
+    exponents : ``"kuramoto"`` fixes β/ν̄ = 1/5 and 1/ν̄ = 2/5; ``"free"`` fits them.
+    n_boot, seed, degree : as in `finite_size_scaling`.
+
+    Returns
+    -------
+    (ScalingEstimate, r_eq as a DataArray (n, bpm, run)); x_c is ω_c(∞) in BPM.
+    """
+    from .critical import sweep_runs
+
+    choices = {"kuramoto": KURAMOTO_EXPONENTS, "free": None}
+    if exponents not in choices:
+        raise ParameterError(f"`exponents` must be one of {sorted(choices)}, got {exponents!r}.")
+    r = sweep_runs(sweep)
+    if r.sizes["n"] < 2:
+        raise ParameterError(
+            f"the collapse needs at least 2 sizes N, the sweep has N = {r.n.values.tolist()}; "
+            f"sweep --n with several values (e.g. --n 64,256,1024)."
+        )
+    est = finite_size_scaling(
+        r.bpm.values,
+        r.n.values,
+        r.values,
+        exponents=choices[exponents],
+        degree=degree,
+        n_boot=n_boot,
+        seed=seed,
+    )
+    return est, r
+
+
 def plot_collapse(fit: Collapse, x, sizes, r, r_err, *, path=None, x_label="x"):
     """Two panels: r(x) for each N, and r·N^a against (x − x_c)·N^b with the master curve.
 
-    Returns the matplotlib Figure (also saved to ``path`` when given).
+    Returns the figure (also written to ``path`` when given).
     """
     import matplotlib
 
-    if path is not None:
-        matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from ..plots import finish_figure, new_figure
 
     x, sizes, r, r_err = _check(x, sizes, r, r_err)
-    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4), layout="constrained")
+    fig = new_figure(path, figsize=(10, 4), layout="constrained")
+    left, right = fig.subplots(1, 2)
+    colors = matplotlib.colormaps["viridis"](np.linspace(0, 0.9, sizes.size))
     u_all = []
-    for n, rn, en in zip(sizes, r, r_err, strict=True):
-        left.errorbar(x, rn, yerr=en, marker="o", ms=3, capsize=2, label=f"N = {n}")
+    for color, n, rn, en in zip(colors, sizes, r, r_err, strict=True):
+        left.errorbar(x, rn, yerr=en, marker="o", ms=3, capsize=2, color=color,
+                      label=f"N = {n}")  # fmt: skip
         u = (x - fit.x_c) * float(n) ** fit.b
-        right.errorbar(
-            u,
-            rn * float(n) ** fit.a,
-            yerr=en * float(n) ** fit.a,
-            marker="o",
-            ms=3,
-            capsize=2,
-            ls="none",
-            label=f"N = {n}",
-        )
-        inside = (x >= fit.window[0]) & (x <= fit.window[1]) & (n in fit.sizes)
-        u_all.extend(u[inside])
+        scale = float(n) ** fit.a
+        right.errorbar(u, rn * scale, yerr=en * scale, marker="o", ms=3, capsize=2,
+                       ls="none", color=color, label=f"N = {n}")  # fmt: skip
+        if int(n) in fit.sizes:
+            inside = (x >= fit.window[0]) & (x <= fit.window[1]) & np.isfinite(rn)
+            u_all.extend(u[inside])
     left.axvline(fit.x_c, color="k", ls=":", lw=1)
-    left.set_xlabel(x_label)
-    left.set_ylabel("r_eq")
+    left.set(xlabel=x_label, ylabel="r_eq (mean over runs)")
     left.legend(fontsize=8)
     if u_all:
         uu = np.linspace(min(u_all), max(u_all), 200)
         right.plot(uu, fit.master(uu), "k-", lw=1, label="master curve")
     kind = "fixed" if fit.fixed else "fitted"
-    right.set_xlabel(f"({x_label} − x_c)·N^{fit.b:.3g}")
-    right.set_ylabel(f"r_eq·N^{fit.a:.3g}")
+    right.set(xlabel=f"({x_label} − x_c)·N^{fit.b:.3g}", ylabel=f"r_eq·N^{fit.a:.3g}")
     right.set_title(
-        f"x_c = {fit.x_c:.4g} ± {fit.x_c_err:.2g}, exponents {kind}, χ²/dof = {fit.chi2_dof:.2g}",
+        f"x_c = {fit.x_c:.5g} ± {fit.x_c_err:.2g} (stat), exponents {kind}, "
+        f"χ²/dof = {fit.chi2_dof:.2g}",
         fontsize=9,
     )
     right.legend(fontsize=8)
-    if path is not None:
-        fig.savefig(path, dpi=120)
-    return fig
+    return finish_figure(fig, path)
