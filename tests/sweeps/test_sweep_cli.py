@@ -126,6 +126,9 @@ def test_critical_scaling_collapses_the_sweep(tmp_path, capsys):
     assert not (tmp_path / "s_critical.png").with_name("mine.png").exists()
     assert main(["critical", str(path), "--collapse-plot", str(plot)]) == 2
     assert "`--collapse-plot` needs `--scaling" in capsys.readouterr().err
+    args = ["critical", str(path), "--scaling", "free", "--no-plot", "--collapse-plot", str(plot)]
+    assert main(args) == 2
+    assert "`--collapse-plot` and `--no-plot` exclude each other" in capsys.readouterr().err
 
 
 def test_critical_scaling_needs_two_sizes(tmp_path, capsys):

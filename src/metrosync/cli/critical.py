@@ -85,7 +85,10 @@ def run(args) -> int:
             raise ParameterError(
                 "`--collapse-plot` needs `--scaling kuramoto` or `--scaling free`."
             )
-    elif not args.no_plot:
+    elif args.no_plot:
+        if args.collapse_plot is not None:
+            raise ParameterError("`--collapse-plot` and `--no-plot` exclude each other; give one.")
+    else:
         collapse_plot = args.collapse_plot or args.sweep.with_name(
             args.sweep.stem + "_collapse.png"
         )

@@ -205,7 +205,8 @@ def collapse(
     if rs.size <= n_par:
         raise ParameterError(
             f"the collapse needs more than {n_par} points for `degree`={degree}, "
-            f"got {rs.size} in `window` {(lo, hi)}: widen the window or lower the degree."
+            f"got {rs.size} in `window` {(lo, hi)}: sweep more values of x (ω₀) or sizes, "
+            f"widen the window, or lower the degree."
         )
     used_sizes = tuple(int(n) for n in sizes if np.any(ns == n))
     # tanh(u/u_scale) spans most of (−1, 1) across the window at the median N; the
