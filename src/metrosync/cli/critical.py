@@ -95,8 +95,6 @@ def run(args) -> int:
         check_output(collapse_plot, "--collapse-plot", suffixes=FIGURE)
     ds = _open(args.sweep, args.select)
     result = critical_frequency(ds, n_boot=args.bootstrap, seed=args.seed)
-    if args.scaling is not None:
-        _scaling(ds, result, args, collapse_plot)
     print(f"metrosync critical: {args.sweep} ({args.bootstrap} bootstrap replicas over runs)")
     print(f"  {'N':>6}  {'omega_c (sigma_r peak)':>25}  {'omega_c (steepest rise)':>25}")
     bpm = result.bpm.values
@@ -127,6 +125,8 @@ def run(args) -> int:
             f"  * at an end of the bpm grid ({bpm[0]:g} .. {bpm[-1]:g} BPM): the transition "
             f"may lie outside it; widen the sweep's --bpm range or add runs."
         )
+    if args.scaling is not None:
+        _scaling(ds, result, args, collapse_plot)
     write_outputs(result, out=args.out, plot=plot, plotter=plot_critical)
     return 0
 
