@@ -35,6 +35,7 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import least_squares
 
+from .. import interrupts
 from ..errors import ParameterError
 
 #: (β/ν̄, 1/ν̄) of the Kuramoto transition with random natural frequencies.
@@ -381,6 +382,7 @@ def finite_size_scaling(
     rng = np.random.default_rng(seed)
     runs = r_runs.shape[-1]
     for _ in range(n_boot):
+        interrupts.check()  # a long loop of fits: let Ctrl-C land between two
         pick = rng.integers(0, runs, size=(sizes.size, 1, runs))
         rb, eb = mean_and_error(np.take_along_axis(r_runs, pick, axis=-1))
         try:
