@@ -168,5 +168,15 @@ def _scaling(ds, result, args, path) -> None:
     )
     if path is not None:
         mean, err = mean_and_error(r.values)
-        plot_collapse(best, r.bpm.values, r.n.values, mean, err, path=path, x_label="ω₀ (BPM)")
+        plot_collapse(
+            best,
+            r.bpm.values,
+            r.n.values,
+            mean,
+            err,
+            path=path,
+            x_label="ω₀",
+            c_label="ω_c",
+            units="BPM",
+        )
         print(f"wrote {path}")

@@ -471,8 +471,13 @@ def sweep_scaling(
     return est, r
 
 
-def plot_collapse(fit: Collapse, x, sizes, r, r_err, *, path=None, x_label="x"):
+def plot_collapse(
+    fit: Collapse, x, sizes, r, r_err, *, path=None, x_label="x", c_label=None, units=""
+):
     """Two panels: r(x) for each N, and r·N^a against (x − x_c)·N^b with the master curve.
+
+    ``x_label`` names x, ``c_label`` its critical value (default ``x_label`` + "_c"),
+    ``units`` their unit.
 
     Returns the figure (also written to ``path`` when given).
     """
@@ -496,15 +501,17 @@ def plot_collapse(fit: Collapse, x, sizes, r, r_err, *, path=None, x_label="x"):
             inside = (x >= fit.window[0]) & (x <= fit.window[1]) & np.isfinite(rn)
             u_all.extend(u[inside])
     left.axvline(fit.x_c, color="k", ls=":", lw=1)
-    left.set(xlabel=x_label, ylabel="r_eq (mean over runs)")
+    c_label = c_label or f"{x_label}_c"
+    unit = f" {units}" if units else ""
+    left.set(xlabel=f"{x_label} ({units})" if units else x_label, ylabel="r_eq (mean over runs)")
     left.legend(fontsize=8)
     if u_all:
         uu = np.linspace(min(u_all), max(u_all), 200)
         right.plot(uu, fit.master(uu), "k-", lw=1, label="master curve")
     kind = "fixed" if fit.fixed else "fitted"
-    right.set(xlabel=f"({x_label} − x_c)·N^{fit.b:.3g}", ylabel=f"r_eq·N^{fit.a:.3g}")
+    right.set(xlabel=f"({x_label} − {c_label})·N^{fit.b:.3g}", ylabel=f"r_eq·N^{fit.a:.3g}")
     right.set_title(
-        f"x_c = {fit.x_c:.5g} ± {fit.x_c_err:.2g} (stat), exponents {kind}, "
+        f"{c_label} = {fit.x_c:.5g} ± {fit.x_c_err:.2g}{unit} (stat), exponents {kind}, "
         f"χ²/dof = {fit.chi2_dof:.2g}",
         fontsize=9,
     )
