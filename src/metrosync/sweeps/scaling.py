@@ -11,8 +11,9 @@ a fitted scale: a master curve that may saturate on either side of the transitio
 so that a BPM grid wide enough for the smallest N still collapses at the largest.
 The fit is one weighted least-squares problem over all sizes at once, in the raw
 r, so each point keeps its own error; x_c, the polynomial's coefficients and,
-unless fixed, the exponents a = β/ν̄ and b = 1/ν̄ are its parameters. Statistical
-errors come from the fit's covariance, scaled up by √(χ²/dof) when that exceeds 1.
+unless fixed, the exponents a = β/ν̄ and b = 1/ν̄ are its parameters. The statistical
+error of one fit comes from its covariance, scaled up by √(χ²/dof) when that exceeds
+1; `finite_size_scaling` takes the larger of that and a bootstrap over runs.
 
 `finite_size_scaling` repeats the fit over narrower x-windows around x_c and over
 size sets with the smallest or the largest N left out; the spread of those fits
@@ -21,8 +22,9 @@ quadrature to the statistical one. For the Kuramoto model with randomly drawn
 (quenched) natural frequencies β = 1/2 and ν̄ = 5/2, so a = 1/5 and b = 2/5 (Hong,
 Chaté, Park and Tang, Phys. Rev. Lett. 98, 184101 (2007)); `KURAMOTO_EXPONENTS`.
 
-Arrays: ``x`` (K,), ``sizes`` (M,), ``r`` and ``r_err`` (M, K); NaN marks a missing
-point. Nothing here knows about metronomes or units.
+Arrays: ``x`` (K,), ``sizes`` (M,), ``r`` and ``r_err`` (M, K), per-run values
+(M, K, B); NaN marks a missing point. Only `sweep_scaling` knows about sweeps (it
+reads ω₀ in BPM as x); the rest knows nothing of metronomes or units.
 """
 
 from __future__ import annotations
