@@ -91,3 +91,48 @@ def test_sweep_the_offset_between_two_groups(tmp_path, capsys):
         assert np.isfinite(ds.r_eq_group).all()
     assert main([*args[:-3], "--n", "3", "--out", str(out)]) == 2
     assert "drop `n` (--n)" in capsys.readouterr().err
+
+
+def _scaling_sweep(path, sizes=(64, 256, 1024), seed=0):
+    """r = N^(−1/5)·F((ω₀ − 185)/8·N^(2/5)) plus noise, 16 runs a point: ω_c(∞) = 185 BPM."""
+    rng = np.random.default_rng(seed)
+    bpm = np.arange(177.0, 193.5, 1.5)
+    n = np.array(sizes)
+    u = (bpm[None, :] - 185.0) / 8 * n[:, None] ** 0.4
+    r = n[:, None] ** -0.2 * (0.5 / (1 + np.exp(-u)) + 0.1)
+    runs = r[..., None] + rng.normal(0, 0.02, r.shape + (16,))
+    xr.Dataset({"r_eq": (("n", "bpm", "run"), runs)}, coords={"n": n, "bpm": bpm}).to_netcdf(
+        path, engine="h5netcdf"
+    )
+
+
+def test_critical_scaling_collapses_the_sweep(tmp_path, capsys):
+    path = tmp_path / "s.nc"
+    _scaling_sweep(path)
+    args = ["critical", str(path), "--bootstrap", "20", "--scaling", "kuramoto",
+            "--out", str(tmp_path / "c.nc")]  # fmt: skip
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "collapse over N = [64, 256, 1024] (exponents fixed at 1/5, 2/5" in text
+    assert "omega_c(inf) = " in text and "fit windows and N sets" in text
+    assert (tmp_path / "s_collapse.png").stat().st_size > 1000
+    with xr.open_dataset(tmp_path / "c.nc", engine="h5netcdf") as c:
+        value, err = c.attrs["scaling_omega_c_inf"], c.attrs["scaling_omega_c_inf_err"]
+    assert 0 < err < 1.0 and abs(value - 185.0) < 3 * err
+    plot = tmp_path / "mine.png"
+    args = ["critical", str(path), "--bootstrap", "20", "--scaling", "free", "--no-plot"]
+    assert main(args) == 0
+    assert "beta/nu = " in capsys.readouterr().out
+    assert not (tmp_path / "s_critical.png").with_name("mine.png").exists()
+    assert main(["critical", str(path), "--collapse-plot", str(plot)]) == 2
+    assert "`--collapse-plot` needs `--scaling" in capsys.readouterr().err
+    args = ["critical", str(path), "--scaling", "free", "--no-plot", "--collapse-plot", str(plot)]
+    assert main(args) == 2
+    assert "`--collapse-plot` and `--no-plot` exclude each other" in capsys.readouterr().err
+
+
+def test_critical_scaling_needs_two_sizes(tmp_path, capsys):
+    path = tmp_path / "one.nc"
+    _scaling_sweep(path, sizes=(64,))
+    assert main(["critical", str(path), "--bootstrap", "20", "--scaling", "kuramoto"]) == 2
+    assert "at least 2 sizes N" in capsys.readouterr().err

@@ -32,6 +32,23 @@ def register(subparsers) -> None:
                         help="figure path (default: SWEEP with suffix _critical.png)")  # fmt: skip
     figure.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.add_argument("--out", type=Path, default=None, help="write the estimates to FILE.nc")
+    parser.add_argument(
+        "--scaling",
+        choices=("kuramoto", "free"),
+        default=None,
+        help=(
+            "also collapse r_eq * N^(beta/nu) against (omega_0 - omega_c) * N^(1/nu) over all N "
+            "(finite-size scaling) for omega_c(inf): 'kuramoto' fixes beta/nu = 1/5 and "
+            "1/nu = 2/5, 'free' fits them; the error includes the spread over fit windows "
+            "and N sets"
+        ),
+    )
+    parser.add_argument(
+        "--collapse-plot",
+        type=Path,
+        default=None,
+        help="collapse figure path (default: SWEEP with suffix _collapse.png)",
+    )
     add_aliases(parser, n_boot="--bootstrap")
     parser.set_defaults(func=run)
 
@@ -62,6 +79,20 @@ def run(args) -> int:
     )
     check_output(plot, "--plot", suffixes=FIGURE)
     check_output(args.out, "--out", suffixes=NETCDF)
+    collapse_plot = None
+    if args.scaling is None:
+        if args.collapse_plot is not None:
+            raise ParameterError(
+                "`--collapse-plot` needs `--scaling kuramoto` or `--scaling free`."
+            )
+    elif args.no_plot:
+        if args.collapse_plot is not None:
+            raise ParameterError("`--collapse-plot` and `--no-plot` exclude each other; give one.")
+    else:
+        collapse_plot = args.collapse_plot or args.sweep.with_name(
+            args.sweep.stem + "_collapse.png"
+        )
+        check_output(collapse_plot, "--collapse-plot", suffixes=FIGURE)
     ds = _open(args.sweep, args.select)
     result = critical_frequency(ds, n_boot=args.bootstrap, seed=args.seed)
     print(f"metrosync critical: {args.sweep} ({args.bootstrap} bootstrap replicas over runs)")
@@ -94,5 +125,58 @@ def run(args) -> int:
             f"  * at an end of the bpm grid ({bpm[0]:g} .. {bpm[-1]:g} BPM): the transition "
             f"may lie outside it; widen the sweep's --bpm range or add runs."
         )
+    if args.scaling is not None:
+        _scaling(ds, result, args, collapse_plot)
     write_outputs(result, out=args.out, plot=plot, plotter=plot_critical)
     return 0
+
+
+def _scaling(ds, result, args, path) -> None:
+    """Collapse the sweep, print ω_c(∞) and the exponents, store them in ``result.attrs``."""
+    from ..sweeps.scaling import mean_and_error, plot_collapse, sweep_scaling
+
+    # the bootstrap refits the whole collapse, so it gets fewer replicas than ω_c(N)
+    n_boot = min(args.bootstrap, 100)
+    est, r = sweep_scaling(ds, exponents=args.scaling, n_boot=n_boot, seed=args.seed)
+    best = est.best
+    label = "fixed at 1/5, 2/5" if best.fixed else "fitted"
+    print(
+        f"  collapse over N = {list(best.sizes)} (exponents {label}, {best.points} points, "
+        f"chi2/dof = {best.chi2_dof:.2f}, {n_boot} bootstrap replicas):"
+    )
+    print(
+        f"    omega_c(inf) = {est.x_c:.2f} +- {est.x_c_err:.2f} BPM "
+        f"(systematic {est.x_c_syst:.2f} over {len(est.variants)} fit windows and N sets)"
+    )
+    if not best.fixed:
+        print(f"    beta/nu = {est.a:.3f} +- {est.a_err:.3f} (Kuramoto: 0.2)")
+        print(f"    1/nu    = {est.b:.3f} +- {est.b_err:.3f} (Kuramoto: 0.4)")
+    if best.chi2_dof > 3:
+        print("    chi2/dof > 3: the data do not collapse on one curve; trust no number above.")
+    result.attrs.update(
+        {
+            "scaling_exponents": args.scaling,
+            "scaling_omega_c_inf": est.x_c,
+            "scaling_omega_c_inf_err": est.x_c_err,
+            "scaling_omega_c_inf_syst": est.x_c_syst,
+            "scaling_beta_over_nu": est.a,
+            "scaling_beta_over_nu_err": est.a_err,
+            "scaling_inv_nu": est.b,
+            "scaling_inv_nu_err": est.b_err,
+            "scaling_chi2_dof": best.chi2_dof,
+        }
+    )
+    if path is not None:
+        mean, err = mean_and_error(r.values)
+        plot_collapse(
+            best,
+            r.bpm.values,
+            r.n.values,
+            mean,
+            err,
+            path=path,
+            x_label="ω₀",
+            c_label="ω_c",
+            units="BPM",
+        )
+        print(f"wrote {path}")

@@ -7,6 +7,7 @@
 ``executors``  in process, Dask LocalCluster, or an existing Dask cluster
 ``sweep``      the `sweep` entry point
 ``critical``   the critical frequency ω_c(N) and its finite-size extrapolation
+``scaling``    the finite-size-scaling collapse of r_eq(ω₀, N) and ω_c(∞) from it
 """
 
 from .grid import Grid, parse_values

@@ -227,20 +227,11 @@ def judge(fit: Extrapolation, bpm: np.ndarray, sizes: int) -> str:
     return ""
 
 
-def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) -> xr.Dataset:
-    """ω_c(N) by both estimators, with bootstrap errors and the N → ∞ extrapolation.
+def sweep_runs(sweep: xr.Dataset) -> xr.DataArray:
+    """r_eq of a merged sweep as (n, bpm, run), bpm ascending; see `critical_frequency`.
 
-    Parameters
-    ----------
-    sweep : a merged sweep with a ``bpm`` dimension (at least 3 values), a ``run``
-        dimension, optionally an ``n`` dimension; any other dimension must have length 1
-        (select a slice first, e.g. ``ds.sel(drive=6e-5)``).
-    n_boot : bootstrap replicas.   seed : seed of the resampling.
-
-    Returns
-    -------
-    xarray.Dataset with r_mean, sigma_r (n, bpm) and omega_c_{peak,rise} and their
-    ``_err`` (n); attrs hold the extrapolation for each method.
+    Refuses a sweep without ``bpm`` and ``run``, with under 3 BPMs, with another swept
+    dimension of more than one value, or with an N whose every run is NaN.
     """
     if "r_eq" not in sweep or "bpm" not in sweep.dims or "run" not in sweep.dims:
         raise ParameterError(
@@ -251,8 +242,6 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
         raise ParameterError(
             f"`bpm` needs at least 3 values to locate ω_c, got {sweep.sizes['bpm']}."
         )
-    if isinstance(n_boot, bool) or not isinstance(n_boot, int) or n_boot < 2:
-        raise ParameterError(f"`n_boot` must be an integer >= 2, got {n_boot!r}.")
     extra = [d for d in sweep.dims if d not in ("bpm", "run", "n", "time")]
     wide = [d for d in extra if sweep.sizes[d] > 1]
     if wide:
@@ -274,6 +263,27 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
             f"too short for the crossing phase (each metronome must cross zero twice before "
             f"the final window). Sweep a longer `duration`, or select other N."
         )
+    return r
+
+
+def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) -> xr.Dataset:
+    """ω_c(N) by both estimators, with bootstrap errors and the N → ∞ extrapolation.
+
+    Parameters
+    ----------
+    sweep : a merged sweep with a ``bpm`` dimension (at least 3 values), a ``run``
+        dimension, optionally an ``n`` dimension; any other dimension must have length 1
+        (select a slice first, e.g. ``ds.sel(drive=6e-5)``).
+    n_boot : bootstrap replicas.   seed : seed of the resampling.
+
+    Returns
+    -------
+    xarray.Dataset with r_mean, sigma_r (n, bpm) and omega_c_{peak,rise} and their
+    ``_err`` (n); attrs hold the extrapolation for each method.
+    """
+    if isinstance(n_boot, bool) or not isinstance(n_boot, int) or n_boot < 2:
+        raise ParameterError(f"`n_boot` must be an integer >= 2, got {n_boot!r}.")
+    r = sweep_runs(sweep)
     bpm = r.bpm.values.astype(float)
     step = float(np.min(np.diff(bpm)))
     values = r.values
