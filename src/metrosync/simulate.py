@@ -299,8 +299,9 @@ def _warn_silent_escapement(ensemble: Ensemble, amplitude) -> None:
     start = f"`amplitude` = {amplitude!r} rad" if amplitude is not None else "the start swing"
     warnings.warn(
         f"`escapement_offset` = {float(offset[beyond].max()):.4g} rad lies beyond "
-        f"{start} ({float(swing[beyond].min()):.3g} rad) of {int(beyond.sum())} "
-        f"metronome(s) in {runs} of {ensemble.runs} run(s): their escapement never fires, "
+        f"{start} ({float(swing[beyond].min()):.3g} rad) of "
+        f"{plural(int(beyond.sum()), 'metronome')} in {runs} of "
+        f"{plural(ensemble.runs, 'run')}: their escapement never fires, "
         f'the pendulum decays ("metronome death"), and the run is flagged `stopped` in '
         f"`status`. Give an `escapement_offset` below the swing, or start wider (`amplitude`).",
         EscapementWarning,
