@@ -90,6 +90,6 @@ def test_the_warning_names_the_offset_the_swing_and_the_fix():
                       amplitude=0.4)  # fmt: skip
     text = str(caught[0].message)
     assert "`escapement_offset` = 0.5 rad lies beyond `amplitude` = 0.4 rad (0.4 rad)" in text
-    assert "of 6 metronome(s) in 3 of 3 run(s)" in text and "metronome death" in text
+    assert "of 6 metronomes in 3 of 3 runs" in text and "metronome death" in text
     assert "start wider (`amplitude`)" in text
     assert (ds.status.values == STATUS_STOPPED).all()
