@@ -1,0 +1,21 @@
+"""See real metronomes: angles, passes, phases and r(t) measured from a video.
+
+One entry point, `track(path)`; the steps are modules of their own: `reader` (the
+file, streamed with the container's times), `detection` (the metronomes found from
+what swings), `angles` (each rod's angle per frame), `tracking` (passes, phases, r and
+the dataset), `preview` (the picture of what was found), `sound` (the audio track
+against the picture), `plots`. `track` is imported on first use (it needs scipy and
+xarray), so that the reader's checks stay quick to import.
+"""
+
+from .reader import VideoFileError, open_video
+
+__all__ = ["VideoFileError", "open_video", "track"]
+
+
+def __getattr__(name: str):
+    if name == "track":
+        from .tracking import track
+
+        return track
+    raise AttributeError(f"module 'metrosync.video' has no attribute {name!r}")

@@ -1,0 +1,163 @@
+"""A rod's angle about its pivot in each picture, with a quality flag and a confidence.
+
+Contract: a `RodGauge` is built once per metronome from its `Region` and the background
+picture; ``gauge.measure(picture, gain)`` returns the angle (rad, from the picture's
+upward direction, positive clockwise) and a strength, and `finish` turns the per-frame
+measurements into angles with a quality flag and a confidence.
+
+The picture is sampled on a polar grid about the pivot (angles across the swept sector
+with a margin, radii along the rod), by bilinear interpolation at indices computed
+once. What differs from the background there, summed along each ray (weighted by the
+radius: far pixels tell the angle best), is the angular profile; the rod is its peak,
+and the angle is the profile's centroid around the peak. Several peaks (another rod
+crossing the sector, where metronomes overlap in the picture) are told apart by
+continuity: the one nearest the angle predicted from the previous two frames wins.
+Identity is therefore tied to the pivot: a gauge only ever looks about its own pivot.
+
+Quality flags: `MEASURED` (a clear peak), `INTERPOLATED` (no clear peak, filled from
+the neighbours over a gap of at most ``max_gap`` frames), `LOST` (NaN).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .detection import Region
+
+MEASURED, INTERPOLATED, LOST = 0, 1, 2
+QUALITY_NAMES = "0 measured, 1 interpolated, 2 lost"
+#: Extra angle on each side of the swept sector, rad.
+MARGIN = 0.25
+
+
+class RodGauge:
+    """Measures one metronome's rod angle; see the module docstring."""
+
+    def __init__(self, region: Region, bg: np.ndarray) -> None:
+        h, w = bg.shape
+        self.region = region
+        px, py = region.pivot
+        r_in = max(region.r_inner, 2.0)
+        r_out = max(region.r_outer, r_in + 4.0)
+        step = 0.7 / r_out
+        half = region.half_width + MARGIN
+        self.angles = region.centre + np.arange(-half, half + step, step)
+        radii = np.arange(r_in, r_out, 1.0)
+        a, r = np.meshgrid(self.angles, radii, indexing="ij")
+        x = px + r * np.sin(a)
+        y = py - r * np.cos(a)
+        inside = (x >= 0) & (x <= w - 1) & (y >= 0) & (y <= h - 1)
+        x, y = np.clip(x, 0, w - 1.001), np.clip(y, 0, h - 1.001)
+        x0, y0 = np.floor(x).astype(np.intp), np.floor(y).astype(np.intp)
+        fx, fy = (x - x0).astype(np.float32), (y - y0).astype(np.float32)
+        base = y0 * w + x0
+        self._index = np.stack([base, base + 1, base + w, base + w + 1])
+        self._weight = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy])
+        self._weight *= (inside * r).astype(np.float32)[None]
+        self.row = float(py - 0.6 * r_out * np.cos(region.centre))
+        self._bg = self._sample(bg.ravel())
+        self._step = step
+        self._prev: list[float] = []
+        # the rod's angular width at mid-radius, in bins, sets the centroid's window
+        self._half_window = int(np.clip(np.ceil(6.0 / (0.5 * (r_in + r_out)) / step), 2, 40))
+
+    def _sample(self, flat: np.ndarray) -> np.ndarray:
+        return np.einsum("kar,kar->ar", flat[self._index], self._weight)
+
+    def measure(self, picture: np.ndarray, gain: float) -> tuple[float, float]:
+        """(angle, strength) in one grey picture (H, W) scaled by ``gain``; NaN angle
+        when the profile has no peak above its noise."""
+        profile = np.abs(self._sample(picture.ravel()) * gain - self._bg).sum(axis=1)
+        base = np.median(profile)
+        spread = 1.4826 * np.median(np.abs(profile - base)) + 1e-6
+        lifted = profile - base
+        k = self._pick_peak(lifted, spread)
+        if k is None:
+            self._prev = []
+            return float("nan"), 0.0
+        lo, hi = max(0, k - self._half_window), min(lifted.size, k + self._half_window + 1)
+        weights = np.clip(lifted[lo:hi], 0, None)
+        angle = float(np.dot(weights, self.angles[lo:hi]) / weights.sum())
+        self._prev = [*self._prev[-1:], angle]
+        return angle, float(lifted[k] / spread)
+
+    def _pick_peak(self, lifted: np.ndarray, spread: float) -> int | None:
+        top = float(lifted.max())
+        if top < 6.0 * spread:
+            return None
+        if len(self._prev) < 2:
+            return int(np.argmax(lifted))
+        predicted = 2 * self._prev[-1] - self._prev[-2]
+        inner = lifted[1:-1]
+        peaks = np.flatnonzero((inner >= lifted[:-2]) & (inner >= lifted[2:])
+                               & (inner >= 0.5 * top)) + 1  # fmt: skip
+        if peaks.size == 0:
+            return int(np.argmax(lifted))
+        return int(peaks[np.argmin(np.abs(self.angles[peaks] - predicted))])
+
+
+def finish(
+    angle: np.ndarray, strength: np.ndarray, time: np.ndarray, *, max_gap: int = 3
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quality and confidence for one metronome's per-frame measurements.
+
+    angle, strength, time : (T,) from `RodGauge.measure` and the frame times.
+    max_gap : longest run of frames without a clear peak that is interpolated.
+    Returns (angle (T,) with short gaps filled, quality (T,) int8, confidence (T,) in
+    [0, 1]). A measurement that jumps far from its neighbours' line (a wrong peak) is
+    treated as lost. The confidence is the peak's strength over the median strength.
+    """
+    angle = np.array(angle, dtype=float)
+    strength = np.asarray(strength, dtype=float)
+    ok = np.isfinite(angle)
+    if ok.sum() >= 5:
+        idx = np.flatnonzero(ok)
+        # a measurement far off the line through its neighbours is a wrong peak
+        mid = 0.5 * (angle[idx[:-2]] + angle[idx[2:]])
+        off = np.abs(angle[idx[1:-1]] - mid)
+        scale = np.median(np.abs(np.diff(angle[idx]))) + 1e-6
+        bad = idx[1:-1][off > 4.0 * scale + 0.05]
+        angle[bad] = np.nan
+        ok[bad] = False
+    quality = np.where(ok, MEASURED, LOST).astype(np.int8)
+    typical = np.median(strength[ok]) if ok.any() else 1.0
+    confidence = np.where(ok, np.clip(strength / (typical + 1e-9), 0, 1), 0.0)
+    if ok.sum() >= 2:
+        lost = np.flatnonzero(~ok)
+        runs = np.split(lost, np.flatnonzero(np.diff(lost) > 1) + 1) if lost.size else []
+        good = np.flatnonzero(ok)
+        for run in runs:
+            if run.size <= max_gap and run[0] > good[0] and run[-1] < good[-1]:
+                angle[run] = np.interp(time[run], time[ok], angle[ok])
+                quality[run] = INTERPOLATED
+                confidence[run] = 0.5 * confidence[max(run[0] - 1, 0)]
+    return angle, quality, confidence
+
+
+def swing_middle(angle: np.ndarray) -> float:
+    """The middle of the swing: median over swings of (peak + trough) / 2, rad.
+
+    angle : (T,) per-frame angles (NaN allowed). Each extreme's value is refined by the
+    parabola through its three samples; wiggles smaller than half the typical swing
+    (noise) are not extremes. NaN if no swing is seen.
+    """
+    a = np.asarray(angle, dtype=float)
+    ok = np.isfinite(a)
+    if ok.sum() < 5:
+        return float("nan")
+    x = a[ok]
+    centre = np.median(x)
+    big = 0.5 * np.percentile(np.abs(x - centre), 95)
+    left, mid, right = x[:-2], x[1:-1], x[2:]
+    curv = left - 2 * mid + right
+    with np.errstate(invalid="ignore", divide="ignore"):
+        value = mid - np.where(curv != 0, (left - right) ** 2 / (8 * curv), 0.0)
+    peak = np.flatnonzero((mid > left) & (mid >= right) & (mid - centre > big))
+    trough = np.flatnonzero((mid < left) & (mid <= right) & (centre - mid > big))
+    if peak.size == 0 or trough.size == 0:
+        return float(centre)
+    nxt = np.searchsorted(trough, peak)
+    pairs = nxt < trough.size
+    if not pairs.any():
+        return float(centre)
+    return float(np.median(0.5 * (value[peak[pairs]] + value[trough[nxt[pairs]]])))

@@ -1,0 +1,228 @@
+"""Finding the metronomes in a video: where the picture moves, and about which pivot.
+
+Contract: `find_metronomes(pictures, count=None)` takes grey pictures (F, H, W) from the
+first seconds of a video and returns one `Region` per metronome, sorted left to right:
+its pivot (pixels), the directions its rod sweeps (from the pivot) and the radii its
+rod covers. No marker is needed; only that the rods swing and the camera stands still.
+
+The method:
+
+1. the background is the per-pixel median of the pictures, after each picture's
+   brightness is scaled to the median's (lighting flicker);
+2. in each picture, what differs from the background by more than the noise is a
+   moving part; each connected piece of it that is long and thin is a rod, and
+   gives a line (its principal axis);
+3. every line votes along its length into an accumulator: the lines of one rod, at
+   different moments, all pass through its pivot, so pivots are the accumulator's
+   peaks, while lines of different rods cross at scattered points;
+4. the lines near each pivot give the swept sector and the radii.
+
+`regions_from_pivots` builds the regions for pivots given by hand (``--regions``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ..errors import MetrosyncError
+
+#: Fewest lines through a pivot, as a fraction of the pictures, for it to count.
+MIN_SUPPORT = 0.25
+
+
+class DetectionError(MetrosyncError, ValueError):
+    """No metronome, or not the number asked for, could be found in the picture."""
+
+
+@dataclass(frozen=True)
+class Region:
+    """Where one metronome is in the picture.
+
+    pivot : (x, y) of the rod's pivot, pixels (x right, y down).
+    centre : direction of the middle of the swing from the pivot, rad, measured from
+        the picture's upward direction, positive clockwise (to the right).
+    half_width : half the swept angle, rad (the swing's amplitude seen in the picture).
+    r_inner, r_outer : radii from the pivot that the rod covers, pixels.
+    support : fraction of the pictures in which this rod was seen.
+    """
+
+    pivot: tuple[float, float]
+    centre: float
+    half_width: float
+    r_inner: float
+    r_outer: float
+    support: float
+
+
+def background(pictures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(median picture (H, W), per-picture brightness gain (F,)) of pictures (F, H, W)."""
+    bg = np.median(pictures, axis=0)
+    level = np.median(bg) + 1e-6
+    gain = level / (np.median(pictures.reshape(len(pictures), -1), axis=1) + 1e-6)
+    return bg, gain
+
+
+def rod_lines(pictures: np.ndarray, bg: np.ndarray, gain: np.ndarray) -> list[np.ndarray]:
+    """Per picture, the lines of the long thin moving pieces: (L, 5) arrays of
+    centroid x, y, direction ux, uy (unit), and half-length (pixels)."""
+    diff = np.abs(pictures * gain[:, None, None] - bg[None])
+    noise = 1.4826 * np.median(np.abs(diff - np.median(diff)))
+    threshold = max(6.0 * noise + np.median(diff), 12.0)
+    min_pixels = max(12, int(2e-4 * bg.size))
+    out = []
+    for frame in diff:
+        mask = ndimage.binary_opening(frame > threshold)
+        labels, count = ndimage.label(mask)
+        lines = []
+        if count:
+            index = np.arange(1, count + 1)
+            sizes = ndimage.sum_labels(mask, labels, index)
+            ys, xs = np.nonzero(labels)
+            lab = labels[ys, xs]
+            for j in index[sizes >= min_pixels]:
+                sel = lab == j
+                line = _principal_axis(xs[sel].astype(float), ys[sel].astype(float))
+                if line is not None:
+                    lines.append(line)
+        out.append(np.array(lines).reshape(-1, 5))
+    return out
+
+
+def _principal_axis(xs: np.ndarray, ys: np.ndarray) -> np.ndarray | None:
+    cx, cy = xs.mean(), ys.mean()
+    cov = np.cov(np.stack([xs - cx, ys - cy]))
+    values, vectors = np.linalg.eigh(cov)
+    if values[1] <= 0 or values[0] / values[1] > 0.2:  # not long and thin
+        return None
+    ux, uy = vectors[:, 1]
+    return np.array([cx, cy, ux, uy, 2.0 * np.sqrt(values[1])])
+
+
+def vote(lines: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
+    """Accumulator (H, W): each line adds 1 along its length, extended 1.5× each way."""
+    h, w = shape
+    acc = np.zeros(shape)
+    for frame_lines in lines:
+        seen = np.zeros(shape, dtype=bool)
+        for cx, cy, ux, uy, half in frame_lines:
+            s = np.arange(-2.5 * half, 2.5 * half, 0.7)
+            x = np.rint(cx + s * ux).astype(int)
+            y = np.rint(cy + s * uy).astype(int)
+            inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
+            seen[y[inside], x[inside]] = True
+        acc += seen
+    return ndimage.gaussian_filter(acc, 1.5)
+
+
+def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[Region]:
+    """The metronomes in pictures (F, H, W) of the first seconds; see the module docstring.
+
+    count : the number of metronomes; default: every pivot that enough lines cross.
+    Raises `DetectionError` when nothing moves, or fewer than ``count`` are found.
+    """
+    pictures = np.asarray(pictures, dtype=np.float32)
+    f, h, w = pictures.shape
+    bg, gain = background(pictures)
+    lines = rod_lines(pictures, bg, gain)
+    moving = sum(len(x) > 0 for x in lines)
+    if moving < max(3, 0.2 * f):
+        raise DetectionError(
+            f"nothing swings in the first {f} frames: no rod moves against the background. "
+            f"Check that the metronomes are running and in view, and that the camera stands "
+            f"still; or give the pivots by hand (--regions)."
+        )
+    acc = vote(lines, (h, w))
+    peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
+    floor = MIN_SUPPORT * f
+    chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
+    if count is not None:
+        chosen = peaks[:count] if len(peaks) >= count else peaks
+    regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    if count is not None and len(regions) < count:
+        raise DetectionError(
+            f"found {len(regions)} swinging metronomes, not the {count} asked for (--count). "
+            f"Check that every rod swings in view in the first seconds, or give the pivots "
+            f"by hand (--regions)."
+        )
+    if not regions:
+        raise DetectionError(
+            "things move in the picture but no rod swings about a fixed pivot. Check that "
+            "the camera stands still, or give the pivots by hand (--regions)."
+        )
+    regions = _drop_duplicates(regions)
+    return sorted(regions, key=lambda r: (r.pivot[0], r.pivot[1]))
+
+
+def _peaks(acc: np.ndarray, min_distance: int) -> list[tuple[int, int]]:
+    """Local maxima (x, y) of ``acc``, strongest first."""
+    top = ndimage.maximum_filter(acc, size=2 * min_distance + 1)
+    ys, xs = np.nonzero((acc == top) & (acc > 0))
+    order = np.argsort(-acc[ys, xs])
+    return [(int(xs[i]), int(ys[i])) for i in order]
+
+
+def _region(pivot, lines, frames: int) -> Region | None:
+    """The sector swept by the lines that pass near ``pivot`` (the rod's lines)."""
+    px, py = pivot
+    angles, near, far = [], [], []
+    for frame_lines in lines:
+        best = None
+        for cx, cy, ux, uy, half in frame_lines:
+            dx, dy = cx - px, cy - py
+            dist = abs(dx * uy - dy * ux)  # distance of the pivot from the line
+            along = np.hypot(dx, dy)
+            if dist < max(3.0, 0.08 * along) and along > 0.3 * half:
+                if best is None or dist < best[0]:
+                    best = (dist, dx, dy, along, half)
+        if best is not None:
+            _, dx, dy, along, half = best
+            angles.append(np.arctan2(dx, -dy))
+            near.append(max(along - half, 0.0))
+            far.append(along + half)
+    support = len(angles) / frames
+    if support < MIN_SUPPORT / 2 or len(angles) < 3:
+        return None
+    a = np.unwrap(np.array(angles))
+    lo, hi = np.percentile(a, [2, 98])
+    centre = float(np.angle(np.exp(1j * 0.5 * (lo + hi))))
+    return Region(
+        pivot=(float(px), float(py)),
+        centre=centre,
+        half_width=float(max(0.5 * (hi - lo), 0.05)),
+        r_inner=float(np.percentile(near, 20)),
+        r_outer=float(np.percentile(far, 90)),
+        support=float(support),
+    )
+
+
+def _drop_duplicates(regions: list[Region]) -> list[Region]:
+    """Two peaks on one rod (its pivot and a point along it): keep the better supported."""
+    kept: list[Region] = []
+    for r in sorted(regions, key=lambda r: -r.support):
+        if all(np.hypot(r.pivot[0] - k.pivot[0], r.pivot[1] - k.pivot[1]) > 0.5 * k.r_inner
+               or abs(r.centre - k.centre) > k.half_width + r.half_width
+               for k in kept):  # fmt: skip
+            kept.append(r)
+    return kept
+
+
+def regions_from_pivots(
+    pivots: list[tuple[float, float]], pictures: np.ndarray
+) -> list[Region]:
+    """Regions for pivots given by hand (pixels of the pictures, upright), their sectors
+    measured from the rods seen in ``pictures``; a pivot with no rod seen near it gets a
+    default sector (upward ± 45°, radii up to a fifth of the picture)."""
+    pictures = np.asarray(pictures, dtype=np.float32)
+    f, h, w = pictures.shape
+    bg, gain = background(pictures)
+    lines = rod_lines(pictures, bg, gain)
+    out = []
+    for x, y in pivots:
+        region = _region((x, y), lines, f)
+        if region is None:
+            region = Region((float(x), float(y)), 0.0, np.pi / 4, 3.0, 0.2 * max(h, w), 0.0)
+        out.append(region)
+    return out
