@@ -20,8 +20,9 @@ def angles_sine(t, freq_hz, amplitude, phase):
     return amplitude * np.sin(2 * np.pi * np.asarray(freq_hz) * t + np.asarray(phase))
 
 
-def draw(theta, pivots, *, size=(480, 270), length=80, width=4, noise=0.0, rng=None,
-         background=None):
+def draw(
+    theta, pivots, *, size=(480, 270), length=80, width=4, noise=0.0, rng=None, background=None
+):
     """One grey picture (H, W) uint8 with a rod per metronome (pivot below, rod up)."""
     w, h = size
     img = np.full((h, w), 40.0) if background is None else background.astype(float).copy()
@@ -40,8 +41,18 @@ def draw(theta, pivots, *, size=(480, 270), length=80, width=4, noise=0.0, rng=N
     return np.clip(img, 0, 255).astype(np.uint8)
 
 
-def write_video(path, times, pictures, *, rate=30, rotation=0, codec="libx264",
-                audio=None, audio_rate=44100, time_base=Fraction(1, 90000)):
+def write_video(
+    path,
+    times,
+    pictures,
+    *,
+    rate=30,
+    rotation=0,
+    codec="libx264",
+    audio=None,
+    audio_rate=44100,
+    time_base=Fraction(1, 90000),
+):
     """Encode grey pictures at the given frame times (s) to ``path``; ``audio`` is an
     optional mono float array played from t = 0."""
     path = Path(path)
@@ -73,8 +84,9 @@ def write_video(path, times, pictures, *, rate=30, rotation=0, codec="libx264",
             block = 1024
             samples = np.asarray(audio, dtype=np.float32)
             for i in range(0, samples.size - block + 1, block):
-                af = av.AudioFrame.from_ndarray(samples[None, i:i + block], format="fltp",
-                                                layout="mono")
+                af = av.AudioFrame.from_ndarray(
+                    samples[None, i : i + block], format="fltp", layout="mono"
+                )
                 af.sample_rate = audio_rate
                 af.pts = i
                 for packet in astream.encode(af):
@@ -89,8 +101,22 @@ def _chain(first, rest):
     yield from rest
 
 
-def scene(path, *, n=3, seconds=12.0, fps=30.0, jitter=0.0, drop=0.0, seed=0, size=(480, 270),
-          noise=3.0, rotation=0, audio=False, freq=None, amplitude=0.45):
+def scene(
+    path,
+    *,
+    n=3,
+    seconds=12.0,
+    fps=30.0,
+    jitter=0.0,
+    drop=0.0,
+    seed=0,
+    size=(480, 270),
+    noise=3.0,
+    rotation=0,
+    audio=False,
+    freq=None,
+    amplitude=0.45,
+):
     """Write a scene of ``n`` rods in a row and return (times, θ (T, N), pivots)."""
     rng = np.random.default_rng(seed)
     w, h = size
@@ -105,8 +131,7 @@ def scene(path, *, n=3, seconds=12.0, fps=30.0, jitter=0.0, drop=0.0, seed=0, si
     phase = rng.uniform(0, 2 * np.pi, n)
     theta = angles_sine(times, f, amplitude, phase)
     length = 0.28 * h
-    pictures = (draw(th, pivots, size=size, length=length, noise=noise, rng=rng)
-                for th in theta)
+    pictures = (draw(th, pivots, size=size, length=length, noise=noise, rng=rng) for th in theta)
     sound = None
     if audio:
         sound = clicks(times, theta, 44100)
@@ -125,5 +150,5 @@ def clicks(times, theta, rate):
             a0, a1 = theta[i, j], theta[i + 1, j]
             tc = times[i] + (times[i + 1] - times[i]) * a0 / (a0 - a1)
             k = int(tc * rate)
-            sound[k:k + 200] += 0.5 * burst[: sound[k:k + 200].size]
+            sound[k : k + 200] += 0.5 * burst[: sound[k : k + 200].size]
     return sound

@@ -209,9 +209,7 @@ def _drop_duplicates(regions: list[Region]) -> list[Region]:
     return kept
 
 
-def regions_from_pivots(
-    pivots: list[tuple[float, float]], pictures: np.ndarray
-) -> list[Region]:
+def regions_from_pivots(pivots: list[tuple[float, float]], pictures: np.ndarray) -> list[Region]:
     """Regions for pivots given by hand (pixels of the pictures, upright), their sectors
     measured from the rods seen in ``pictures``; a pivot with no rod seen near it gets a
     default sector (upward ± 45°, radii up to a fifth of the picture)."""

@@ -172,8 +172,21 @@ def _measure(video, gauges, max_side: int, progress: bool):
             np.array(strengths).reshape(-1, n))  # fmt: skip
 
 
-def _dataset(video, regions, times, angle, quality, confidence, upright, shift, *, grid_dt,
-             equilibrium_window, options, seconds) -> xr.Dataset:
+def _dataset(
+    video,
+    regions,
+    times,
+    angle,
+    quality,
+    confidence,
+    upright,
+    shift,
+    *,
+    grid_dt,
+    equilibrium_window,
+    options,
+    seconds,
+) -> xr.Dataset:
     n = len(regions)
     passes, ups, downs, amps = [], [], [], []
     for j in range(n):
