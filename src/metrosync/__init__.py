@@ -4,12 +4,12 @@ A model, integrators, observables and analysis tools for the system of Boda, Né
 Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
-`analyze_audio` (a sound recording of metronomes), `sweep` (parameter grids),
-`reproduce` (the paper's studies), `animate`, `write_wav`, `write_page`, `plot_run`
-(seeing and hearing a run), `write_playground` (the model live in a browser), and
-`reduced_theory`, `simulate_reduced` (the phase-model reduction, `metrosync.theory`).
-Those that need matplotlib, dask or an audio library are imported on first use, so
-that ``import metrosync`` stays quick.
+`analyze_audio` (a sound recording of metronomes), `track` (a video of them),
+`sweep` (parameter grids), `reproduce` (the paper's studies), `animate`, `write_wav`,
+`write_page`, `plot_run` (seeing and hearing a run), `write_playground` (the model
+live in a browser), and `reduced_theory`, `simulate_reduced` (the phase-model
+reduction, `metrosync.theory`). Those that need matplotlib, dask, an audio or a video
+library are imported on first use, so that ``import metrosync`` stays quick.
 """
 
 from ._version import __version__
@@ -28,7 +28,7 @@ from .model import (  # noqa: E402
 )
 from .simulate import simulate  # noqa: E402
 
-#: Names served on first use from the modules that need matplotlib, dask or soundfile.
+#: Names served on first use from the modules that need matplotlib, dask, soundfile or av.
 _LAZY = {
     "animate": "show",
     "plot_run": "show",
@@ -38,6 +38,7 @@ _LAZY = {
     "sweep": "sweeps",
     "reproduce": "paper",
     "analyze_audio": "audio",
+    "track": "video",
     "reduced_theory": "theory",
     "simulate_reduced": "theory",
 }

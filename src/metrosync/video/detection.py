@@ -17,7 +17,7 @@ The method:
    peaks, while lines of different rods cross at scattered points;
 4. the lines near each pivot give the swept sector and the radii.
 
-`regions_from_pivots` builds the regions for pivots given by hand (``--regions``).
+`regions_given` builds the regions for pivots or boxes given by hand (``--regions``).
 """
 
 from __future__ import annotations
@@ -209,16 +209,36 @@ def _drop_duplicates(regions: list[Region]) -> list[Region]:
     return kept
 
 
-def regions_from_pivots(pivots: list[tuple[float, float]], pictures: np.ndarray) -> list[Region]:
-    """Regions for pivots given by hand (pixels of the pictures, upright), their sectors
-    measured from the rods seen in ``pictures``; a pivot with no rod seen near it gets a
-    default sector (upward ± 45°, radii up to a fifth of the picture)."""
+def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
+    """Regions for metronomes given by hand, in the pictures' pixels: a pivot ``(x, y)``
+    gets the sector of the rod seen about it (upward ± 45° when none is seen); a box
+    ``(x0, y0, x1, y1)`` is searched for one metronome."""
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
     lines = rod_lines(pictures, bg, gain)
     out = []
-    for x, y in pivots:
+    for given in regions:
+        if len(given) == 4:
+            x0, y0 = int(max(0, given[0])), int(max(0, given[1]))
+            x1, y1 = int(min(w, np.ceil(given[2]))), int(min(h, np.ceil(given[3])))
+            if x1 - x0 < 8 or y1 - y0 < 8:
+                raise DetectionError(
+                    f"the box {given} is smaller than 8 pixels or outside the picture "
+                    f"({w}x{h} as analysed); check the regions file."
+                )
+            try:
+                (found,) = find_metronomes(pictures[:, y0:y1, x0:x1], count=1)
+            except DetectionError:
+                raise DetectionError(
+                    f"no rod swings about a fixed pivot inside the box {given}; give its "
+                    f"pivot instead ('x y')."
+                ) from None
+            px, py = found.pivot
+            out.append(Region((px + x0, py + y0), found.centre, found.half_width,
+                              found.r_inner, found.r_outer, found.support))  # fmt: skip
+            continue
+        x, y = given
         region = _region((x, y), lines, f)
         if region is None:
             region = Region((float(x), float(y)), 0.0, np.pi / 4, 3.0, 0.2 * max(h, w), 0.0)

@@ -1,7 +1,7 @@
 """`track`: a video of metronomes → angles, passes, phases and r(t), as an `xarray.Dataset`.
 
-Contract: ``track(path, *, count=None, pivots=None, ...)`` opens the video (`reader`),
-finds the metronomes in its first seconds (`detection`, or the pivots given), measures
+Contract: ``track(path, *, count=None, regions=None, ...)`` opens the video (`reader`),
+finds the metronomes in its first seconds (`detection`, or the regions given), measures
 every rod's angle in every frame (`angles`), and times the upward passes through the
 vertical to measure as the light gate does (`metrosync.observables.crossings`). The
 dataset has the light-gate analysis's variables and conventions (a ``log`` dimension of
@@ -15,12 +15,15 @@ one, the video), so that the same plots and tools read it:
     crossing_time            (metronome, swing)    upward passes, s (NaN padded)
     angle, angle_quality, angle_confidence   (frame, metronome)   per frame
     frame_time               (frame)       the container's presentation times, s
-    pivot_x, pivot_y, vertical   (metronome)   the pivot (pixels of the analysed,
-                                  upright picture) and the picture direction taken as
-                                  the vertical (rad from the picture's up, clockwise)
+    pivot_x, pivot_y, vertical   (metronome)   the pivot (pixels of the video as
+                                  shown) and the picture direction taken as the
+                                  vertical (rad from the picture's up, clockwise)
+    sector_half_width, rod_inner, rod_outer   (metronome)   the region searched
+    first_frame              (y, x)        the first picture as analysed, for the preview
 
 and attrs ``r_eq``, ``sigma_bpm``, ``z`` (two metronomes: +1 in phase, −1 anti-phase),
-the video's facts, the options, and what was lost. Angles are about the vertical,
+the video's facts, the options, what was lost, and the sound's check (``sound``,
+``sound_latency``, ``sound_agrees``: 1, 0, or −1 without sound). Angles are about the vertical,
 positive clockwise as seen, corrected for a camera turned ``view_angle`` degrees off
 square (the horizontal is foreshortened by cos(view_angle)).
 
@@ -34,6 +37,7 @@ from __future__ import annotations
 import math
 import time as clock
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -57,7 +61,7 @@ def track(
     path: str | Path,
     *,
     count: int | None = None,
-    pivots: list[tuple[float, float]] | None = None,
+    regions: list[tuple[float, ...]] | None = None,
     max_side: int = DEFAULT_MAX_SIDE,
     view_angle: float = 0.0,
     vertical: str = "swing",
@@ -67,6 +71,8 @@ def track(
     equilibrium_window: float | None = None,
     max_gap: int = 3,
     progress: bool = False,
+    sound: bool = True,
+    report: Callable[[str], None] | None = None,
 ) -> xr.Dataset:
     """Track the metronomes in a video.
 
@@ -74,8 +80,9 @@ def track(
     ----------
     path : MP4, MOV, MKV or AVI file.
     count : the number of metronomes; default: as many as found.
-    pivots : pivots given by hand, (x, y) pixels of the upright picture scaled to
-        ``max_side`` (the preview's pixels); default: found.
+    regions : metronomes given by hand, in the pixels of the video as shown (upright,
+        full size): ``(x, y)`` a pivot, ``(x0, y0, x1, y1)`` a box around one swing
+        (see `metrosync.video.regions`); default: found.
     max_side : longest side of the pictures analysed, pixels.
     view_angle : degrees between the camera's axis and the square-on direction, turned
         about the vertical; the measured angles are corrected for it.
@@ -86,28 +93,38 @@ def track(
     grid_dt : spacing of the r(t) grid, s.
     equilibrium_window : seconds at the end averaged for ``r_eq``; default a quarter.
     max_gap : longest run of frames without a clear rod that is interpolated.
+    sound : when the video has an audio track, time its ticks against the passes
+        (`metrosync.video.sound`); attrs ``sound`` and ``sound_latency``.
     progress : show a progress bar.
+    report : called with a line that says what will be done and how long it should take,
+        before the long part (a huge file is announced before it is read).
 
     Returns
     -------
     xarray.Dataset, described in the module docstring.
     """
-    _check(count, pivots, max_side, view_angle, vertical, readout, learn, grid_dt, max_gap)
+    _check(count, regions, max_side, view_angle, vertical, readout, learn, grid_dt, max_gap)
     video = open_video(path)
     started = clock.perf_counter()
     pictures = _learning_pictures(video, max_side, learn)
+    if report is not None:
+        report(_estimate(video, pictures.shape[0], clock.perf_counter() - started, learn))
     if pictures.shape[0] < 3:
         raise detection.DetectionError(
             f"{str(video.path)!r} holds {pictures.shape[0]} frame(s) in its first {learn:g} s: "
             f"too few to see anything swing; film at least ten seconds."
         )
-    if pivots is not None:
-        regions = detection.regions_from_pivots(pivots, pictures)
+    # the pictures analysed are smaller than the video: given regions are scaled
+    scale = pictures.shape[2] / video.upright_size[0]
+    if regions is not None:
+        scaled = [tuple(v * scale for v in given) for given in regions]
+        found = detection.regions_given(scaled, pictures)
     else:
-        regions = detection.find_metronomes(pictures, count=count)
+        found = detection.find_metronomes(pictures, count=count)
     bg, _ = detection.background(pictures)
+    first = pictures[0].astype(np.uint8)
     del pictures
-    gauges = [RodGauge(region, bg) for region in regions]
+    gauges = [RodGauge(region, bg) for region in found]
     times, raw, strength = _measure(video, gauges, max_side, progress)
     if video.loss:
         warnings.warn(f"{video.path}: {video.loss}.", UserWarning, stacklevel=2)
@@ -116,7 +133,7 @@ def track(
             f"{str(video.path)!r} gave {times.size} frame(s): too few to time a swing."
         )
     height = bg.shape[0]
-    n = len(regions)
+    n = len(found)
     angle = np.empty_like(raw)
     quality = np.empty(raw.shape, dtype=np.int8)
     confidence = np.empty_like(raw)
@@ -130,13 +147,38 @@ def track(
         angle[:, j] = np.arctan(np.tan(seen) / math.cos(math.radians(view_angle)))
     # Each row of a rolling-shutter picture is taken later than the one above it.
     shift = np.array([readout * gauge.row / height for gauge in gauges])
-    return _dataset(video, regions, times, angle, quality, confidence, upright, shift,
+    ds = _dataset(video, found, times, angle, quality, confidence, upright, shift,
+                    first=first, scale=scale,
                     grid_dt=grid_dt, equilibrium_window=equilibrium_window,
                     options=dict(max_side=max_side, view_angle=view_angle, vertical=vertical,
                                  readout=readout, learn=learn, max_gap=max_gap,
                                  count=-1 if count is None else count,
-                                 pivots_given=int(pivots is not None)),
+                                 regions_given=int(regions is not None)),
                     seconds=clock.perf_counter() - started)  # fmt: skip
+    ds.attrs.update(sound="", sound_latency=float("nan"), sound_agrees=-1)
+    if sound and video.has_audio:
+        _add_sound(ds, video)
+    return ds
+
+
+def _add_sound(ds: xr.Dataset, video) -> None:
+    """The audio track against the passes, in attrs (a warning when it cannot be used)."""
+    from ..errors import MetrosyncError
+    from .sound import sound_check
+
+    passes = []
+    for j in range(ds.sizes["metronome"]):
+        t = ds.frame_time.values
+        a = ds.angle.values[:, j]
+        passes += [ph.zero_crossings(t, a), ph.zero_crossings(t, a, upward=False)]
+    try:
+        check = sound_check(video.path, passes)
+    except MetrosyncError as error:
+        warnings.warn(f"{video.path}: the sound was not used: {error}", UserWarning,
+                      stacklevel=3)  # fmt: skip
+        return
+    ds.attrs.update(sound=check.sentence(), sound_latency=check.latency,
+                    sound_agrees=int(check.agree))  # fmt: skip
 
 
 def _learning_pictures(video, max_side: int, learn: float) -> np.ndarray:
@@ -147,6 +189,29 @@ def _learning_pictures(video, max_side: int, learn: float) -> np.ndarray:
     if not kept:
         return np.empty((0, 1, 1), dtype=np.float32)
     return np.stack(kept).astype(np.float32)
+
+
+def _estimate(video, learned: int, seconds: float, learn: float) -> str:
+    """What the tracking will read, and about how long it will take."""
+    w, h = video.upright_size
+    length = f"{video.duration:.1f} s" if math.isfinite(video.duration) else "unknown length"
+    frames = video.frames_estimate
+    line = (f"{video.path.name}: {w}x{h} {video.codec}, {length}, about {frames} frames "
+            f"at {video.nominal_fps:.4g} fps nominal")  # fmt: skip
+    decoded = min(learn, video.duration if math.isfinite(video.duration) else learn)
+    if frames and learned and seconds > 0 and decoded > 0:
+        # the first pass decoded `decoded` seconds; measuring costs about as much again
+        per_frame = 1.5 * seconds / max(decoded * max(video.nominal_fps, 1.0), 1.0)
+        line += f"; expect about {_duration(per_frame * frames)} of work"
+    return line
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
 
 
 def _measure(video, gauges, max_side: int, progress: bool):
@@ -182,6 +247,8 @@ def _dataset(
     upright,
     shift,
     *,
+    first,
+    scale,
     grid_dt,
     equilibrium_window,
     options,
@@ -258,10 +325,19 @@ def _dataset(
         "frame_time": (("frame",), times,
                        {"units": "s", "long_name": "presentation time since the first frame"}),
         "frames_lost": (("metronome",), lost, {"long_name": "fraction of frames lost"}),
-        "pivot_x": (("metronome",), np.array([r.pivot[0] for r in regions]),
-                    {"units": "pixel", "long_name": "pivot, from the left"}),
-        "pivot_y": (("metronome",), np.array([r.pivot[1] for r in regions]),
-                    {"units": "pixel", "long_name": "pivot, from the top"}),
+        "pivot_x": (("metronome",), np.array([r.pivot[0] / scale for r in regions]),
+                    {"units": "pixel", "long_name": "pivot, from the left of the video"}),
+        "pivot_y": (("metronome",), np.array([r.pivot[1] / scale for r in regions]),
+                    {"units": "pixel", "long_name": "pivot, from the top of the video"}),
+        "sector_half_width": (("metronome",), np.array([r.half_width for r in regions]),
+                              {"units": "rad", "long_name": "half the angle swept, as seen"}),
+        "rod_inner": (("metronome",), np.array([r.r_inner / scale for r in regions]),
+                      {"units": "pixel", "long_name": "nearest radius the rod is seen at"}),
+        "rod_outer": (("metronome",), np.array([r.r_outer / scale for r in regions]),
+                      {"units": "pixel", "long_name": "farthest radius the rod is seen at"}),
+        "first_frame": (("y", "x"), first,
+                        {"long_name": "first frame, grey, as analysed (picture_scale of the "
+                                      "video's size)"}),
         "vertical": (("metronome",), upright,
                      {"units": "rad", "long_name": "picture direction taken as the vertical"}),
         "path": (("log",), np.array([str(video.path)]), {"long_name": "video file"}),
@@ -273,6 +349,7 @@ def _dataset(
         "sigma_bpm": ph.frequency_spread(freq),
         "z": z,
         "grid_dt": grid_dt,
+        "picture_scale": scale,
         "instrument": "video",
         "video_codec": video.codec,
         "video_size": f"{video.upright_size[0]}x{video.upright_size[1]}",
@@ -295,7 +372,7 @@ def _dataset(
         },
         attrs=attrs,
     )
-    for name in ("angle", "angle_confidence", "angle_quality"):
+    for name in ("angle", "angle_confidence", "angle_quality", "first_frame"):
         ds[name].encoding = {"zlib": True, "complevel": 1}
     return ds
 
@@ -312,15 +389,15 @@ def _z(times: np.ndarray, angle: np.ndarray, start: float) -> float:
     return z_order(t, smooth[0], smooth[1])
 
 
-def _check(count, pivots, max_side, view_angle, vertical, readout, learn, grid_dt, max_gap):
+def _check(count, regions, max_side, view_angle, vertical, readout, learn, grid_dt, max_gap):
     if count is not None and (isinstance(count, bool) or not isinstance(count, int | np.integer)
                               or not 1 <= count <= 64):  # fmt: skip
         raise ParameterError(f"`count` must be a whole number in 1..64, got {count!r}.")
-    if pivots is not None and len(pivots) == 0:
-        raise ParameterError("`pivots` is empty: give at least one (x, y), or leave it out.")
-    if count is not None and pivots is not None and count != len(pivots):
+    if regions is not None and len(regions) == 0:
+        raise ParameterError("`regions` is empty: give at least one pivot or box, or leave it out.")
+    if count is not None and regions is not None and count != len(regions):
         raise ParameterError(
-            f"`count` {count} differs from the {len(pivots)} pivots given; leave one out."
+            f"`count` {count} differs from the {len(regions)} regions given; leave one out."
         )
     if not (isinstance(max_side, int | np.integer) and 64 <= max_side <= 8192):
         raise ParameterError(f"`max_side` must be pixels in 64..8192, got {max_side!r}.")
