@@ -42,7 +42,8 @@ class Video:
 
     path : the file.
     width, height : the decoded picture's size before rotation, pixels.
-    rotation : degrees counter-clockwise that the picture is turned to be shown upright.
+    rotation : degrees counter-clockwise (0, 90, 180, 270) that the picture is turned to
+        be shown upright.
     nominal_fps : the rate the container states (may differ from the real times).
     duration : the container's stated length, s (NaN if unknown).
     frames_estimate : frames expected from the stated length and rate (0 if unknown).
@@ -141,9 +142,15 @@ def _open(path: Path):
     try:
         return av.open(str(path), metadata_errors="ignore")
     except av.error.FFmpegError as error:
+        cut = ""
+        if path.suffix.lower() in (".mp4", ".mov", ".m4v", ".3gp"):
+            cut = (
+                " An MP4 or MOV cut short before its index was written (a recording stopped "
+                "by a crash, a copy broken off) cannot be read at all: copy it again."
+            )
         raise VideoFileError(
             f"cannot read {str(path)!r} as a video ({error.strerror or error}); give an MP4, "
-            f"MOV, MKV or AVI file from a camera or phone."
+            f"MOV, MKV or AVI file from a camera or phone.{cut}"
         ) from None
 
 
@@ -197,7 +204,7 @@ def open_video(path: str | Path) -> Video:
             path=path,
             width=first.width,
             height=first.height,
-            rotation=int(round(first.rotation or 0)),
+            rotation=int(round(first.rotation or 0)) % 360,
             nominal_fps=fps,
             duration=duration,
             frames_estimate=int(estimate),
