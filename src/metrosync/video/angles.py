@@ -9,7 +9,7 @@ The picture is sampled on a polar grid about the pivot (angles across the swept 
 with a margin, radii along the rod), by bilinear interpolation at indices computed
 once. What differs from the background there, summed along each ray (weighted by the
 radius: far pixels tell the angle best), is the angular profile; the rod is its peak,
-and the angle is the profile's centroid around the peak. Several peaks (another rod
+and the angle is the centroid of the peak's upper half. Several peaks (another rod
 crossing the sector, where metronomes overlap in the picture) are told apart by
 continuity: the one nearest the angle predicted from the previous two frames wins.
 Identity is therefore tied to the pivot: a gauge only ever looks about its own pivot.
@@ -58,6 +58,7 @@ class RodGauge:
         self._bg = self._sample(bg.ravel())
         self._step = step
         self._prev: list[float] = []
+        self._typical = 0.0  # running height of the rod's peak
         # the rod's angular width at mid-radius, in bins, sets the centroid's window
         self._half_window = int(np.clip(np.ceil(6.0 / (0.5 * (r_in + r_out)) / step), 2, 40))
 
@@ -65,25 +66,31 @@ class RodGauge:
         return np.einsum("kar,kar->ar", flat[self._index], self._weight)
 
     def measure(self, picture: np.ndarray, gain: float) -> tuple[float, float]:
-        """(angle, strength) in one grey picture (H, W) scaled by ``gain``; NaN angle
-        when the profile has no peak above its noise."""
+        """(angle, strength) in one grey picture (H, W) scaled by ``gain``: the strength is
+        the peak's height over the rod's usual one; NaN angle when there is no peak."""
         profile = np.abs(self._sample(picture.ravel()) * gain - self._bg).sum(axis=1)
-        base = np.median(profile)
-        spread = 1.4826 * np.median(np.abs(profile - base)) + 1e-6
+        # the low quartile, not the median: other rods crossing the sector (metronomes
+        # overlapping in the picture) raise the profile over many angles
+        base = np.percentile(profile, 25)
+        spread = 1.4826 * np.median(np.abs(profile - np.median(profile))) + 1e-6
         lifted = profile - base
         k = self._pick_peak(lifted, spread)
         if k is None:
             self._prev = []
             return float("nan"), 0.0
         lo, hi = max(0, k - self._half_window), min(lifted.size, k + self._half_window + 1)
-        weights = np.clip(lifted[lo:hi], 0, None)
+        weights = np.clip(lifted[lo:hi] - 0.5 * lifted[k], 0, None)
         angle = float(np.dot(weights, self.angles[lo:hi]) / weights.sum())
         self._prev = [*self._prev[-1:], angle]
-        return angle, float(lifted[k] / spread)
+        height = float(lifted[k])
+        self._typical = height if not self._typical else 0.95 * self._typical + 0.05 * height
+        return angle, height / self._typical
 
     def _pick_peak(self, lifted: np.ndarray, spread: float) -> int | None:
         top = float(lifted.max())
-        if top < 6.0 * spread:
+        # a peak counts when it stands out of the profile's noise, or is as high as the
+        # rod's usual peak (when other rods crowd the sector, its spread is no noise)
+        if top < 6.0 * spread and not (self._typical and top >= 0.4 * self._typical):
             return None
         if len(self._prev) < 2:
             return int(np.argmax(lifted))
@@ -105,7 +112,7 @@ def finish(
     max_gap : longest run of frames without a clear peak that is interpolated.
     Returns (angle (T,) with short gaps filled, quality (T,) int8, confidence (T,) in
     [0, 1]). A measurement that jumps far from its neighbours' line (a wrong peak) is
-    treated as lost. The confidence is the peak's strength over the median strength.
+    treated as lost. The confidence is the peak's height over the rod's usual one.
     """
     angle = np.array(angle, dtype=float)
     strength = np.asarray(strength, dtype=float)
@@ -120,8 +127,7 @@ def finish(
         angle[bad] = np.nan
         ok[bad] = False
     quality = np.where(ok, MEASURED, LOST).astype(np.int8)
-    typical = np.median(strength[ok]) if ok.any() else 1.0
-    confidence = np.where(ok, np.clip(strength / (typical + 1e-9), 0, 1), 0.0)
+    confidence = np.where(ok, np.clip(strength, 0, 1), 0.0)
     if ok.sum() >= 2:
         lost = np.flatnonzero(~ok)
         runs = np.split(lost, np.flatnonzero(np.diff(lost) > 1) + 1) if lost.size else []

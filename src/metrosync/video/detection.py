@@ -29,8 +29,11 @@ from scipy import ndimage
 
 from ..errors import MetrosyncError
 
-#: Fewest lines through a pivot, as a fraction of the pictures, for it to count.
+#: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
 MIN_SUPPORT = 0.25
+#: Weakest pivot kept, as a fraction of the strongest one's votes: where rods overlap in
+#: the picture, their lines cross at points between the pivots too, with fewer votes.
+MIN_PEAK = 0.4
 
 
 class DetectionError(MetrosyncError, ValueError):
@@ -102,13 +105,14 @@ def _principal_axis(xs: np.ndarray, ys: np.ndarray) -> np.ndarray | None:
 
 
 def vote(lines: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
-    """Accumulator (H, W): each line adds 1 along its length, extended 1.5× each way."""
+    """Accumulator (H, W): each line adds 1 along its length, extended to twice it each
+    way (the pivot lies beyond the moving piece's end)."""
     h, w = shape
     acc = np.zeros(shape)
     for frame_lines in lines:
         seen = np.zeros(shape, dtype=bool)
         for cx, cy, ux, uy, half in frame_lines:
-            s = np.arange(-2.5 * half, 2.5 * half, 0.7)
+            s = np.arange(-2.0 * half, 2.0 * half, 0.7)
             x = np.rint(cx + s * ux).astype(int)
             y = np.rint(cy + s * uy).astype(int)
             inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
@@ -132,25 +136,25 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
         raise DetectionError(
             f"nothing swings in the first {f} frames: no rod moves against the background. "
             f"Check that the metronomes are running and in view, and that the camera stands "
-            f"still; or give the pivots by hand (--regions)."
+            f"still; or give the pivots by hand (`regions`)."
         )
     acc = vote(lines, (h, w))
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
-    floor = MIN_SUPPORT * f
+    floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
-    if count is not None:
-        chosen = peaks[:count] if len(peaks) >= count else peaks
+    if count is not None:  # the strongest `count`, if not much weaker than the best
+        chosen = [p for p in peaks if acc[p[1], p[0]] >= 0.5 * floor][:count]
     regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
     if count is not None and len(regions) < count:
         raise DetectionError(
-            f"found {len(regions)} swinging metronomes, not the {count} asked for (--count). "
+            f"found {len(regions)} swinging metronomes, not the {count} asked for (`count`). "
             f"Check that every rod swings in view in the first seconds, or give the pivots "
-            f"by hand (--regions)."
+            f"by hand (`regions`)."
         )
     if not regions:
         raise DetectionError(
             "things move in the picture but no rod swings about a fixed pivot. Check that "
-            "the camera stands still, or give the pivots by hand (--regions)."
+            "the camera stands still, or give the pivots by hand (`regions`)."
         )
     regions = _drop_duplicates(regions)
     return sorted(regions, key=lambda r: (r.pivot[0], r.pivot[1]))
@@ -174,7 +178,8 @@ def _region(pivot, lines, frames: int) -> Region | None:
             dx, dy = cx - px, cy - py
             dist = abs(dx * uy - dy * ux)  # distance of the pivot from the line
             along = np.hypot(dx, dy)
-            if dist < max(3.0, 0.08 * along) and along > 0.3 * half:
+            # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
+            if dist < max(3.0, 0.08 * along) and along > 0.8 * half:
                 if best is None or dist < best[0]:
                     best = (dist, dx, dy, along, half)
         if best is not None:
@@ -183,7 +188,7 @@ def _region(pivot, lines, frames: int) -> Region | None:
             near.append(max(along - half, 0.0))
             far.append(along + half)
     support = len(angles) / frames
-    if support < MIN_SUPPORT / 2 or len(angles) < 3:
+    if support < MIN_SUPPORT or len(angles) < 3:
         return None
     a = np.unwrap(np.array(angles))
     lo, hi = np.percentile(a, [2, 98])
