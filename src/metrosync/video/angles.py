@@ -54,7 +54,10 @@ class RodGauge:
         self._index = np.stack([base, base + 1, base + w, base + w + 1])
         self._weight = np.stack([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy])
         self._weight *= (inside * r).astype(np.float32)[None]
-        self.row = float(py - 0.6 * r_out * np.cos(region.centre))
+        # where on the rod the angle is read: the mean radius, weighted as the profile is
+        mean_r = 2.0 / 3.0 * (r_out**3 - r_in**3) / (r_out**2 - r_in**2)
+        self.point = (float(px + mean_r * np.sin(region.centre)),
+                      float(py - mean_r * np.cos(region.centre)))  # fmt: skip
         self._bg = self._sample(bg.ravel())
         self._step = step
         self._prev: list[float] = []
@@ -140,30 +143,38 @@ def finish(
     return angle, quality, confidence
 
 
-def swing_middle(angle: np.ndarray) -> float:
-    """The middle of the swing: median over swings of (peak + trough) / 2, rad.
+def swing_middle_in_time(time: np.ndarray, angle: np.ndarray) -> float:
+    """The angle seen when the rod is midway in time between its extremes, rad.
 
-    angle : (T,) per-frame angles (NaN allowed). Each extreme's value is refined by the
-    parabola through its three samples; wiggles smaller than half the typical swing
-    (noise) are not extremes. NaN if no swing is seen.
+    time, angle : (T,) per-frame times and angles (NaN allowed). A swing that is
+    symmetric about the vertical crosses it midway in time between a turn on one side
+    and the next on the other; the angle seen then is the picture's image of the
+    vertical, whatever the perspective does to the angles in between (it keeps their
+    order, and so the times of the turns). Median over half-swings; NaN if none.
     """
+    t = np.asarray(time, dtype=float)
     a = np.asarray(angle, dtype=float)
     ok = np.isfinite(a)
-    if ok.sum() < 5:
+    if ok.sum() < 8:
         return float("nan")
-    x = a[ok]
+    t, x = t[ok], a[ok]
     centre = np.median(x)
     big = 0.5 * np.percentile(np.abs(x - centre), 95)
     left, mid, right = x[:-2], x[1:-1], x[2:]
     curv = left - 2 * mid + right
+    turn = np.flatnonzero(((mid > left) & (mid >= right) & (mid - centre > big))
+                          | ((mid < left) & (mid <= right) & (centre - mid > big))) + 1  # fmt: skip
+    if turn.size < 2:
+        return float(centre)
+    c = curv[turn - 1]
     with np.errstate(invalid="ignore", divide="ignore"):
-        value = mid - np.where(curv != 0, (left - right) ** 2 / (8 * curv), 0.0)
-    peak = np.flatnonzero((mid > left) & (mid >= right) & (mid - centre > big))
-    trough = np.flatnonzero((mid < left) & (mid <= right) & (centre - mid > big))
-    if peak.size == 0 or trough.size == 0:
+        shift = np.where(c != 0, 0.5 * (x[turn - 1] - x[turn + 1]) / c, 0.0)
+    shift = np.clip(shift, -1, 1)
+    step = np.where(shift >= 0, t[turn + 1] - t[turn], t[turn] - t[turn - 1])
+    when = t[turn] + shift * step
+    side = x[turn] > centre
+    halves = np.flatnonzero(side[:-1] != side[1:])  # a turn, then one on the other side
+    if halves.size == 0:
         return float(centre)
-    nxt = np.searchsorted(trough, peak)
-    pairs = nxt < trough.size
-    if not pairs.any():
-        return float(centre)
-    return float(np.median(0.5 * (value[peak[pairs]] + value[trough[nxt[pairs]]])))
+    middle = 0.5 * (when[halves] + when[halves + 1])
+    return float(np.median(np.interp(middle, t, x)))

@@ -71,6 +71,15 @@ class Video:
             return self.height, self.width
         return self.width, self.height
 
+    def stored_row(self, x: float, y: float, shape: tuple[int, int]) -> float:
+        """Where the upright picture's point (x, y), in a picture of ``shape`` (H, W),
+        lies among the stored picture's rows, as a fraction from the top (0..1): a
+        rolling shutter exposes the stored rows in turn."""
+        h, w = shape
+        k = int(round(self.rotation / 90.0)) % 4
+        # np.rot90 by k quarter turns counter-clockwise made the upright picture
+        return [y / h, x / w, 1.0 - y / h, 1.0 - x / w][k]
+
     def scaled_size(self, max_side: int) -> tuple[int, int]:
         """(width, height) of the decoded picture with its longer side at most ``max_side``
         (even sizes, for the scaler); before rotation."""

@@ -27,9 +27,12 @@ the video's facts, the options, what was lost, and the sound's check (``sound``,
 positive clockwise as seen, corrected for a camera turned ``view_angle`` degrees off
 square (the horizontal is foreshortened by cos(view_angle)).
 
-The vertical is the middle of the swing (the median of (peak + trough) / 2), since
-metronomes swing symmetrically about it; ``vertical="picture"`` takes the picture's up
-direction instead (a camera held level, a metronome with an asymmetric swing).
+The vertical is the middle of the swing: the angle seen midway in time between two
+turns (`swing_middle_in_time`), since metronomes swing symmetrically about it and the
+perspective changes angles but not the times of the turns; ``vertical="picture"``
+takes the picture's up direction instead (a camera held level and square-on, a
+metronome out of beat: only then is the tick/tock asymmetry measured, since the middle
+of the swing makes it zero by construction).
 """
 
 from __future__ import annotations
@@ -50,7 +53,7 @@ from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
 from ..observables.zorder import z_order
 from . import detection
-from .angles import LOST, MEASURED, QUALITY_NAMES, RodGauge, finish, swing_middle
+from .angles import LOST, MEASURED, QUALITY_NAMES, RodGauge, finish, swing_middle_in_time
 from .reader import DEFAULT_MAX_SIDE, open_video
 
 #: Seconds at the start used to find the metronomes, and the most pictures kept for it.
@@ -132,7 +135,6 @@ def track(
         raise detection.DetectionError(
             f"{str(video.path)!r} gave {times.size} frame(s): too few to time a swing."
         )
-    height = bg.shape[0]
     n = len(found)
     angle = np.empty_like(raw)
     quality = np.empty(raw.shape, dtype=np.int8)
@@ -142,11 +144,14 @@ def track(
         angle[:, j], quality[:, j], confidence[:, j] = finish(raw[:, j], strength[:, j], times,
                                                               max_gap=max_gap)  # fmt: skip
         ok = np.isfinite(angle[:, j])
-        upright[j] = 0.0 if vertical == "picture" or not ok.any() else swing_middle(angle[:, j])
+        if vertical == "swing" and ok.any():
+            upright[j] = swing_middle_in_time(times, angle[:, j])
+        else:
+            upright[j] = 0.0
         seen = angle[:, j] - upright[j]
         angle[:, j] = np.arctan(np.tan(seen) / math.cos(math.radians(view_angle)))
     # Each row of a rolling-shutter picture is taken later than the one above it.
-    shift = np.array([readout * gauge.row / height for gauge in gauges])
+    shift = np.array([readout * video.stored_row(*gauge.point, bg.shape) for gauge in gauges])
     ds = _dataset(video, found, times, angle, quality, confidence, upright, shift,
                     first=first, scale=scale,
                     grid_dt=grid_dt, equilibrium_window=equilibrium_window,
