@@ -31,6 +31,8 @@ from ..errors import MetrosyncError
 
 #: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
 MIN_SUPPORT = 0.25
+#: Largest amplitude of a swing, as seen, rad.
+MAX_SWING = 1.0
 #: Weakest pivot kept, as a fraction of the strongest one's votes: where rods overlap in
 #: the picture, their lines cross at points between the pivots too, with fewer votes.
 MIN_PEAK = 0.4
@@ -72,36 +74,43 @@ def rod_lines(pictures: np.ndarray, bg: np.ndarray, gain: np.ndarray) -> list[np
     """Per picture, the lines of the long thin moving pieces: (L, 5) arrays of
     centroid x, y, direction ux, uy (unit), and half-length (pixels)."""
     diff = np.abs(pictures * gain[:, None, None] - bg[None])
-    noise = 1.4826 * np.median(np.abs(diff - np.median(diff)))
-    threshold = max(6.0 * noise + np.median(diff), 12.0)
+    sample = diff[:: max(1, len(diff) // 16)]
+    level = np.median(sample)
+    noise = 1.4826 * np.median(np.abs(sample - level))
+    threshold = max(6.0 * noise + level, 12.0)
     min_pixels = max(12, int(2e-4 * bg.size))
-    out = []
-    for frame in diff:
-        mask = ndimage.binary_opening(frame > threshold)
-        labels, count = ndimage.label(mask)
-        lines = []
-        if count:
-            index = np.arange(1, count + 1)
-            sizes = ndimage.sum_labels(mask, labels, index)
-            ys, xs = np.nonzero(labels)
-            lab = labels[ys, xs]
-            for j in index[sizes >= min_pixels]:
-                sel = lab == j
-                line = _principal_axis(xs[sel].astype(float), ys[sel].astype(float))
-                if line is not None:
-                    lines.append(line)
-        out.append(np.array(lines).reshape(-1, 5))
-    return out
+    return [_lines(frame > threshold, min_pixels) for frame in diff]
 
 
-def _principal_axis(xs: np.ndarray, ys: np.ndarray) -> np.ndarray | None:
-    cx, cy = xs.mean(), ys.mean()
-    cov = np.cov(np.stack([xs - cx, ys - cy]))
-    values, vectors = np.linalg.eigh(cov)
-    if values[1] <= 0 or values[0] / values[1] > 0.2:  # not long and thin
-        return None
-    ux, uy = vectors[:, 1]
-    return np.array([cx, cy, ux, uy, 2.0 * np.sqrt(values[1])])
+def _lines(mask: np.ndarray, min_pixels: int) -> np.ndarray:
+    """(L, 5) principal axes of the connected pieces of ``mask`` that are long and thin."""
+    labels, count = ndimage.label(mask)
+    if count == 0:
+        return np.empty((0, 5))
+    ys, xs = np.nonzero(labels)
+    lab = labels[ys, xs]
+    xs, ys = xs.astype(float), ys.astype(float)
+    n = np.bincount(lab, minlength=count + 1)[1:]
+    big = n >= min_pixels
+    if not big.any():
+        return np.empty((0, 5))
+
+    def total(w):
+        return np.bincount(lab, weights=w, minlength=count + 1)[1:][big]
+
+    n = n[big].astype(float)
+    cx, cy = total(xs) / n, total(ys) / n
+    sxx = total(xs * xs) / n - cx**2
+    syy = total(ys * ys) / n - cy**2
+    sxy = total(xs * ys) / n - cx * cy
+    # eigenvalues and the major axis of each piece's 2x2 covariance
+    half_trace, det = 0.5 * (sxx + syy), sxx * syy - sxy**2
+    root = np.sqrt(np.maximum(half_trace**2 - det, 0.0))
+    major, minor = half_trace + root, half_trace - root
+    angle = 0.5 * np.arctan2(2 * sxy, sxx - syy)
+    thin = (major > 0) & (minor <= 0.2 * major)
+    return np.stack([cx, cy, np.cos(angle), np.sin(angle), 2.0 * np.sqrt(np.maximum(major, 0))],
+                    axis=1)[thin]  # fmt: skip
 
 
 def vote(lines: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
@@ -142,9 +151,11 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
     floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
-    if count is not None:  # the strongest `count`, if not much weaker than the best
-        chosen = [p for p in peaks if acc[p[1], p[0]] >= 0.5 * floor][:count]
     regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    if count is not None:  # the strongest `count`, if not much weaker than the best
+        weaker = [p for p in peaks if 0.6 * floor <= acc[p[1], p[0]] < floor]
+        more = [r for r in (_region(p, lines, f) for p in weaker) if r is not None]
+        regions = (regions + [r for r in more if r.support >= 2 * MIN_SUPPORT])[:count]
     if count is not None and len(regions) < count:
         raise DetectionError(
             f"found {len(regions)} swinging metronomes, not the {count} asked for (`count`). "
@@ -192,6 +203,8 @@ def _region(pivot, lines, frames: int) -> Region | None:
         return None
     a = np.unwrap(np.array(angles))
     lo, hi = np.percentile(a, [2, 98])
+    if hi - lo > 2 * MAX_SWING:  # lines through the point from all sides: rods crossing
+        return None
     centre = float(np.angle(np.exp(1j * 0.5 * (lo + hi))))
     return Region(
         pivot=(float(px), float(py)),
