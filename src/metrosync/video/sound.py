@@ -6,7 +6,8 @@ detector (`analyze_audio`), puts the ticks on the picture's clock (the audio str
 start time against the first frame's), and compares them with the rods' passes
 through the vertical (both directions: a metronome ticks at each). It returns a
 `SoundCheck`: the ticks heard, the offset of each from the nearest pass, the median
-offset (the sound's latency plus where in the swing the escapement ticks), and whether
+offset that puts most ticks on a pass (the sound's latency plus where in the swing the
+escapement ticks; searched within ±`MAX_LATENCY`), and whether
 picture and sound agree: most ticks fall within `TOLERANCE` of that offset.
 """
 
@@ -22,6 +23,8 @@ from ..errors import MetrosyncError
 
 #: Largest spread of a tick about the median offset for it to agree with a pass, s.
 TOLERANCE = 0.015
+#: Largest delay of the sound behind the picture (either way) that is looked for, s.
+MAX_LATENCY = 0.2
 #: Fraction of the ticks that must agree for picture and sound to agree.
 AGREEMENT = 0.8
 
@@ -99,16 +102,28 @@ def sound_check(path: str | Path, passes: list[np.ndarray]) -> SoundCheck:
     ticks = heard.tick_time.values + shift
     if ticks.size == 0 or every.size == 0:
         return SoundCheck(ticks, np.full(ticks.size, np.nan), float("nan"), 0.0, 0.0)
-    k = np.clip(np.searchsorted(every, ticks), 1, every.size - 1)
-    before, after = every[k - 1], every[k]
-    nearest = np.where(np.abs(ticks - before) <= np.abs(ticks - after), before, after)
-    offset = ticks - nearest
-    latency = float(np.median(offset))
+    latency = _latency(ticks, every)
+    offset = ticks - _nearest(every, ticks - latency)
     agreeing = float(np.mean(np.abs(offset - latency) <= TOLERANCE))
-    shifted = ticks - latency
-    j = np.clip(np.searchsorted(shifted, every), 1, max(shifted.size - 1, 1))
-    gap = np.minimum(
-        np.abs(every - shifted[j - 1]), np.abs(every - shifted[np.minimum(j, shifted.size - 1)])
-    )
-    heard_fraction = float(np.mean(gap <= TOLERANCE))
-    return SoundCheck(ticks, offset, latency, agreeing, heard_fraction)
+    gap = np.abs(every - _nearest(ticks - latency, every))
+    return SoundCheck(ticks, offset, latency, agreeing, float(np.mean(gap <= TOLERANCE)))
+
+
+def _nearest(sorted_times: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """For each of ``times``, the nearest of ``sorted_times``."""
+    k = np.clip(np.searchsorted(sorted_times, times), 1, max(sorted_times.size - 1, 1))
+    before, after = sorted_times[k - 1], sorted_times[np.minimum(k, sorted_times.size - 1)]
+    return np.where(np.abs(times - before) <= np.abs(times - after), before, after)
+
+
+def _latency(ticks: np.ndarray, passes: np.ndarray) -> float:
+    """The delay that puts most ticks on a pass: with several metronomes a tick's nearest
+    pass may be another's, so every delay in ±`MAX_LATENCY` is tried (1 ms steps), and
+    the best refined as the median offset of the ticks it matches."""
+    trials = np.arange(-MAX_LATENCY, MAX_LATENCY + 1e-9, 1e-3)
+    hits = [np.sum(np.abs(ticks - d - _nearest(passes, ticks - d)) <= 0.25 * TOLERANCE)
+            for d in trials]  # fmt: skip
+    best = float(trials[int(np.argmax(hits))])
+    offset = ticks - _nearest(passes, ticks - best)
+    close = np.abs(offset - best) <= 0.5 * TOLERANCE
+    return float(np.median(offset[close])) if close.any() else best
