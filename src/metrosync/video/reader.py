@@ -8,7 +8,7 @@ length and audio track. `Video.frames` yields ``(time, picture)`` one frame at a
 * ``time`` is the frame's presentation timestamp (PTS × time base) in seconds from the
   first frame, never an index divided by a nominal rate: phones record at a variable
   rate, and a "30 fps" file may hold frames 31 and 36 ms apart, or drop some;
-* ``picture`` is a float32 (height, width) grey image (0–255) at a reduced size (the
+* ``picture`` is a uint8 (height, width) grey image at a reduced size (the
   longer side at most ``max_side`` pixels), turned upright by the rotation the file
   asks for (a phone held upright stores a landscape picture and a rotation of ±90°).
 
@@ -127,7 +127,7 @@ class Video:
                     if k:
                         picture = np.rot90(picture, k)
                     self.decoded += 1
-                    yield t, picture.astype(np.float32)
+                    yield t, picture
             except av.error.FFmpegError as error:
                 self.loss = (
                     f"decoding stopped at {max(last, 0.0):.2f} s after {self.decoded} frames "

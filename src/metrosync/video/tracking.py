@@ -57,7 +57,7 @@ from .angles import LOST, MEASURED, QUALITY_NAMES, RodGauge, finish, swing_middl
 from .reader import DEFAULT_MAX_SIDE, open_video
 
 #: Seconds at the start used to find the metronomes, and the most pictures kept for it.
-LEARN_SECONDS, LEARN_PICTURES = 6.0, 180
+LEARN_SECONDS, LEARN_PICTURES = 6.0, 120
 
 
 def track(
@@ -189,8 +189,8 @@ def _add_sound(ds: xr.Dataset, video) -> None:
 def _learning_pictures(video, max_side: int, learn: float) -> np.ndarray:
     """Up to `LEARN_PICTURES` pictures spread over the first ``learn`` seconds."""
     every = max(1, int(round(learn * max(video.nominal_fps, 1.0) / LEARN_PICTURES)))
-    kept = [p.astype(np.uint8) for i, (_, p) in enumerate(video.frames(max_side=max_side,
-            stop=learn)) if i % every == 0]  # fmt: skip
+    kept = [p for i, (_, p) in enumerate(video.frames(max_side=max_side, stop=learn))
+            if i % every == 0]  # fmt: skip
     if not kept:
         return np.empty((0, 1, 1), dtype=np.float32)
     return np.stack(kept).astype(np.float32)
@@ -227,7 +227,7 @@ def _measure(video, gauges, max_side: int, progress: bool):
     with progress_bar(total=video.frames_estimate or None, unit="frame", enabled=progress,
                       desc="tracking") as bar:  # fmt: skip
         for t, picture in video.frames(max_side=max_side):
-            small = np.median(picture[::8, ::8])
+            small = float(picture[::8, ::8].mean())
             level = small if level is None else level
             gain = level / (small + 1e-6)
             row = [g.measure(picture, gain) for g in gauges]
