@@ -94,7 +94,12 @@ def sound_check(path: str | Path, passes: list[np.ndarray]) -> SoundCheck:
     every = np.sort(np.concatenate([np.asarray(p, dtype=float) for p in passes]))
     with tempfile.TemporaryDirectory() as folder:
         wav = Path(folder) / "track.wav"
-        shift = _extract(Path(path), wav)
+        import av
+
+        try:
+            shift = _extract(Path(path), wav)
+        except (av.error.FFmpegError, RuntimeError, ValueError) as error:
+            raise MetrosyncError(f"the audio track cannot be decoded ({error})") from None
         try:
             heard = analyze_audio(wav)
         except MetrosyncError as error:

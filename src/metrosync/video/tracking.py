@@ -53,7 +53,7 @@ from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
 from ..observables.zorder import z_order
 from . import detection
-from .angles import LOST, MEASURED, QUALITY_NAMES, RodGauge, finish, swing_middle_in_time
+from .angles import LOST, QUALITY_NAMES, RodGauge, finish, swing_middle_in_time
 from .reader import DEFAULT_MAX_SIDE, open_video
 
 #: Seconds at the start used to find the metronomes, and the most pictures kept for it.
@@ -422,6 +422,3 @@ def _check(count, regions, max_side, view_angle, vertical, readout, learn, grid_
     if not (isinstance(max_gap, int | np.integer) and 0 <= max_gap <= 100):
         raise ParameterError(f"`max_gap` must be a whole number of frames in 0..100, "
                              f"got {max_gap!r}.")  # fmt: skip
-
-
-__all__ = ["MEASURED", "track"]
