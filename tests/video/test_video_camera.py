@@ -21,7 +21,7 @@ def run(t_end, n, seed):
 
 
 def filmed(folder, fps, seed, n=3):
-    t, theta = run(14.0, n, seed)
+    t, theta = run(12.0, n, seed)
     camera = Camera(fps=fps, width=640, height=360, drop_fraction=0.03, vfr_jitter_s=0.001,
                     yaw_deg=30.0, flicker_hz=100.0)  # fmt: skip
     truth = film(folder / f"run{fps:g}.mp4", t, theta, camera=camera, seed=seed,
@@ -80,3 +80,27 @@ def test_the_sound_is_heard_30_ms_after_the_passes(at_60):
     assert ds.attrs["sound_agrees"] == 1
     # within 5 ms: the tick detector dates a click by its rise, a few ms into it
     assert ds.attrs["sound_latency"] == pytest.approx(truth.audio_delay_s, abs=0.005)
+
+
+@pytest.mark.slow
+def test_the_number_of_metronomes_is_found_in_95_percent_of_scenes(tmp_path):
+    from metrosync.video.detection import DetectionError, find_metronomes
+    from metrosync.video.reader import open_video
+    from metrosync.video.tracking import _learning_pictures
+
+    found = []
+    for n in range(1, 9):
+        for seed in range(3):
+            rng = np.random.default_rng(100 * n + seed)
+            t, theta = run(7.0, n, 100 * n + seed)
+            camera = Camera(fps=30, width=640, height=360, vfr_jitter_s=0.002,
+                            drop_fraction=0.02,
+                            yaw_deg=float(rng.uniform(20, 40) * rng.choice([-1, 1])))  # fmt: skip
+            scene = Scene.random(n, seed=100 * n + seed, overlap=0.0)
+            film(tmp_path / "scene.mp4", t, theta, scene=scene, camera=camera, seed=seed)
+            pictures = _learning_pictures(open_video(tmp_path / "scene.mp4"), 640, 6.0)
+            try:
+                found.append(len(find_metronomes(pictures)) == n)
+            except DetectionError:
+                found.append(False)
+    assert np.mean(found) >= 0.95, f"found the right number in {sum(found)} of {len(found)}"

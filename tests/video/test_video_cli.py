@@ -77,7 +77,7 @@ def test_bad_files_get_one_line_and_no_traceback(tmp_path, capsys):
 
 def test_a_truncated_file_is_used_and_the_loss_said(tmp_path, capsys):
     whole = tmp_path / "whole.mkv"
-    synth_video.scene(whole, n=2, seconds=16, size=(320, 180))
+    synth_video.scene(whole, n=2, seconds=12, size=(320, 180))
     cut = tmp_path / "cut.mkv"
     cut.write_bytes(whole.read_bytes()[: int(whole.stat().st_size * 0.6)])
     code, out, err = run(capsys, cut)

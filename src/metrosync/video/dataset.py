@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import AnalysisError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
 from ..observables.zorder import z_order
@@ -52,7 +52,16 @@ def tracking_dataset(
         kept, cycles = ph.passes_on_period_grid(up)
         passes.append((kept, cycles))
         amps.append(ph.swing_amplitudes(t_j, angle[:, j], kept))
-    spans = [ph.channel_span(k, str(video.path), j) for j, (k, _) in enumerate(passes)]
+    spans = []
+    for j, ((kept, _), region) in enumerate(zip(passes, regions, strict=True)):
+        if kept.size < 2:
+            x, y = (v / scale for v in region.pivot)
+            raise AnalysisError(
+                f"{video.path}: metronome {j} (pivot at {x:.0f}, {y:.0f} px) passes the "
+                f"vertical {kept.size} time(s), too few for a phase: film longer, check that "
+                f"its rod is in view and swings, or give the others' pivots (`regions`)."
+            )
+        spans.append((float(kept[0]), float(kept[-1])))
     grid = ph.common_grid(spans, grid_dt)
     if grid.size < 2:
         raise ParameterError(
