@@ -90,17 +90,21 @@ def register(subparsers) -> None:
     )
     m.add_argument("--no-sound", action="store_true", help="ignore the video's audio track")
     out = parser.add_argument_group("output")
-    out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
+    out.add_argument(
+        "--out", type=Path, default=None, metavar="FILE", help="write the dataset to FILE.nc"
+    )
     out.add_argument(
         "--plot",
         type=Path,
         default=None,
+        metavar="FILE",
         help="write r(t) and the last seconds' angles to FILE.png",
     )
     out.add_argument(
         "--preview",
         type=Path,
         default=None,
+        metavar="FILE",
         help="write the first frame with what was found to FILE.png",
     )
     add_aliases(
