@@ -27,7 +27,7 @@ def filmed(folder, fps, seed, n=3):
     truth = film(folder / f"run{fps:g}.mp4", t, theta, camera=camera, seed=seed,
                  scene=Scene.random(n, seed=seed, overlap=0.0),
                  audio=Microphone(delay_s=0.03))  # fmt: skip
-    return truth, track(truth.path, readout=camera.readout)
+    return truth, track(truth.path)  # the readout estimated from the rods
 
 
 @pytest.fixture(scope="module")
@@ -104,3 +104,9 @@ def test_the_number_of_metronomes_is_found_in_95_percent_of_scenes(tmp_path):
             except DetectionError:
                 found.append(False)
     assert np.mean(found) >= 0.95, f"found the right number in {sum(found)} of {len(found)}"
+
+
+def test_the_rolling_shutter_is_estimated_from_the_rods(at_60, at_30):
+    for truth, ds in (at_60, at_30):
+        readout = truth.row_delay_s * truth.height
+        assert ds.attrs["readout"] == pytest.approx(readout, rel=0.3)

@@ -69,9 +69,10 @@ def register(subparsers) -> None:
     m.add_argument(
         "--readout",
         type=float,
-        default=0.0,
+        default=None,
         metavar="S",
-        help="rolling-shutter readout time, top row to bottom row (0: none)",
+        help="rolling-shutter readout time, top row to bottom row (0: a global shutter; "
+        "default: estimated from how the moving rods look bent)",
     )
     m.add_argument(
         "--max-gap",
@@ -183,6 +184,7 @@ def summary(ds) -> str:
         lines.append(f"  z = {a['z']:+.3f} (+1 in phase, -1 in anti-phase)")
     if a.get("loss"):
         lines.append(f"  lost: {a['loss']}")
+    lines.append(f"  rolling shutter: {a['readout'] * 1e3:.1f} ms ({a['readout_source']})")
     if a.get("sound"):
         lines.append(f"  sound: {a['sound']}")
     return "\n".join(lines)

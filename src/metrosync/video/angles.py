@@ -43,6 +43,10 @@ class RodGauge:
         half = region.half_width + MARGIN
         self.angles = region.centre + np.arange(-half, half + step, step)
         radii = np.arange(r_in, r_out, 1.5)
+        # the rod's inner and outer halves, read apart: a rolling shutter skews them
+        self._split = max(1, radii.size // 2)
+        self.radius_inner = float(np.average(radii[: self._split], weights=radii[: self._split]))
+        self.radius_outer = float(np.average(radii[self._split :], weights=radii[self._split :]))
         a, r = np.meshgrid(self.angles, radii, indexing="ij")
         x = px + r * np.sin(a)
         y = py - r * np.cos(a)
@@ -68,10 +72,13 @@ class RodGauge:
     def _sample(self, flat: np.ndarray) -> np.ndarray:
         return np.einsum("kar,kar->ar", flat[self._index], self._weight)
 
-    def measure(self, picture: np.ndarray, gain: float) -> tuple[float, float]:
-        """(angle, strength) in one grey picture (H, W) scaled by ``gain``: the strength is
-        the peak's height over the rod's usual one; NaN angle when there is no peak."""
-        profile = np.abs(self._sample(picture.ravel()) * gain - self._bg).sum(axis=1)
+    def measure(self, picture: np.ndarray, gain: float) -> tuple[float, float, float]:
+        """(angle, strength, skew) in one grey picture (H, W) scaled by ``gain``: the
+        strength is the peak's height over the rod's usual one; the skew is the angle of
+        the rod's outer half less its inner half's. NaN angle when there is no peak."""
+        differs = np.abs(self._sample(picture.ravel()) * gain - self._bg)
+        inner = differs[:, : self._split].sum(axis=1)
+        profile = inner + differs[:, self._split :].sum(axis=1)
         # the low quartile, not the median: other rods crossing the sector (metronomes
         # overlapping in the picture) raise the profile over many angles
         ranked = np.sort(profile)
@@ -82,14 +89,17 @@ class RodGauge:
         k = self._pick_peak(lifted, spread)
         if k is None:
             self._prev = []
-            return float("nan"), 0.0
+            return float("nan"), 0.0, float("nan")
         lo, hi = max(0, k - self._half_window), min(lifted.size, k + self._half_window + 1)
-        weights = np.clip(lifted[lo:hi] - 0.5 * lifted[k], 0, None)
-        angle = float(np.dot(weights, self.angles[lo:hi]) / weights.sum())
+        angle = _centroid(lifted[lo:hi], self.angles[lo:hi])
+        outer = profile - inner
+        skew = _centroid(outer[lo:hi] - outer[lo:hi].min(), self.angles[lo:hi]) - _centroid(
+            inner[lo:hi] - inner[lo:hi].min(), self.angles[lo:hi]
+        )
         self._prev = [*self._prev[-1:], angle]
         height = float(lifted[k])
         self._typical = height if not self._typical else 0.95 * self._typical + 0.05 * height
-        return angle, height / self._typical
+        return angle, height / self._typical, skew
 
     def _pick_peak(self, lifted: np.ndarray, spread: float) -> int | None:
         top = float(lifted.max())
@@ -106,6 +116,13 @@ class RodGauge:
         if peaks.size == 0:
             return int(np.argmax(lifted))
         return int(peaks[np.argmin(np.abs(self.angles[peaks] - predicted))])
+
+
+def _centroid(profile: np.ndarray, angles: np.ndarray) -> float:
+    """Centroid of the part of a peak above half its height."""
+    weights = np.clip(profile - 0.5 * profile.max(), 0, None)
+    total = weights.sum()
+    return float(np.dot(weights, angles) / total) if total > 0 else float("nan")
 
 
 def finish(

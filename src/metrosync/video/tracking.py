@@ -50,7 +50,7 @@ from .. import interrupts
 from ..errors import ParameterError
 from ..observables import crossings as ph
 from . import detection
-from .angles import RodGauge, finish, swing_middle_in_time
+from .angles import MEASURED, RodGauge, finish, swing_middle_in_time
 from .dataset import tracking_dataset
 from .reader import DEFAULT_MAX_SIDE, open_video
 
@@ -66,7 +66,7 @@ def track(
     max_side: int = DEFAULT_MAX_SIDE,
     view_angle: float = 0.0,
     vertical: str = "swing",
-    readout: float = 0.0,
+    readout: float | None = None,
     learn: float = LEARN_SECONDS,
     grid_dt: float = 0.1,
     equilibrium_window: float | None = None,
@@ -89,7 +89,8 @@ def track(
         about the vertical; the measured angles are corrected for it.
     vertical : ``"swing"`` (the middle of the swing) or ``"picture"`` (straight up).
     readout : the rolling shutter's readout time, s (the time from the picture's first
-        row to its last); each measurement is dated at its rod's row. 0: a global shutter.
+        row to its last); each measurement is dated at its rod's row. 0: a global
+        shutter; default: estimated from the rods' skew (`estimate_readout`).
     learn : seconds at the start used to find the metronomes.
     grid_dt : spacing of the r(t) grid, s.
     equilibrium_window : seconds at the end averaged for ``r_eq``; default a quarter.
@@ -126,7 +127,7 @@ def track(
     first = pictures[0].astype(np.uint8)
     del pictures
     gauges = [RodGauge(region, bg) for region in found]
-    times, raw, strength = _measure(video, gauges, max_side, progress)
+    times, raw, strength, skew = _measure(video, gauges, max_side, progress)
     if video.loss:
         warnings.warn(f"{video.path}: {video.loss}.", UserWarning, stacklevel=2)
     if times.size < 4:
@@ -138,10 +139,12 @@ def track(
     quality = np.empty(raw.shape, dtype=np.int8)
     confidence = np.empty_like(raw)
     upright = np.empty(n)
+    seen_from_up = np.empty_like(raw)
     for j in range(n):
         angle[:, j], quality[:, j], confidence[:, j] = finish(raw[:, j], strength[:, j], times,
                                                               max_gap=max_gap)  # fmt: skip
         ok = np.isfinite(angle[:, j])
+        seen_from_up[:, j] = angle[:, j]
         if vertical == "swing" and ok.any():
             upright[j] = swing_middle_in_time(times, angle[:, j])
         else:
@@ -149,12 +152,18 @@ def track(
         seen = angle[:, j] - upright[j]
         angle[:, j] = np.arctan(np.tan(seen) / math.cos(math.radians(view_angle)))
     # Each row of a rolling-shutter picture is taken later than the one above it.
+    source = "given"
+    if readout is None:
+        readout, error = estimate_readout(video, gauges, bg.shape, times, seen_from_up,
+                                          quality, skew)  # fmt: skip
+        source = f"estimated from the rods' skew, ± {error * 1e3:.1f} ms"
     shift = np.array([readout * video.stored_row(*gauge.point, bg.shape) for gauge in gauges])
     ds = tracking_dataset(video, found, times, angle, quality, confidence, upright, shift,
                     first=first, scale=scale,
                     grid_dt=grid_dt, equilibrium_window=equilibrium_window,
                     options=dict(max_side=max_side, view_angle=view_angle, vertical=vertical,
-                                 readout=readout, learn=learn, max_gap=max_gap,
+                                 readout=readout, readout_source=source, learn=learn,
+                                 max_gap=max_gap,
                                  count=-1 if count is None else count,
                                  regions_given=int(regions is not None)),
                     seconds=clock.perf_counter() - started)  # fmt: skip
@@ -220,7 +229,7 @@ def _duration(seconds: float) -> str:
 def _measure(video, gauges, max_side: int, progress: bool):
     from ..progress import progress_bar
 
-    times, angles, strengths = [], [], []
+    times, angles, strengths, skews = [], [], [], []
     level = None
     with progress_bar(total=video.frames_estimate or None, unit="frame", enabled=progress,
                       desc="tracking") as bar:  # fmt: skip
@@ -230,14 +239,51 @@ def _measure(video, gauges, max_side: int, progress: bool):
             gain = level / (small + 1e-6)
             row = [g.measure(picture, gain) for g in gauges]
             times.append(t)
-            angles.append([a for a, _ in row])
-            strengths.append([s for _, s in row])
+            angles.append([a for a, _, _ in row])
+            strengths.append([s for _, s, _ in row])
+            skews.append([k for _, _, k in row])
             bar.update(1)
             if len(times) % 256 == 0:
                 interrupts.check()
     n = len(gauges)
     return (np.array(times), np.array(angles).reshape(-1, n),
-            np.array(strengths).reshape(-1, n))  # fmt: skip
+            np.array(strengths).reshape(-1, n), np.array(skews).reshape(-1, n))  # fmt: skip
+
+
+def estimate_readout(video, gauges, shape, times, seen, quality, skew) -> tuple[float, float]:
+    """The rolling shutter's readout time from the rods' skew, and its standard error, s.
+
+    A rolling shutter exposes a rod's outer half at another moment than its inner half,
+    so a rod turning at ω looks bent by ω · readout · (their rows' difference as a
+    fraction of the stored picture). The skew of every measured frame (`RodGauge`)
+    against ω times that difference, less each metronome's mean (a rod drawn slightly
+    bent), gives the readout by least squares; within 0..50 ms.
+    """
+    xs, ys = [], []
+    for j, gauge in enumerate(gauges):
+        good = (quality[:, j] == MEASURED) & np.isfinite(skew[:, j])
+        if good.sum() < 20:
+            continue
+        phi = seen[:, j]
+        omega = np.gradient(np.where(np.isfinite(phi), phi, 0.0), times)
+        px, py = gauge.region.pivot
+        rows = [video.stored_row(px + r * np.sin(phi), py - r * np.cos(phi), shape)
+                for r in (gauge.radius_outer, gauge.radius_inner)]  # fmt: skip
+        x = (omega * (rows[0] - rows[1]))[good]
+        y = skew[good, j]
+        keep = np.abs(y - np.median(y)) <= 5 * 1.4826 * np.median(np.abs(y - np.median(y))) + 1e-9
+        xs.append(x[keep] - x[keep].mean())
+        ys.append(y[keep] - y[keep].mean())
+    if not xs:
+        return 0.0, float("nan")
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    sxx = float(np.dot(x, x))
+    if sxx <= 0 or x.size < 20:
+        return 0.0, float("nan")
+    slope = float(np.dot(x, y) / sxx)
+    residual = y - slope * x
+    error = float(np.sqrt(np.dot(residual, residual) / (x.size - 1) / sxx))
+    return float(np.clip(slope, 0.0, 0.05)), error
 
 
 def _check(count, regions, max_side, view_angle, vertical, readout, learn, grid_dt, max_gap):
@@ -259,7 +305,7 @@ def _check(count, regions, max_side, view_angle, vertical, readout, learn, grid_
         )
     if vertical not in ("swing", "picture"):
         raise ParameterError(f"`vertical` must be 'swing' or 'picture', got {vertical!r}.")
-    if not (math.isfinite(readout) and 0 <= readout < 1):
+    if readout is not None and not (math.isfinite(readout) and 0 <= readout < 1):
         raise ParameterError(f"`readout` must be a time in [0, 1) s, got {readout!r}.")
     if not (math.isfinite(learn) and 1 <= learn <= 120):
         raise ParameterError(f"`learn` must be seconds in 1..120, got {learn!r}.")
