@@ -85,9 +85,13 @@ def main() -> None:
     if done.returncode:
         sys.exit(done.stderr)
     peak_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", done.stderr)[1])
+    cpu = sum(float(re.search(rf"{kind} time \(seconds\): ([\d.]+)", done.stderr)[1])
+              for kind in ("User", "System"))  # fmt: skip
     print(done.stdout.strip().splitlines()[0])
+    load = os.getloadavg()[0]
     print(f"wall {wall:.0f} s for {length:.0f} s of video: {length / wall:.2f}x real time; "
-          f"peak memory {peak_kb / 1024:.0f} MiB; {os.cpu_count()} cores")  # fmt: skip
+          f"CPU {cpu:.0f} s ({cpu / length:.2f} s per s of video); peak memory "
+          f"{peak_kb / 1024:.0f} MiB; {os.cpu_count()} cores, load average {load:.1f}")  # fmt: skip
 
 
 if __name__ == "__main__":
