@@ -31,6 +31,8 @@ from ..errors import MetrosyncError
 
 #: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
 MIN_SUPPORT = 0.25
+#: Fewest pictures, as a fraction, in which a pivot with few votes must be seen.
+FAINT_SUPPORT = 0.7
 #: Largest amplitude of a swing, as seen, rad.
 MAX_SWING = 1.0
 #: Weakest pivot kept, as a fraction of the strongest one's votes: where rods overlap in
@@ -157,6 +159,11 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
     regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    # A faint rod (dark on a dark body) gives short, scattered lines: few votes, but
+    # through its pivot in most pictures, which crossings of other rods never are.
+    faint = [p for p in peaks if 0.25 * floor <= acc[p[1], p[0]] < floor]
+    regions += [r for r in (_region(p, lines, f) for p in faint)
+                if r is not None and r.support >= FAINT_SUPPORT]  # fmt: skip
     if count is not None:  # the strongest `count`, if not much weaker than the best
         weaker = [p for p in peaks if 0.6 * floor <= acc[p[1], p[0]] < floor]
         more = [r for r in (_region(p, lines, f) for p in weaker) if r is not None]
