@@ -176,13 +176,18 @@ class Scene:
             bob_len = rod * rng.uniform(0.08, 0.14)
             bob_pos = rod * rng.uniform(0.35, 0.85)
             bob_pos = min(bob_pos, rod - 0.6 * bob_len)
-            z = rng.normal(0.0, 0.04)
+            depth = base * rng.uniform(0.7, 1.0)
+            z = rng.normal(0.0, 0.025)
             if previous is not None:
                 gap = 0.5 * (previous.base_width + base)
                 if rng.random() < overlap:
-                    # Closer than their widths: one of the two stands in front.
-                    x += gap * rng.uniform(0.55, 0.85)
-                    z = previous.z + rng.choice([-1.0, 1.0]) * rng.uniform(0.12, 0.25)
+                    # Closer than their widths: one stands behind the other (their bodies
+                    # must not meet), on the side that keeps the row near Z = 0.
+                    x += gap * rng.uniform(0.65, 0.95)
+                    if previous.z <= 0.0:
+                        z = previous.z + previous.body_depth + rng.uniform(0.005, 0.04)
+                    else:
+                        z = previous.z - depth - rng.uniform(0.005, 0.04)
                 else:
                     x += gap * rng.uniform(1.15, 1.9)
             metronome = Metronome(
@@ -191,7 +196,7 @@ class Scene:
                 body_height=height,
                 base_width=base,
                 top_width=base * rng.uniform(0.3, 0.55),
-                body_depth=base * rng.uniform(0.7, 1.0),
+                body_depth=depth,
                 pivot_height=height * rng.uniform(0.1, 0.2),
                 rod_length=rod,
                 rod_width=rod * rng.uniform(0.012, 0.03),

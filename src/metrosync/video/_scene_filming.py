@@ -16,7 +16,7 @@ import av
 import numpy as np
 
 from ..errors import ParameterError
-from ..show.sound import PITCH_RANGE, click_waveform
+from ..observables.entrainment import upward_crossings
 from ._scene import Scene
 from ._scene_render import (
     MIN_SWEEP,
@@ -30,6 +30,7 @@ from ._scene_render import (
     rod_coverage,
     rod_points,
 )
+from ._scene_sound import Sound
 
 #: Tick of the presentation timestamps in each container: MP4 and MOV take a phone's
 #: 1/90000 s, Matroska counts milliseconds, and AVI counts frame periods.
@@ -39,8 +40,6 @@ RGB_TO_YUV = np.array(
     np.float32,
 )
 YUV_OFFSET = np.array([16.0, 128.0, 128.0], np.float32)
-#: Audio samples per encoded audio frame.
-AUDIO_FRAME = 1024
 
 
 def to_yuv(rgb) -> np.ndarray:
@@ -83,7 +82,7 @@ def aim(scene: Scene, camera, sweeps: np.ndarray) -> Pinhole:
 class Filming:
     """One run filmed by one camera: schedule, static layers, per-frame rendering."""
 
-    def __init__(self, scene: Scene, camera, times: np.ndarray, theta: np.ndarray, rng, fmt: str):
+    def __init__(self, scene: Scene, camera, times, theta, rng, fmt: str, *, pictures: bool = True):
         self.scene, self.camera, self.format = scene, camera, fmt
         self.rate = Fraction(camera.fps).limit_denominator(1001)
         self.time_base = TIME_BASES.get(fmt, 1 / self.rate)
@@ -93,7 +92,9 @@ class Filming:
         self.row_delay = camera.readout / camera.height
         self.exposure = camera.exposure
         self._schedule()
-        self._static()
+        self._layout()
+        if pictures:
+            self._static()
 
     # -- time ---------------------------------------------------------------------------
     def _schedule(self) -> None:
@@ -106,8 +107,9 @@ class Filming:
         count = int(math.floor((last - lead) / period)) + 1
         if count < 1:
             raise ParameterError(
-                f"The trajectory ({self.times[-1]:.3g} s) is too short for one frame at "
-                f"{cam.frame_rate:g} fps: pass a longer run."
+                f"`times` spans {self.times[-1]:.3g} s, too short for one frame at "
+                f"{cam.frame_rate:g} fps with its exposure and readout "
+                f"({lead + tail:.3g} s): pass a longer run."
             )
         nominal = lead + period * np.arange(count)
         jitter = np.clip(rng.normal(0.0, cam.vfr_jitter_s, count), -jitter_cap, jitter_cap)
@@ -123,15 +125,9 @@ class Filming:
         self.frame_times = self.pts * float(self.time_base)
 
     # -- static layers ------------------------------------------------------------------
-    def _static(self) -> None:
+    def _layout(self) -> None:
+        """Each metronome's swept box, what nearer bodies hide of it, sizes and colours."""
         cam, pin = self.camera, self.pinhole
-        rgb = background(self.scene, pin)
-        yuv = to_yuv(rgb)
-        del rgb
-        self.Y = np.ascontiguousarray(yuv[..., 0])
-        self.U = half(yuv[..., 1])
-        self.V = half(yuv[..., 2])
-        del yuv
         order = sorted(
             range(self.scene.n), key=lambda i: -pin.depth(self.scene.metronomes[i].pivot)
         )
@@ -166,14 +162,23 @@ class Filming:
                     vis *= 1.0 - cov
             self.vis[i] = vis
             self.colours[i] = (to_yuv(m.rod_colour), to_yuv(m.bob_colour))
+
+    def _static(self) -> None:
+        cam = self.camera
+        rgb = background(self.scene, self.pinhole)
+        yuv = to_yuv(rgb)
+        del rgb
+        self.Y = np.ascontiguousarray(yuv[..., 0])
+        self.U = half(yuv[..., 1])
+        self.V = half(yuv[..., 2])
+        del yuv
         h, w = cam.height, cam.width
         self.noise_pad = 16
         if cam.noise > 0:
             shape = (2, h + self.noise_pad, w + self.noise_pad)
             self.noise_y = self.rng.normal(0.0, cam.noise, shape).astype(np.float32)
-            shape = (2, h // 2 + self.noise_pad, w // 2 + self.noise_pad)
-            self.noise_c = self.rng.normal(0.0, 0.6 * cam.noise, shape).astype(np.float32)
         self.flicker_phase = float(self.rng.uniform(0, 2 * np.pi))
+        self.drift = (self.rng.uniform(2.0, 15.0, 3), self.rng.uniform(0, 2 * np.pi, 3))
         self.buffer = np.empty((h * 3 // 2, w), np.uint8)
         self.work = (self.Y.copy(), self.U.copy(), self.V.copy())
         self.no_flicker = np.ones(h, np.float32)
@@ -233,19 +238,25 @@ class Filming:
     def _light(self, t: float) -> np.ndarray:
         """(H,) float32: each row's light, 1 on average, averaged over its exposure."""
         cam = self.camera
+        level = 1.0
+        if cam.light_drift > 0:
+            periods, phases = self.drift
+            level += cam.light_drift * float(np.mean(np.sin(2 * np.pi * t / periods + phases)))
         if not (cam.flicker_hz > 0 and cam.flicker_depth > 0):
-            return self.no_flicker
+            return self.no_flicker if level == 1.0 else np.full(cam.height, level, np.float32)
         rows = t + self.row_delay * np.arange(cam.height)
         smear = np.sinc(cam.flicker_hz * self.exposure)
         gain = 1.0 + 0.5 * cam.flicker_depth * smear * np.cos(
             2 * np.pi * cam.flicker_hz * rows + self.flicker_phase
         )
-        return gain.astype(np.float32)
+        return (level * gain).astype(np.float32)
 
     def _noise(self, chroma: int) -> tuple[np.ndarray, int, int]:
-        if self.camera.noise <= 0:
+        # Luma only: a phone's processing removes nearly all chroma noise, which would
+        # otherwise cost the encoder most of its bits.
+        if self.camera.noise <= 0 or chroma:
             return self.no_noise, 0, 0
-        bank = self.noise_c if chroma else self.noise_y
+        bank = self.noise_y
         pad = self.noise_pad
         b, dy, dx = self.rng.integers(len(bank)), self.rng.integers(pad), self.rng.integers(pad)
         return bank[b], int(dy), int(dx)
@@ -276,7 +287,7 @@ class Filming:
             stream.options = {"preset": cam.preset}
             if cam.rotation:
                 stream.set_display_rotation(cam.rotation)
-            sound = _Sound(container, audio, self) if audio is not None else None
+            sound = Sound(container, audio, self.ticks(), self.rng) if audio is not None else None
             for t, pts in zip(self.frame_times, self.pts, strict=True):
                 frame = av.VideoFrame.from_ndarray(self.render(float(t)), format="yuv420p")
                 frame.pts = int(pts)
@@ -290,16 +301,33 @@ class Filming:
 
     # -- truth --------------------------------------------------------------------------
     def ticks(self) -> list[np.ndarray]:
-        from .camera import _all_crossings
+        return [all_crossings(self.times, self.theta[:, i]) for i in range(self.scene.n)]
 
-        return [_all_crossings(self.times, self.theta[:, i]) for i in range(self.scene.n)]
+    def visible(self) -> np.ndarray:
+        """(N,) fraction of each rod, over its whole swing, that nearer bodies leave seen."""
+        out = np.ones(self.scene.n)
+        for i, m in enumerate(self.scene.metronomes):
+            if self.boxes[i] is None:
+                out[i] = 0.0
+                continue
+            x0, y0, x1, y1 = self.boxes[i]
+            angles = np.linspace(-1.0, 1.0, 9)[:, None] * min(self.sweeps[i], 0.5)
+            tips = self.pinhole.project(rod_points(m, angles)[0])
+            pivot = self.pinhole.project(m.pivot)
+            along = np.linspace(0.05, 1.0, 24)[None, :, None]
+            xy = pivot + along * (tips - pivot)
+            col = np.clip(np.round(xy[..., 0]).astype(int) - x0, 0, x1 - x0 - 1)
+            row = np.clip(np.round(xy[..., 1]).astype(int) - y0, 0, y1 - y0 - 1)
+            inside = (xy[..., 0] >= 0) & (xy[..., 0] < self.camera.width)
+            inside &= (xy[..., 1] >= 0) & (xy[..., 1] < self.camera.height)
+            out[i] = float(np.mean(self.vis[i][row, col] * inside))
+        return out
 
     def _filmed(self, times: np.ndarray) -> np.ndarray:
         return times[(times >= 0.0) & (times <= self.frame_times[-1])]
 
-    def truth(self, path: Path, audio):
-        from .camera import FilmTruth, upward_crossings
-
+    def truth(self, path: Path, audio) -> dict:
+        """The fields of `FilmTruth`."""
         cam, pin = self.camera, self.pinhole
         rest = [rod_points(m, 0.0) for m in self.scene.metronomes]
         pivot = pin.project(np.array([m.pivot for m in self.scene.metronomes]))
@@ -311,7 +339,7 @@ class Filming:
         width, height = (
             (cam.height, cam.width) if cam.rotation in (90, 270) else (cam.width, cam.height)
         )
-        return FilmTruth(
+        return dict(
             path=path, n=self.scene.n, width=width, height=height, fps=float(cam.fps),
             frame_times=self.frame_times.copy(), theta=theta, row_delay_s=self.row_delay,
             exposure_s=self.exposure, dropped=self.dropped,
@@ -321,8 +349,15 @@ class Filming:
             ticks=[self._filmed(t) for t in self.ticks()], start_s=self.origin,
             audio=audio is not None,
             audio_delay_s=0.0 if audio is None else float(audio.delay_s), rotation=cam.rotation,
-            scene=self.scene, camera=cam, pinhole=pin,
+            visible=self.visible(), scene=self.scene, camera=cam, pinhole=pin,
         )  # fmt: skip
+
+
+def all_crossings(times: np.ndarray, theta: np.ndarray) -> np.ndarray:
+    """Times (K,) where θ (T,) passes 0 either way, linear between samples ``times``."""
+    sign = theta >= 0
+    k = np.flatnonzero(sign[:-1] != sign[1:])
+    return times[k] + (times[k + 1] - times[k]) * theta[k] / (theta[k] - theta[k + 1])
 
 
 def displayed(xy: np.ndarray, cam) -> np.ndarray:
@@ -337,61 +372,3 @@ def displayed(xy: np.ndarray, cam) -> np.ndarray:
     elif cam.rotation == 270:
         x, y = h - 1 - y, x
     return np.column_stack([x, y])
-
-
-class _Sound:
-    """The sound track, rendered and encoded block by block as the picture advances."""
-
-    def __init__(self, container, mic, filming: Filming):
-        self.mic, self.rate = mic, mic.sample_rate
-        self.stream = container.add_stream(mic.codec, rate=self.rate, layout="mono")
-        self.container = container
-        self.rng = filming.rng
-        n = filming.scene.n
-        pitches = np.linspace(*PITCH_RANGE, n) if n > 1 else [PITCH_RANGE[0]]
-        self.waves = [0.9 / n * click_waveform(p, self.rate) for p in pitches]
-        onsets, owners = [], []
-        for i, ticks in enumerate(filming.ticks()):
-            onsets.append(np.round((ticks + mic.delay_s) * self.rate).astype(np.int64))
-            owners.append(np.full(ticks.size, i))
-        onsets, owners = np.concatenate(onsets), np.concatenate(owners)
-        order = np.argsort(onsets, kind="stable")
-        self.onsets, self.owners = onsets[order], owners[order]
-        self.longest = max(w.size for w in self.waves)
-        self.done = 0
-        self.s16 = mic.codec == "pcm_s16le"
-
-    def until(self, t: float) -> None:
-        end = int(math.floor(t * self.rate))
-        while self.done + AUDIO_FRAME <= end:
-            self._frame()
-
-    def _frame(self) -> None:
-        s0, n = self.done, AUDIO_FRAME
-        block = (
-            self.rng.normal(0.0, self.mic.noise, n).astype(np.float32)
-            if self.mic.noise
-            else (np.zeros(n, np.float32))
-        )
-        lo = np.searchsorted(self.onsets, s0 - self.longest, side="left")
-        hi = np.searchsorted(self.onsets, s0 + n, side="left")
-        for onset, owner in zip(self.onsets[lo:hi], self.owners[lo:hi], strict=True):
-            wave = self.waves[owner]
-            a, b = max(s0, onset), min(s0 + n, onset + wave.size)
-            if b > a:
-                block[a - s0 : b - s0] += wave[a - onset : b - onset]
-        np.clip(block, -1.0, 1.0, out=block)
-        if self.s16:
-            frame = av.AudioFrame.from_ndarray(
-                (block * 32767).astype(np.int16)[None, :], format="s16", layout="mono"
-            )
-        else:
-            frame = av.AudioFrame.from_ndarray(block[None, :], format="fltp", layout="mono")
-        frame.sample_rate = self.rate
-        frame.pts = s0
-        frame.time_base = Fraction(1, self.rate)
-        self.container.mux(self.stream.encode(frame))
-        self.done += n
-
-    def close(self) -> None:
-        self.container.mux(self.stream.encode(None))
