@@ -116,3 +116,18 @@ def test_the_rolling_shutter_is_estimated_from_the_rods(at_60, at_30):
     for truth, ds in (at_60, at_30):
         readout = truth.row_delay_s * truth.height
         assert ds.attrs["readout"] == pytest.approx(readout, rel=0.3)
+
+
+def test_a_phone_held_upright_is_turned_and_its_shutter_dated(tmp_path):
+    # portrait: the picture is stored on its side, so the shutter's rows run across it
+    t, theta = run(12.0, 2, 5)
+    camera = Camera(fps=60, width=640, height=360, rotation=90, drop_fraction=0.02,
+                    vfr_jitter_s=0.001)  # fmt: skip
+    truth = film(tmp_path / "portrait.mp4", t, theta, camera=camera, seed=5,
+                 scene=Scene.random(2, seed=5, overlap=0.0))  # fmt: skip
+    ds = track(truth.path, sound=False)
+    assert ds.attrs["video_size"] == "360x640"
+    found = errors(truth, ds)
+    assert sorted(i for i, _, _ in found) == [0, 1]
+    for _, err, missed in found:
+        assert missed <= 1 and np.sqrt(np.mean(err**2)) < 2e-3
