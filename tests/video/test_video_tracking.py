@@ -133,3 +133,25 @@ def test_options_are_checked_with_their_names():
         track("x.mp4", vertical="up")
     with pytest.raises(ValueError, match="`regions`"):
         track("x.mp4", regions=[])
+
+
+@pytest.mark.parametrize("lag, z", [(0.0, 1.0), (np.pi, -1.0)])
+def test_z_of_two_metronomes_in_and_out_of_phase(tmp_path, lag, z):
+    path = tmp_path / "two.mp4"
+    times = np.arange(0, 10, 1 / 30)
+    theta = synth_video.angles_sine(times, [1.5, 1.5], 0.4, [0.3, 0.3 + lag])
+    pictures = (synth_video.draw(th, [(110, 150), (210, 150)], size=(320, 180), length=60)
+                for th in theta)  # fmt: skip
+    synth_video.write_video(path, times, pictures)
+    ds = track(path)
+    assert ds.attrs["z"] == pytest.approx(z, abs=0.1)
+    assert ds.attrs["r_eq"] == pytest.approx(1.0 if lag == 0 else 0.0, abs=0.02)
+
+
+def test_a_box_given_by_hand_finds_the_pivot_inside(three_rods):
+    path, _, _, pivots = three_rods
+    x, y = pivots[1]
+    ds = track(path, regions=[(x - 60, y - 90, x + 60, y + 10)])
+    assert ds.sizes["metronome"] == 1
+    assert float(ds.pivot_x[0]) == pytest.approx(x, abs=3)
+    assert float(ds.pivot_y[0]) == pytest.approx(y, abs=3)

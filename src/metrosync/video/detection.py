@@ -229,14 +229,21 @@ def _region(pivot, lines, frames: int) -> Region | None:
 
 
 def _drop_duplicates(regions: list[Region]) -> list[Region]:
-    """Two peaks on one rod (its pivot and a point along it): keep the better supported."""
+    """A peak inside another's swept sector is a point on that rod (where its pieces'
+    lines meet, at the bob): keep the better supported of the two."""
     kept: list[Region] = []
     for r in sorted(regions, key=lambda r: -r.support):
-        if all(np.hypot(r.pivot[0] - k.pivot[0], r.pivot[1] - k.pivot[1]) > 0.5 * k.r_inner
-               or abs(r.centre - k.centre) > k.half_width + r.half_width
-               for k in kept):  # fmt: skip
+        if not any(_inside(r.pivot, k) for k in kept):
             kept.append(r)
     return kept
+
+
+def _inside(point: tuple[float, float], region: Region) -> bool:
+    dx, dy = point[0] - region.pivot[0], point[1] - region.pivot[1]
+    radius = np.hypot(dx, dy)
+    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre)))
+    return bool(radius <= 1.1 * region.r_outer and (
+        radius < 4.0 or abs(off) <= region.half_width + 0.15))  # fmt: skip
 
 
 def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
