@@ -156,7 +156,11 @@ def track(
     if readout is None:
         readout, error = estimate_readout(video, gauges, bg.shape, times, seen_from_up,
                                           quality, skew)  # fmt: skip
-        source = f"estimated from the rods' skew, ± {error * 1e3:.1f} ms"
+        source = (
+            f"estimated from the rods' skew, ± {error * 1e3:.1f} ms"
+            if math.isfinite(error)
+            else "not measurable from the rods (too few frames); taken as 0"
+        )
     shift = np.array([readout * video.stored_row(*gauge.point, bg.shape) for gauge in gauges])
     ds = tracking_dataset(video, found, times, angle, quality, confidence, upright, shift,
                     first=first, scale=scale,
