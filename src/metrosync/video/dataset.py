@@ -59,7 +59,7 @@ def tracking_dataset(
             raise AnalysisError(
                 f"{video.path}: metronome {j} (pivot at {x:.0f}, {y:.0f} px) passes the "
                 f"vertical {kept.size} time(s), too few for a phase: film longer, check that "
-                f"its rod is in view and swings, or give the others' pivots (`regions`)."
+                f"its rod is in view and swings, or give the others' pivots with `regions`."
             )
         spans.append((float(kept[0]), float(kept[-1])))
     grid = ph.common_grid(spans, grid_dt)

@@ -152,7 +152,7 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
         raise DetectionError(
             f"nothing swings in the first {f} frames: no rod moves against the background. "
             f"Check that the metronomes are running and in view, and that the camera stands "
-            f"still; or give the pivots by hand (`regions`)."
+            f"still; or give the pivots by hand with `regions`."
         )
     acc = vote(lines, (h, w))
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
@@ -170,14 +170,14 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
         regions = (regions + [r for r in more if r.support >= 2 * MIN_SUPPORT])[:count]
     if count is not None and len(regions) < count:
         raise DetectionError(
-            f"found {len(regions)} swinging metronomes, not the {count} asked for (`count`). "
+            f"found {len(regions)} swinging metronomes, not the {count} asked for by `count`. "
             f"Check that every rod swings in view in the first seconds, or give the pivots "
-            f"by hand (`regions`)."
+            f"by hand with `regions`."
         )
     if not regions:
         raise DetectionError(
             "things move in the picture but no rod swings about a fixed pivot. Check that "
-            "the camera stands still, or give the pivots by hand (`regions`)."
+            "the camera stands still, or give the pivots by hand with `regions`."
         )
     regions = _drop_duplicates(regions)
     return sorted(regions, key=lambda r: (r.pivot[0], r.pivot[1]))
