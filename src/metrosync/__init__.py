@@ -4,12 +4,13 @@ A model, integrators, observables and analysis tools for the system of Boda, Né
 Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
-`analyze_audio` (a sound recording of metronomes), `sweep` (parameter grids),
-`reproduce` (the paper's studies), `animate`, `write_wav`, `write_page`, `plot_run`
-(seeing and hearing a run), `write_playground` (the model live in a browser), and
-`reduced_theory`, `simulate_reduced` (the phase-model reduction, `metrosync.theory`).
-Each is imported on first use, so that ``import metrosync`` is quick and loads no
-numerical library: the command line sets up its Ctrl-C handling before those load.
+`analyze_audio` (a sound recording of metronomes), `track` (a video of them),
+`sweep` (parameter grids), `reproduce` (the paper's studies), `animate`, `write_wav`,
+`write_page`, `plot_run` (seeing and hearing a run), `write_playground` (the model
+live in a browser), and `reduced_theory`, `simulate_reduced` (the phase-model
+reduction, `metrosync.theory`). Each is imported on first use, so that
+``import metrosync`` is quick and loads no numerical library: the command line sets
+up its Ctrl-C handling before those load.
 """
 
 import importlib
@@ -49,6 +50,7 @@ _LAZY = {
     "sweep": "sweeps",
     "reproduce": "paper",
     "analyze_audio": "audio",
+    "track": "video",
     "reduced_theory": "theory",
     "simulate_reduced": "theory",
 }

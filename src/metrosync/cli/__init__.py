@@ -30,7 +30,7 @@ from ..errors import MetrosyncError
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = (
     "simulate", "presets", "reproduce", "analyze", "calibrate", "sweep",
-    "critical", "theory", "animate", "listen", "page", "playground", "record",
+    "critical", "theory", "animate", "listen", "page", "playground", "record", "track",
 )  # fmt: skip
 
 

@@ -113,3 +113,120 @@ def kept_from_half_periods(
     kept = times[keep]
     cycles = np.diff(half_period[keep]) // 2
     return kept, cycles
+
+
+# Passes from a sampled angle (video): the angle θ(t) of each frame, sampled at
+# irregular times, gives the passes through the vertical at sub-sample precision.
+
+
+def zero_crossings(
+    time: np.ndarray, angle: np.ndarray, *, upward: bool = True, hysteresis: float = 0.0
+) -> np.ndarray:
+    """Times where ``angle`` crosses 0 upward (− to +) or downward, at sub-sample precision.
+
+    time : (T,) increasing sample times, s (irregular spacing allowed).
+    angle : (T,) angle, rad; NaN where unknown (no crossing is placed across a NaN).
+    hysteresis : a crossing counts only once the angle has been below −hysteresis
+        (above, for downward) since the last one, so that noise near 0 gives one pass.
+    Returns (K,) crossing times. Each is the root of a cubic fitted by least squares
+    to the (up to) six samples around the sign change, or of the line through the two
+    samples when fewer than four are finite.
+    """
+    t = np.asarray(time, dtype=float)
+    a = np.asarray(angle, dtype=float)
+    if not upward:
+        a = -a
+    if t.size < 2:
+        return np.empty(0)
+    ok = np.isfinite(a)
+    cand = np.flatnonzero(ok[:-1] & ok[1:] & (a[:-1] < 0) & (a[1:] >= 0))
+    if hysteresis > 0 and cand.size:
+        below = np.flatnonzero(ok & (a < -hysteresis))
+        keep, armed_after = [], -1
+        for i in cand:
+            # armed if some sample since the previous kept crossing went below -h
+            j = np.searchsorted(below, armed_after + 1)
+            if j < below.size and below[j] <= i:
+                keep.append(i)
+                armed_after = i
+        cand = np.array(keep, dtype=int)
+    out = np.empty(cand.size)
+    for n, i in enumerate(cand):
+        out[n] = _root_near(t, a, ok, int(i))
+    return out
+
+
+def _root_near(t: np.ndarray, a: np.ndarray, ok: np.ndarray, i: int) -> float:
+    """Root in [t[i], t[i+1]] of a cubic through the finite samples i−2 .. i+3."""
+    lo, hi = max(0, i - 2), min(t.size, i + 4)
+    idx = np.arange(lo, hi)
+    idx = idx[ok[idx]]
+    t0, dt = t[i], t[i + 1] - t[i]
+    linear = t0 + dt * (-a[i]) / (a[i + 1] - a[i])
+    if idx.size < 4:
+        return float(linear)
+    x = (t[idx] - t0) / dt
+    coef = np.polyfit(x, a[idx], 3)
+    roots = np.roots(coef)
+    real = roots[np.abs(roots.imag) < 1e-9].real
+    real = real[(real >= -0.25) & (real <= 1.25)]
+    if real.size == 0:
+        return float(linear)
+    best = real[np.argmin(np.abs(real - (linear - t0) / dt))]
+    return float(t0 + dt * best)
+
+
+def passes_on_period_grid(crossings: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(kept, cycles) from one direction's crossings, as the light gate keeps passes.
+
+    crossings : (K,) times of one direction's passes, increasing. Intervals are counted
+    in whole periods of their median interval, so that a stretch where the metronome
+    was lost (k periods missing) counts k + 1 periods. Returns kept (K,) and cycles
+    (K − 1,) ≥ 1.
+    """
+    kept = np.asarray(crossings, dtype=float)
+    if kept.size < 2:
+        return kept, np.empty(0, dtype=int)
+    gaps = np.diff(kept)
+    period = float(np.median(gaps))
+    cycles = np.maximum(1, np.rint(gaps / period)).astype(int)
+    return kept, cycles
+
+
+def swing_amplitudes(time: np.ndarray, angle: np.ndarray, kept: np.ndarray) -> np.ndarray:
+    """(K − 1,) half the peak-to-peak angle between consecutive kept passes, rad.
+
+    time, angle : (T,) the sampled angle (NaN ignored); kept : (K,) pass times.
+    NaN for a period with fewer than 3 finite samples.
+    """
+    t = np.asarray(time, dtype=float)
+    a = np.asarray(angle, dtype=float)
+    edges = np.searchsorted(t, kept)
+    out = np.full(max(kept.size - 1, 0), np.nan)
+    for n in range(out.size):
+        seg = a[edges[n] : edges[n + 1]]
+        seg = seg[np.isfinite(seg)]
+        if seg.size >= 3:
+            out[n] = 0.5 * (seg.max() - seg.min())
+    return out
+
+
+def beat_asymmetry(up: np.ndarray, down: np.ndarray) -> float:
+    """Tick/tock asymmetry: mean (t_down − t_up − (t_up' − t_down)) / (t_up' − t_up), %.
+
+    up, down : (K,), (M,) upward and downward pass times. Each period between
+    consecutive upward passes that holds exactly one downward pass counts; the result
+    is how much longer the half-swing after an upward pass is than the one before the
+    next, as a percentage of the period (0 for a symmetric beat); NaN if none counts.
+    """
+    up = np.asarray(up, dtype=float)
+    down = np.asarray(down, dtype=float)
+    if up.size < 2 or down.size == 0:
+        return float("nan")
+    j = np.searchsorted(down, up[:-1])
+    k = np.searchsorted(down, up[1:])
+    one = (k - j) == 1
+    if not np.any(one):
+        return float("nan")
+    u0, u1, d = up[:-1][one], up[1:][one], down[j[one]]
+    return float(100.0 * np.mean(((d - u0) - (u1 - d)) / (u1 - u0)))

@@ -1,0 +1,283 @@
+"""Finding the metronomes in a video: where the picture moves, and about which pivot.
+
+Contract: `find_metronomes(pictures, count=None)` takes grey pictures (F, H, W) from the
+first seconds of a video and returns one `Region` per metronome, sorted left to right:
+its pivot (pixels), the directions its rod sweeps (from the pivot) and the radii its
+rod covers. No marker is needed; only that the rods swing and the camera stands still.
+
+The method:
+
+1. the background is the per-pixel median of the pictures, after each picture's
+   brightness is scaled to the median's (lighting flicker);
+2. in each picture, what differs from the background by more than the noise is a
+   moving part; each connected piece of it that is long and thin is a rod, and
+   gives a line (its principal axis);
+3. every line votes along its length into an accumulator: the lines of one rod, at
+   different moments, all pass through its pivot, so pivots are the accumulator's
+   peaks, while lines of different rods cross at scattered points;
+4. the lines near each pivot give the swept sector and the radii.
+
+`regions_given` builds the regions for pivots or boxes given by hand (``--regions``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ..errors import MetrosyncError
+
+#: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
+MIN_SUPPORT = 0.25
+#: Fewest pictures, as a fraction, in which a pivot with few votes must be seen.
+FAINT_SUPPORT = 0.7
+#: Largest amplitude of a swing, as seen, rad.
+MAX_SWING = 1.0
+#: Weakest pivot kept, as a fraction of the strongest one's votes: where rods overlap in
+#: the picture, their lines cross at points between the pivots too, with fewer votes.
+MIN_PEAK = 0.4
+
+
+class DetectionError(MetrosyncError, ValueError):
+    """No metronome, or not the number asked for, could be found in the picture."""
+
+
+@dataclass(frozen=True)
+class Region:
+    """Where one metronome is in the picture.
+
+    pivot : (x, y) of the rod's pivot, pixels (x right, y down).
+    centre : direction of the middle of the swing from the pivot, rad, measured from
+        the picture's upward direction, positive clockwise (to the right).
+    half_width : half the swept angle, rad (the swing's amplitude seen in the picture).
+    r_inner, r_outer : radii from the pivot that the rod covers, pixels.
+    support : fraction of the pictures in which this rod was seen.
+    """
+
+    pivot: tuple[float, float]
+    centre: float
+    half_width: float
+    r_inner: float
+    r_outer: float
+    support: float
+
+
+def background(pictures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(median picture (H, W), per-picture brightness gain (F,)) of pictures (F, H, W).
+
+    The median is taken over at most 61 pictures spread over the stretch: enough for a
+    rod, which passes any point in a small part of the time, to vanish from it."""
+    pictures = np.asarray(pictures)
+    every = max(1, int(np.ceil(len(pictures) / 61)))
+    bg = np.median(pictures[::every], axis=0).astype(np.float32)
+    level = float(bg[::4, ::4].mean()) + 1e-6
+    gain = level / (pictures[:, ::4, ::4].mean(axis=(1, 2)) + 1e-6)
+    return bg, gain.astype(np.float32)
+
+
+def rod_lines(pictures: np.ndarray, bg: np.ndarray, gain: np.ndarray) -> list[np.ndarray]:
+    """Per picture, the lines of the long thin moving pieces: (L, 5) arrays of
+    centroid x, y, direction ux, uy (unit), and half-length (pixels)."""
+    diff = np.abs(pictures * gain[:, None, None] - bg[None])
+    sample = diff[:: max(1, len(diff) // 16)]
+    level = np.median(sample)
+    noise = 1.4826 * np.median(np.abs(sample - level))
+    threshold = max(6.0 * noise + level, 12.0)
+    min_pixels = max(12, int(2e-4 * bg.size))
+    return [_lines(frame > threshold, min_pixels) for frame in diff]
+
+
+def _lines(mask: np.ndarray, min_pixels: int) -> np.ndarray:
+    """(L, 5) principal axes of the connected pieces of ``mask`` that are long and thin."""
+    labels, count = ndimage.label(mask)
+    if count == 0:
+        return np.empty((0, 5))
+    ys, xs = np.nonzero(labels)
+    lab = labels[ys, xs]
+    xs, ys = xs.astype(float), ys.astype(float)
+    n = np.bincount(lab, minlength=count + 1)[1:]
+    big = n >= min_pixels
+    if not big.any():
+        return np.empty((0, 5))
+
+    def total(w):
+        return np.bincount(lab, weights=w, minlength=count + 1)[1:][big]
+
+    n = n[big].astype(float)
+    cx, cy = total(xs) / n, total(ys) / n
+    sxx = total(xs * xs) / n - cx**2
+    syy = total(ys * ys) / n - cy**2
+    sxy = total(xs * ys) / n - cx * cy
+    # eigenvalues and the major axis of each piece's 2x2 covariance
+    half_trace, det = 0.5 * (sxx + syy), sxx * syy - sxy**2
+    root = np.sqrt(np.maximum(half_trace**2 - det, 0.0))
+    major, minor = half_trace + root, half_trace - root
+    angle = 0.5 * np.arctan2(2 * sxy, sxx - syy)
+    thin = (major > 0) & (minor <= 0.2 * major)
+    return np.stack([cx, cy, np.cos(angle), np.sin(angle), 2.0 * np.sqrt(np.maximum(major, 0))],
+                    axis=1)[thin]  # fmt: skip
+
+
+def vote(lines: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
+    """Accumulator (H, W): each line adds 1 along its length, extended to twice it each
+    way (the pivot lies beyond the moving piece's end)."""
+    h, w = shape
+    acc = np.zeros(shape)
+    for frame_lines in lines:
+        seen = np.zeros(shape, dtype=bool)
+        for cx, cy, ux, uy, half in frame_lines:
+            s = np.arange(-2.0 * half, 2.0 * half, 0.7)
+            x = np.rint(cx + s * ux).astype(int)
+            y = np.rint(cy + s * uy).astype(int)
+            inside = (x >= 0) & (x < w) & (y >= 0) & (y < h)
+            seen[y[inside], x[inside]] = True
+        acc += seen
+    return ndimage.gaussian_filter(acc, 1.5)
+
+
+def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[Region]:
+    """The metronomes in pictures (F, H, W) of the first seconds; see the module docstring.
+
+    count : the number of metronomes; default: every pivot that enough lines cross.
+    Raises `DetectionError` when nothing moves, or fewer than ``count`` are found.
+    """
+    pictures = np.asarray(pictures, dtype=np.float32)
+    f, h, w = pictures.shape
+    bg, gain = background(pictures)
+    lines = rod_lines(pictures, bg, gain)
+    moving = sum(len(x) > 0 for x in lines)
+    if moving < max(3, 0.2 * f):
+        raise DetectionError(
+            f"nothing swings in the first {f} frames: no rod moves against the background. "
+            f"Check that the metronomes are running and in view, and that the camera stands "
+            f"still; or give the pivots by hand with `regions`."
+        )
+    acc = vote(lines, (h, w))
+    peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
+    floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
+    chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
+    regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    # A faint rod (dark on a dark body) gives short, scattered lines: few votes, but
+    # through its pivot in most pictures, which crossings of other rods never are.
+    faint = [p for p in peaks if 0.25 * floor <= acc[p[1], p[0]] < floor]
+    regions += [r for r in (_region(p, lines, f) for p in faint)
+                if r is not None and r.support >= FAINT_SUPPORT]  # fmt: skip
+    if count is not None:  # the strongest `count`, if not much weaker than the best
+        weaker = [p for p in peaks if 0.6 * floor <= acc[p[1], p[0]] < floor]
+        more = [r for r in (_region(p, lines, f) for p in weaker) if r is not None]
+        regions = (regions + [r for r in more if r.support >= 2 * MIN_SUPPORT])[:count]
+    if count is not None and len(regions) < count:
+        raise DetectionError(
+            f"found {len(regions)} swinging metronomes, not the {count} asked for by `count`. "
+            f"Check that every rod swings in view in the first seconds, or give the pivots "
+            f"by hand with `regions`."
+        )
+    if not regions:
+        raise DetectionError(
+            "things move in the picture but no rod swings about a fixed pivot. Check that "
+            "the camera stands still, or give the pivots by hand with `regions`."
+        )
+    regions = _drop_duplicates(regions)
+    return sorted(regions, key=lambda r: (r.pivot[0], r.pivot[1]))
+
+
+def _peaks(acc: np.ndarray, min_distance: int) -> list[tuple[int, int]]:
+    """Local maxima (x, y) of ``acc``, strongest first."""
+    top = ndimage.maximum_filter(acc, size=2 * min_distance + 1)
+    ys, xs = np.nonzero((acc == top) & (acc > 0))
+    order = np.argsort(-acc[ys, xs])
+    return [(int(xs[i]), int(ys[i])) for i in order]
+
+
+def _region(pivot, lines, frames: int) -> Region | None:
+    """The sector swept by the lines that pass near ``pivot`` (the rod's lines)."""
+    px, py = pivot
+    angles, near, far = [], [], []
+    for frame_lines in lines:
+        best = None
+        for cx, cy, ux, uy, half in frame_lines:
+            dx, dy = cx - px, cy - py
+            dist = abs(dx * uy - dy * ux)  # distance of the pivot from the line
+            along = np.hypot(dx, dy)
+            # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
+            if dist < max(3.0, 0.08 * along) and along > 0.8 * half:
+                if best is None or dist < best[0]:
+                    best = (dist, dx, dy, along, half)
+        if best is not None:
+            _, dx, dy, along, half = best
+            angles.append(np.arctan2(dx, -dy))
+            near.append(max(along - half, 0.0))
+            far.append(along + half)
+    support = len(angles) / frames
+    if support < MIN_SUPPORT or len(angles) < 3:
+        return None
+    a = np.unwrap(np.array(angles))
+    lo, hi = np.percentile(a, [2, 98])
+    if hi - lo > 2 * MAX_SWING:  # lines through the point from all sides: rods crossing
+        return None
+    centre = float(np.angle(np.exp(1j * 0.5 * (lo + hi))))
+    return Region(
+        pivot=(float(px), float(py)),
+        centre=centre,
+        half_width=float(max(0.5 * (hi - lo), 0.05)),
+        r_inner=float(np.percentile(near, 20)),
+        r_outer=float(np.percentile(far, 90)),
+        support=float(support),
+    )
+
+
+def _drop_duplicates(regions: list[Region]) -> list[Region]:
+    """A peak inside another's swept sector is a point on that rod (where its pieces'
+    lines meet, at the bob): keep the better supported of the two."""
+    kept: list[Region] = []
+    for r in sorted(regions, key=lambda r: -r.support):
+        if not any(_inside(r.pivot, k) for k in kept):
+            kept.append(r)
+    return kept
+
+
+def _inside(point: tuple[float, float], region: Region) -> bool:
+    dx, dy = point[0] - region.pivot[0], point[1] - region.pivot[1]
+    radius = np.hypot(dx, dy)
+    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre)))
+    return bool(radius <= 1.1 * region.r_outer and (
+        radius < 4.0 or abs(off) <= region.half_width + 0.15))  # fmt: skip
+
+
+def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
+    """Regions for metronomes given by hand, in the pictures' pixels: a pivot ``(x, y)``
+    gets the sector of the rod seen about it (upward ± 45° when none is seen); a box
+    ``(x0, y0, x1, y1)`` is searched for one metronome."""
+    pictures = np.asarray(pictures, dtype=np.float32)
+    f, h, w = pictures.shape
+    bg, gain = background(pictures)
+    lines = rod_lines(pictures, bg, gain)
+    out = []
+    for given in regions:
+        if len(given) == 4:
+            x0, y0 = int(max(0, given[0])), int(max(0, given[1]))
+            x1, y1 = int(min(w, np.ceil(given[2]))), int(min(h, np.ceil(given[3])))
+            if x1 - x0 < 8 or y1 - y0 < 8:
+                raise DetectionError(
+                    f"the box {given} is smaller than 8 pixels or outside the picture "
+                    f"({w}x{h} as analysed); check the regions file."
+                )
+            try:
+                (found,) = find_metronomes(pictures[:, y0:y1, x0:x1], count=1)
+            except DetectionError:
+                raise DetectionError(
+                    f"no rod swings about a fixed pivot inside the box {given}; give its "
+                    f"pivot instead ('x y')."
+                ) from None
+            px, py = found.pivot
+            out.append(Region((px + x0, py + y0), found.centre, found.half_width,
+                              found.r_inner, found.r_outer, found.support))  # fmt: skip
+            continue
+        x, y = given
+        region = _region((x, y), lines, f)
+        if region is None:
+            region = Region((float(x), float(y)), 0.0, np.pi / 4, 3.0, 0.2 * max(h, w), 0.0)
+        out.append(region)
+    return out
