@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._words import plural
 from . import trains as tr
 from .voices import MIN_SEPARATION, Voices, cluster_voices, impact_features
 
@@ -172,5 +173,5 @@ def tick_length_words(sep: Separation) -> str:
     ticks = int(sep.head.sum())
     per = sep.head.size / max(ticks, 1)
     if per < 1.05:
-        return f"{ticks} ticks, one impact each"
-    return f"grouped into {ticks} ticks ({per:.1f} impacts each, a tick counted once)"
+        return f"{plural(ticks, 'tick')}, one impact each"
+    return f"grouped into {plural(ticks, 'tick')} ({per:.1f} impacts each, a tick counted once)"

@@ -27,8 +27,8 @@ def summary_text(ds) -> str:
         f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",
         f"  impacts heard: {a['impacts']}, {a['tick_structure']}"
         + (
-            f"; {a['ticks_recovered']} ticks hidden by others found again where their "
-            f"metronome's beat put them"
+            f"; {plural(int(a['ticks_recovered']), 'tick')} hidden by others found again "
+            f"where their metronome's beat put them"
             if a.get("ticks_recovered")
             else ""
         ),

@@ -24,8 +24,8 @@ def register(subparsers) -> None:
     out = parser.add_argument_group("animation")
     out.add_argument("--out", type=Path, default=Path("metrosync.gif"), help="FILE.gif or FILE.mp4")
     out.add_argument("--fps", type=float, default=None,
-                     help="frames per second (default 15; at most 50 for a GIF; "
-                     "with --phone: 60)")  # fmt: skip
+                     help="frames per second: 15 unless given, at most 50 for a GIF; "
+                     "60 with --phone")  # fmt: skip
     out.add_argument(
         "--speedup",
         type=float,

@@ -95,5 +95,7 @@ def run(args) -> int:
         )
         return 1
     if summary.ended == "interrupted":
-        raise Interrupted(f"the capture {args.out} is kept, complete ({summary.lines} lines)")
+        raise Interrupted(
+            f"the capture {args.out} is kept, complete ({plural(summary.lines, 'line')})"
+        )
     return 0

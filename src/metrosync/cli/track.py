@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from .._words import plural
 from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import HelpFormatter, add_aliases
 
@@ -162,8 +163,9 @@ def summary(ds) -> str:
     amplitude and frames lost; r_eq, σ, z; what was lost; the sound's verdict."""
     a = ds.attrs
     lines = [
-        f"metrosync track: {a['frames']} frames, {a['measured_fps']:.2f} fps measured "
-        f"({a['nominal_fps']:.4g} nominal), {ds.sizes['metronome']} metronome(s), "
+        f"metrosync track: {plural(int(a['frames']), 'frame')}, "
+        f"{a['measured_fps']:.2f} fps measured ({a['nominal_fps']:.4g} nominal), "
+        f"{plural(ds.sizes['metronome'], 'metronome')}, "
         f"common span {float(ds.time[0]):.1f} .. {float(ds.time[-1]):.1f} s",
         "  metronome  pivot (x, y px)  ticks/min  jitter (ms)  asymmetry (%)  "
         "amplitude (deg)  frames lost",

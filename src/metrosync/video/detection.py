@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .._words import plural
 from ..errors import MetrosyncError
 
 #: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
@@ -150,9 +151,9 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     moving = sum(len(x) > 0 for x in lines)
     if moving < max(3, 0.2 * f):
         raise DetectionError(
-            f"nothing swings in the first {f} frames: no rod moves against the background. "
-            f"Check that the metronomes are running and in view, and that the camera stands "
-            f"still; or give the pivots by hand with `regions`."
+            f"nothing swings in the first {plural(f, 'frame')}: no rod moves against the "
+            f"background. Check that the metronomes are running and in view, and that the "
+            f"camera stands still; or give the pivots by hand with `regions`."
         )
     acc = vote(lines, (h, w))
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..errors import MetrosyncError
 
 #: Default longest side of the pictures analysed, pixels.
@@ -130,8 +131,8 @@ class Video:
                     yield t, picture
             except av.error.FFmpegError as error:
                 self.loss = (
-                    f"decoding stopped at {max(last, 0.0):.2f} s after {self.decoded} frames "
-                    f"({error.strerror or error}); the rest of the file is lost"
+                    f"decoding stopped at {max(last, 0.0):.2f} s after "
+                    f"{plural(self.decoded, 'frame')} ({error.strerror or error}); the rest of the file is lost"
                 )
             if stop is None and not self.loss and np.isfinite(self.duration):
                 expected = self.duration - 2.0 / max(self.nominal_fps, 1.0)
@@ -141,7 +142,7 @@ class Video:
                         f"it was cut short, and {self.duration - last:.1f} s are lost"
                     )
         if dropped_times:
-            note = f"{dropped_times} frames without a new timestamp skipped"
+            note = f"{plural(dropped_times, 'frame')} without a new timestamp skipped"
             self.loss = f"{self.loss}; {note}" if self.loss else note
 
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..errors import MetrosyncError
 
 #: Largest spread of a tick about the median offset for it to agree with a pass, s.
@@ -53,7 +54,7 @@ class SoundCheck:
     def sentence(self) -> str:
         verdict = "agree" if self.agree else "DISAGREE"
         return (
-            f"{self.tick_time.size} ticks heard; picture and sound {verdict}: "
+            f"{plural(self.tick_time.size, 'tick')} heard; picture and sound {verdict}: "
             f"{self.agreeing * 100:.0f}% of the ticks fall within {TOLERANCE * 1e3:.0f} ms "
             f"of a pass, {self.passes_heard * 100:.0f}% of the passes are heard; the ticks "
             f"come {self.latency * 1e3:+.1f} ms after the passes (sound latency and "

@@ -47,6 +47,7 @@ import numpy as np
 import xarray as xr
 
 from .. import interrupts
+from .._words import plural
 from ..errors import ParameterError
 from ..observables import crossings as ph
 from . import detection
@@ -212,7 +213,7 @@ def _estimate(video, learned: int, seconds: float, learn: float) -> str:
     w, h = video.upright_size
     length = f"{video.duration:.1f} s" if math.isfinite(video.duration) else "unknown length"
     frames = video.frames_estimate
-    line = (f"{video.path.name}: {w}x{h} {video.codec}, {length}, about {frames} frames "
+    line = (f"{video.path.name}: {w}x{h} {video.codec}, {length}, about {plural(frames, 'frame')} "
             f"at {video.nominal_fps:.4g} fps nominal")  # fmt: skip
     decoded = min(learn, video.duration if math.isfinite(video.duration) else learn)
     if frames and learned and seconds > 0 and decoded > 0:
