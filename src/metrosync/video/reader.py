@@ -132,7 +132,8 @@ class Video:
             except av.error.FFmpegError as error:
                 self.loss = (
                     f"decoding stopped at {max(last, 0.0):.2f} s after "
-                    f"{plural(self.decoded, 'frame')} ({error.strerror or error}); the rest of the file is lost"
+                    f"{plural(self.decoded, 'frame')} ({error.strerror or error}); "
+                    f"the rest of the file is lost"
                 )
             if stop is None and not self.loss and np.isfinite(self.duration):
                 expected = self.duration - 2.0 / max(self.nominal_fps, 1.0)
