@@ -6,6 +6,7 @@ with the same one line and status 130 as one during the work, never a traceback.
 From `metrosync.cli.main` on, `metrosync.interrupts` takes over.
 """
 
+import signal
 import sys
 
 
@@ -17,7 +18,16 @@ def main(argv: list[str] | None = None) -> int:
         command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
         print(f"metrosync {command}: interrupted: nothing was written", file=sys.stderr)
         return 130
-    return run(argv)
+    try:
+        code = run(argv)
+    except KeyboardInterrupt:  # in the instant after `run` restored Python's handler
+        command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
+        print(f"metrosync {command}: interrupted: its work had ended", file=sys.stderr)
+        return 130
+    # The work is over and its outputs are whole: a Ctrl-C while the interpreter shuts
+    # down would only turn a finished command into one killed by SIGINT.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return code
 
 
 if __name__ == "__main__":

@@ -228,6 +228,8 @@ def test_an_interrupted_sweep_prints_nothing_after_its_one_line(tmp_path):
                 "metrosync sweep: interrupted: nothing was written",  # before the merge
                 f"metrosync sweep: interrupted: 101 of 101 points kept in "
                 f"{out.with_suffix('.points')}; run the same command again to resume",
+                # after the merge wrote the result, before the command ended
+                f"metrosync sweep: interrupted: kept {out} (complete); the rest was not written",
             )
         else:  # the signal came after the work: it finished whole
             assert child.returncode == 0 and out.is_file(), err
