@@ -118,7 +118,7 @@ from corpus_trains import (
 from scipy import signal
 
 from metrosync.errors import ParameterError
-from metrosync.show.ticks import Voice
+from metrosync.show.ticks import Voice, check_sample_rate
 
 __all__ = [
     "BOUNCE_VARIANTS", "COMPRESSOR_BLOCK", "MAX_MICROPHONES", "MAX_TRAINS", "OUTPUT_PEAK",
@@ -258,14 +258,7 @@ def make_recording(
         raise ParameterError(
             f"`trains` must be 1 to {MAX_TRAINS} TickTrain, got {len(trains)} items."
         )
-    if (
-        isinstance(sample_rate, bool)
-        or not isinstance(sample_rate, int | np.integer)
-        or not (8000 <= sample_rate <= 192000)
-    ):
-        raise ParameterError(
-            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
-        )
+    check_sample_rate(sample_rate)
     if not isinstance(impairments, Impairments):
         raise ParameterError(
             f"`impairments` must be an Impairments (e.g. Impairments.phone()), got {impairments!r}."

@@ -280,19 +280,16 @@ def _overlap_peak(wave: np.ndarray, spacing: float) -> float:
         return float(tail[0])
     step = max(int(spacing), 1)
     return float(tail[::step].sum())
+
+
 def check_sound(speedup: float, sample_rate: int) -> None:
     """Refuse a ``speedup`` or ``sample_rate`` no click track can have (made before
     simulating, too)."""
     if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
         raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
-    if (
-        isinstance(sample_rate, bool)
-        or not isinstance(sample_rate, int | np.integer)
-        or not (8000 <= sample_rate <= 192000)
-    ):
-        raise ParameterError(
-            f"`sample_rate` must be an integer in [8000, 192000] Hz, got {sample_rate!r}."
-        )
+    from .ticks import check_sample_rate
+
+    check_sample_rate(sample_rate)
 
 
 def _milliseconds(seconds: float) -> str:

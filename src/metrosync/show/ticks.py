@@ -205,7 +205,7 @@ class Voice:
 
     def impact(self, sample_rate: int, *, tock: bool = False) -> np.ndarray:
         """(L,) one impact (no secondary ones), peak 1, L = ring · sample_rate."""
-        _check_rate(sample_rate)
+        check_sample_rate(sample_rate)
         t = np.arange(int(round(self.ring * sample_rate))) / sample_rate
         shift = self.tock_shift if tock else 1.0
         slowest = self.ring / math.log(1000.0)  # amplitude time constant for −60 dB
@@ -260,7 +260,8 @@ def voices(n: int, seed: int = 0) -> list[Voice]:
     return out
 
 
-def _check_rate(sample_rate) -> None:
+def check_sample_rate(sample_rate) -> None:
+    """Refuse a ``sample_rate`` no sound of ours is made at: an integer in [8000, 192000] Hz."""
     if (
         isinstance(sample_rate, bool)
         or not isinstance(sample_rate, int | np.integer)
