@@ -175,13 +175,7 @@ def analyze_logs(
     ambiguous = np.array([[c.direction_ambiguous for c in chans] for chans in per_log])
     levels = np.array([log.interrupted_level[chosen] for log in logs], dtype=np.int8)
     mean_freq = freq.mean(axis=0)
-    span = grid[-1] - grid[0]
-    window = span / 4 if equilibrium_window is None else float(equilibrium_window)
-    if not (0 < window <= span):
-        raise ParameterError(
-            f"`equilibrium_window` must be in (0, {span:g}] s (the span of the r(t) grid), "
-            f"got {equilibrium_window!r}."
-        )
+    window = ph.equilibrium_window(grid, equilibrium_window)
     r_eq = float(equilibrium_order(r, grid, window))
     sigma = ph.frequency_spread(mean_freq)
     reports = "\n".join(

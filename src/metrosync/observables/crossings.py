@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import AnalysisError
+from ..errors import AnalysisError, ParameterError
 
 TWO_PI = 2.0 * np.pi
 
@@ -230,3 +230,16 @@ def beat_asymmetry(up: np.ndarray, down: np.ndarray) -> float:
         return float("nan")
     u0, u1, d = up[:-1][one], up[1:][one], down[j[one]]
     return float(100.0 * np.mean(((d - u0) - (u1 - d)) / (u1 - u0)))
+
+
+def equilibrium_window(grid: np.ndarray, equilibrium_window: float | None) -> float:
+    """The final window r_eq averages over, s: the last quarter of ``grid`` (T,) unless
+    given; a `ParameterError` when it does not fit in the grid's span."""
+    span = float(grid[-1] - grid[0])
+    window = span / 4 if equilibrium_window is None else float(equilibrium_window)
+    if not (0 < window <= span):
+        raise ParameterError(
+            f"`equilibrium_window` must be in (0, {span:g}] s (the span of the r(t) grid), "
+            f"got {equilibrium_window!r}."
+        )
+    return window

@@ -69,13 +69,7 @@ def tracking_dataset(
             f"video is too short, or a metronome was lost; film longer."
         )
     r = ph.order_on_grid(passes, grid)
-    span = grid[-1] - grid[0]
-    window = span / 4 if equilibrium_window is None else float(equilibrium_window)
-    if not (0 < window <= span):
-        raise ParameterError(
-            f"`equilibrium_window` must be in (0, {span:g}] s (the span of the r(t) grid), "
-            f"got {equilibrium_window!r}."
-        )
+    window = ph.equilibrium_window(grid, equilibrium_window)
     freq = np.array([ph.mean_frequency_bpm(k, c) for k, c in passes])
     jitter = np.array([ph.period_jitter(k, c) for k, c in passes])
     bridged = np.array([int(np.sum(c - 1)) for _, c in passes])
