@@ -3,17 +3,24 @@
 Contract: `recover(recording, scan, ticks, trains)` takes the ticks (`detection.Ticks`,
 sorted) and the metronomes' trains over them (`trains.Train`), and returns (ticks,
 trains, found): the ticks with those it recovered added, the trains with each
-recovered tick in its beat, and how many were recovered.
+recovered tick in its beat, and how many ticks were added.
+
+First, a tick that lies off its train's beat (`trains.off_the_beat`: a later impact
+of a tick whose first impact another tick hid) leaves the train: its beat counts as
+missed. For each beat a train missed, its time is predicted from the nearest heard
+beats of the same kind (tick or tock), up to `REACH` beats before and after:
+interpolated when both were heard (exact for an uneven beat and a steady drift), a
+whole number of swings on when one was. A tick already heard that no train holds
+(the tracker lost the train there and took it up again further on) and that lies
+within `TOLERANCE` of one prediction, and of no other, joins that train.
 
 A tick that falls a few milliseconds after another metronome's, or on its ringing,
 barely raises the detection curve: the detector's threshold, set for the whole
-recording, misses it. Its metronome's beat says where it is. For each beat a train
-missed, its time is predicted from the ticks a full swing before and after (their
-mean when both were heard: exact for an uneven beat and a steady drift); the
-detection curve's highest point within `WINDOW` of it, if it rises at least
-`MIN_RISE` dB, is timed on the waveform like any tick (`detection.refine`), and kept
-when its onset lies within `TOLERANCE` of the prediction and no tick is within the
-detector's resolution (`detection.RESOLUTION`) of it.
+recording, misses it. For the beats still missed, the detection curve's highest
+point within `WINDOW` of the prediction, if it rises at least `MIN_RISE` dB, is
+timed on the waveform like any tick (`detection.refine`), and kept when its onset
+lies within `TOLERANCE` of the prediction and no tick is within the detector's
+resolution (`detection.RESOLUTION`) of it.
 """
 
 from __future__ import annotations
@@ -21,34 +28,91 @@ from __future__ import annotations
 import numpy as np
 
 from . import detection as det
-from .trains import Train
+from .trains import Train, off_the_beat
 
 WINDOW = 3e-3
 MIN_RISE = 1.0
 TOLERANCE = 1.5e-3
+#: Farthest heard beat of the same kind a missed beat is predicted from.
+REACH = 8
 
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
-    """(beats missed, their predicted times) of one train."""
+    """(beats missed, their predicted times) of one train: from the nearest heard beats
+    of the same kind (tick or tock) before and after, at most `REACH` beats away,
+    interpolated (exact for an uneven beat and a steady drift); from one side only, a
+    whole number of swings on."""
     beat = train.beat
     t = times[train.index]
-    at = dict(zip(beat.tolist(), t.tolist(), strict=True))
     missing = np.setdiff1d(np.arange(beat[0], beat[-1] + 1), beat)
     swing = 2 * train.period
     out_n, out_t = [], []
-    for n in missing.tolist():
-        before, after = at.get(n - 2), at.get(n + 2)
-        if before is not None and after is not None:
-            p = 0.5 * (before + after)
-        elif before is not None:
-            p = before + swing
-        elif after is not None:
-            p = after - swing
-        else:
+    for parity in (0, 1):
+        mine = beat % 2 == parity
+        b, tb = beat[mine], t[mine]
+        want = missing[missing % 2 == parity]
+        if b.size == 0 or want.size == 0:
             continue
-        out_n.append(n)
-        out_t.append(p)
-    return np.array(out_n, dtype=np.int64), np.array(out_t)
+        j = np.searchsorted(b, want)
+        lo, hi = np.maximum(j - 1, 0), np.minimum(j, b.size - 1)
+        has_lo = (j > 0) & (want - b[lo] <= REACH)
+        has_hi = (j < b.size) & (b[hi] - want <= REACH)
+        both = has_lo & has_hi
+        p = np.full(want.size, np.nan)
+        span = np.where(both, b[hi] - b[lo], 1)
+        p[both] = (tb[lo] + (tb[hi] - tb[lo]) * (want - b[lo]) / span)[both]
+        only_lo = has_lo & ~has_hi
+        p[only_lo] = (tb[lo] + (want - b[lo]) / 2 * swing)[only_lo]
+        only_hi = has_hi & ~has_lo
+        p[only_hi] = (tb[hi] - (b[hi] - want) / 2 * swing)[only_hi]
+        ok = np.isfinite(p)
+        out_n.append(want[ok])
+        out_t.append(p[ok])
+    if not out_n:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    n, p = np.concatenate(out_n), np.concatenate(out_t)
+    order = np.argsort(n)
+    return n[order].astype(np.int64), p[order]
+
+
+def _on_beat(times: np.ndarray, train: Train) -> Train:
+    """The train without its ticks that lie off its beat (`trains.off_the_beat`): a
+    later impact taken for a tick whose first another tick hid is not the tick; its
+    beat is sought again as missed."""
+    off = off_the_beat(times[train.index], train.beat)
+    if not off.any() or (~off).sum() < 2:
+        return train
+    beat = train.beat[~off]
+    return Train(train.index[~off], beat - beat[0], train.period, train.masked[~off])
+
+
+def _take_unheld(times: np.ndarray, trains: list[Train], owner, beat, pred):
+    """(trains with the ticks no train holds that lie within `TOLERANCE` of one of their
+    predicted beats added, mask of the predictions so met): a tick the tracker lost
+    where its metronome's beat was followed again from elsewhere."""
+    held = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        held[t.index] = True
+    free = np.flatnonzero(~held)
+    met = np.zeros(pred.size, dtype=bool)
+    if free.size == 0 or pred.size == 0:
+        return trains, met
+    j = np.clip(np.searchsorted(times[free], pred), 1, max(free.size - 1, 1))
+    left, right = free[j - 1], free[np.minimum(j, free.size - 1)]
+    nearest = np.where(np.abs(times[left] - pred) <= np.abs(times[right] - pred), left, right)
+    close = np.abs(times[nearest] - pred) <= TOLERANCE
+    # a tick two beats want is neither's
+    wanted, counts = np.unique(nearest[close], return_counts=True)
+    close &= np.isin(nearest, wanted[counts == 1])
+    out = []
+    for m, train in enumerate(trains):
+        mine = close & (owner == m)
+        index = np.concatenate([train.index, nearest[mine]])
+        number = np.concatenate([train.beat, beat[mine]])
+        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
+        k = np.argsort(number, kind="stable")
+        out.append(Train(index[k], number[k], train.period, masked[k]))
+    return out, close
 
 
 def recover(recording, scan, ticks, trains: list[Train]):
@@ -56,6 +120,7 @@ def recover(recording, scan, ticks, trains: list[Train]):
     rate = recording.sample_rate
     hop_s = scan.hop / rate
     reach = max(1, round(WINDOW / hop_s))
+    trains = [_on_beat(ticks.time, t) for t in trains]
     owners, beats, predicted = [], [], []
     for m, train in enumerate(trains):
         n, p = _predictions(ticks.time, train)
@@ -65,6 +130,8 @@ def recover(recording, scan, ticks, trains: list[Train]):
     if not trains:
         return ticks, trains, 0
     owner, beat, pred = (np.concatenate(x) for x in (owners, beats, predicted))
+    trains, met = _take_unheld(ticks.time, trains, owner, beat, pred)
+    owner, beat, pred = owner[~met], beat[~met], pred[~met]
     if pred.size == 0:
         return ticks, trains, 0
     centre = np.round(pred / hop_s).astype(np.int64)

@@ -1,0 +1,93 @@
+"""Missed beats of a train: predicted from its own beat, filled from ticks no train
+holds, and a later impact taken for a tick let go."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from metrosync.audio import recovery as rc
+from metrosync.audio.trains import Train
+
+
+def limping(beats: int, period=0.4, limp=0.02, drift=-1e-5, start=1.0) -> np.ndarray:
+    """Tick times of an uneven beat (tocks ``limp`` of a period late) that speeds up."""
+    n = np.arange(beats)
+    return start + n * period + drift * n**2 + limp * period * (n % 2)
+
+
+def train_of(times: np.ndarray, keep: np.ndarray) -> Train:
+    index = np.flatnonzero(keep)
+    return Train(index, index.copy(), float(np.diff(times).mean()), np.zeros(index.size, bool))
+
+
+def test_a_run_of_missed_beats_is_predicted_on_the_limping_beat():
+    t = limping(40)
+    keep = np.ones(t.size, dtype=bool)
+    keep[[3, 17, 18, 19, 20, 21]] = False  # one beat, then five in a row
+    beats, predicted = rc._predictions(t, train_of(t, keep))
+    assert beats.tolist() == [3, 17, 18, 19, 20, 21]
+    # the drift's curvature over a few swings is far below a millisecond
+    assert np.abs(predicted - t[beats]).max() < 2e-4
+
+
+def test_a_beat_beyond_reach_is_not_predicted():
+    t = limping(60)
+    keep = np.ones(t.size, dtype=bool)
+    keep[20:40] = False
+    beats, _ = rc._predictions(t, train_of(t, keep))
+    far = (beats - 19 > rc.REACH) & (40 - beats > rc.REACH)
+    assert not far.any() and beats.size > 0
+
+
+def test_a_tick_no_train_holds_joins_the_train_whose_beat_it_falls_on():
+    t = limping(30)
+    other = 0.5 + 0.33 * np.arange(35)  # another metronome, also not held at its beat
+    times = np.concatenate([t, other])
+    order = np.argsort(times)
+    times = times[order]
+    mine = np.isin(order, np.arange(t.size))
+    held = mine.copy()
+    lost = np.flatnonzero(mine)[[10, 11, 12]]
+    held[lost] = False
+    index = np.flatnonzero(held)
+    beat = np.flatnonzero(np.isin(np.flatnonzero(mine), index))
+    train = Train(index, beat, 0.4, np.zeros(index.size, bool))
+    n, p = rc._predictions(times, train)
+    owner = np.zeros(n.size, dtype=np.int64)
+    (joined,), met = rc._take_unheld(times, [train], owner, n, p)
+    assert met.all()
+    assert sorted(joined.index.tolist()) == np.flatnonzero(mine).tolist()
+    assert joined.beat.tolist() == list(range(t.size))
+    # a tick of the other metronome is never taken
+    assert not np.isin(joined.index, np.flatnonzero(~mine)).any()
+
+
+def test_a_tick_two_predictions_want_is_neither_trains():
+    times = limping(30)
+    keep = np.ones(times.size, dtype=bool)
+    keep[10] = False
+    a = train_of(times, keep)
+    n, p = rc._predictions(times, a)
+    owner = np.array([0, 1])
+    out, met = rc._take_unheld(times, [a, a], owner, np.repeat(n, 2), np.repeat(p, 2))
+    assert not met.any()
+    assert all(t.index.size == a.index.size for t in out)
+
+
+@pytest.mark.parametrize("late", [0.025, 0.033])
+def test_a_later_impact_taken_for_a_tick_leaves_the_train(late):
+    t = limping(40)
+    t[15] += late  # its first impact was hidden: the next impact of the tick stood in
+    train = train_of(t, np.ones(t.size, dtype=bool))
+    kept = rc._on_beat(t, train)
+    assert 15 not in kept.index and kept.index.size == t.size - 1
+    beats, predicted = rc._predictions(t, kept)
+    assert beats.tolist() == [15]
+    assert abs(predicted[0] - limping(40)[15]) < 2e-4
+
+
+def test_a_train_on_its_beat_is_kept_whole():
+    t = limping(40) + np.random.default_rng(3).normal(0, 0.5e-3, 40)
+    train = train_of(t, np.ones(t.size, dtype=bool))
+    assert rc._on_beat(t, train) is train
