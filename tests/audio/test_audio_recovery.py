@@ -91,3 +91,52 @@ def test_a_train_on_its_beat_is_kept_whole():
     t = limping(40) + np.random.default_rng(3).normal(0, 0.5e-3, 40)
     train = train_of(t, np.ones(t.size, dtype=bool))
     assert rc._on_beat(t, train) is train
+
+
+def test_beats_heard_on_one_side_only_are_predicted_with_the_local_swing():
+    t = limping(100, drift=-5e-6)  # speeding up: the mean beat is off by 0.3 ms a beat
+    keep = np.ones(t.size, dtype=bool)
+    keep[20:70] = False
+    beats, predicted = rc._predictions(t, train_of(t, keep))
+    one_side = beats < 70 - rc.REACH - 1
+    assert one_side.sum() == rc.REACH
+    n = beats[one_side]
+    err = np.abs(predicted[one_side] - t[n])
+    last = np.where(n % 2 == 0, 18, 19)  # the last heard beat of each kind
+    by_mean = np.abs(t[last] + (n - last) * np.diff(t).mean() - t[n])
+    assert err.max() < 1.5e-3
+    assert np.all(err[-4:] < 0.7 * by_mean[-4:])
+
+
+def _two(times_a, times_b):
+    times = np.concatenate([times_a, times_b])
+    order = np.argsort(times, kind="stable")
+    where = np.empty(order.size, dtype=np.int64)
+    where[order] = np.arange(order.size)
+    a = where[: times_a.size]
+    b = where[times_a.size :]
+    trains = [Train(a, np.arange(a.size), 0.4, np.zeros(a.size, bool)),
+              Train(b, np.arange(b.size), 0.45, np.zeros(b.size, bool))]  # fmt: skip
+    label = np.empty(times.size, dtype=np.int8)
+    label[a], label[b] = 0, 1
+    return times[order], trains, label, a
+
+
+def test_a_tick_nearer_another_metronomes_beat_is_neithers():
+    a = limping(40)
+    b = 0.73 + 0.45 * np.arange(36)
+    a[20] = b[np.argmin(np.abs(b - a[20]))] + 0.2e-3  # heard at the other's onset
+    true_20 = limping(40)[20]
+    assert abs(a[20] - true_20) > 1e-3
+    times, trains, label, ia = _two(a, b)
+    out = rc.nearer_another(times, trains, label)
+    assert out[ia[20]] == -1
+    assert (out == label).sum() == label.size - 1
+
+
+def test_a_tick_on_its_own_beat_keeps_its_metronome_beside_another():
+    a = limping(40)
+    b = a[20] + 3e-3 + 0.45 * (np.arange(36) - 17)  # the other ticks 3 ms after a[20]
+    times, trains, label, _ = _two(a, b)
+    out = rc.nearer_another(times, trains, label)
+    assert np.array_equal(out, label)

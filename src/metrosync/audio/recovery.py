@@ -9,8 +9,8 @@ First, a tick that lies off its train's beat (`trains.off_the_beat`: a later imp
 of a tick whose first impact another tick hid) leaves the train: its beat counts as
 missed. For each beat a train missed, its time is predicted from the nearest heard
 beats of the same kind (tick or tock), up to `REACH` beats before and after:
-interpolated when both were heard (exact for an uneven beat and a steady drift), a
-whole number of swings on when one was. A tick already heard that no train holds
+interpolated when both were heard (exact for an uneven beat and a steady drift), on
+the local beat when one side was. A tick already heard that no train holds
 (the tracker lost the train there and took it up again further on) and that lies
 within `TOLERANCE` of one prediction, and of no other, joins that train.
 
@@ -20,7 +20,14 @@ recording, misses it. For the beats still missed, the detection curve's highest
 point within `WINDOW` of the prediction, if it rises at least `MIN_RISE` dB, is
 timed on the waveform like any tick (`detection.refine`), and kept when its onset
 lies within `TOLERANCE` of the prediction and no tick is within the detector's
-resolution (`detection.RESOLUTION`) of it.
+resolution (`detection.RESOLUTION`) of it. Up to `PASSES` passes: each predicts
+from the ticks the last one added, so that a long run of missed beats is filled from
+both ends inwards.
+
+`nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
+tick lies nearer another train's beat than its own train's beat puts it, within the
+detector's resolution: two metronomes ticked together there and its onset may be
+either's.
 """
 
 from __future__ import annotations
@@ -34,14 +41,17 @@ WINDOW = 3e-3
 MIN_RISE = 1.0
 TOLERANCE = 1.5e-3
 #: Farthest heard beat of the same kind a missed beat is predicted from.
-REACH = 8
+REACH = 16
+#: Passes of `recover`: each predicts from the ticks the last one added.
+PASSES = 3
 
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
     """(beats missed, their predicted times) of one train: from the nearest heard beats
     of the same kind (tick or tock) before and after, at most `REACH` beats away,
-    interpolated (exact for an uneven beat and a steady drift); from one side only, a
-    whole number of swings on."""
+    interpolated (exact for an uneven beat and a steady drift); from one side only, on
+    the beat of the two nearest heard beats of the kind there (within 5 % of the
+    train's mean beat, else the mean)."""
     beat = train.beat
     t = times[train.index]
     missing = np.setdiff1d(np.arange(beat[0], beat[-1] + 1), beat)
@@ -61,10 +71,18 @@ def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarra
         p = np.full(want.size, np.nan)
         span = np.where(both, b[hi] - b[lo], 1)
         p[both] = (tb[lo] + (tb[hi] - tb[lo]) * (want - b[lo]) / span)[both]
+        # from one side: the swing of the two nearest heard beats of the kind there
+        # (a metronome that speeds up), or the train's mean
+        before = np.maximum(lo - 1, 0)
+        after = np.minimum(hi + 1, b.size - 1)
+        beat_lo = (tb[lo] - tb[before]) / np.maximum(b[lo] - b[before], 1)
+        beat_hi = (tb[after] - tb[hi]) / np.maximum(b[after] - b[hi], 1)
+        step_lo = _near_mean(np.where(lo > before, beat_lo, 0.0), 0.5 * swing)
+        step_hi = _near_mean(np.where(after > hi, beat_hi, 0.0), 0.5 * swing)
         only_lo = has_lo & ~has_hi
-        p[only_lo] = (tb[lo] + (want - b[lo]) / 2 * swing)[only_lo]
+        p[only_lo] = (tb[lo] + (want - b[lo]) * step_lo)[only_lo]
         only_hi = has_hi & ~has_lo
-        p[only_hi] = (tb[hi] - (b[hi] - want) / 2 * swing)[only_hi]
+        p[only_hi] = (tb[hi] - (b[hi] - want) * step_hi)[only_hi]
         ok = np.isfinite(p)
         out_n.append(want[ok])
         out_t.append(p[ok])
@@ -73,6 +91,11 @@ def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarra
     n, p = np.concatenate(out_n), np.concatenate(out_t)
     order = np.argsort(n)
     return n[order].astype(np.int64), p[order]
+
+
+def _near_mean(beat: np.ndarray, mean: float) -> np.ndarray:
+    """A local beat (s) where it is within 5 % of the train's mean beat, else the mean."""
+    return np.where(np.abs(beat / mean - 1) < 0.05, beat, mean)
 
 
 def _on_beat(times: np.ndarray, train: Train) -> Train:
@@ -117,10 +140,21 @@ def _take_unheld(times: np.ndarray, trains: list[Train], owner, beat, pred):
 
 def recover(recording, scan, ticks, trains: list[Train]):
     """(ticks, trains, recovered): see the module docstring."""
+    trains = [_on_beat(ticks.time, t) for t in trains]
+    recovered = 0
+    for _ in range(PASSES):
+        ticks, trains, added, taken = _pass(recording, scan, ticks, trains)
+        recovered += added
+        if added + taken == 0:
+            break
+    return ticks, trains, recovered
+
+
+def _pass(recording, scan, ticks, trains: list[Train]):
+    """(ticks, trains, ticks added, heard ticks taken) after one pass of `recover`."""
     rate = recording.sample_rate
     hop_s = scan.hop / rate
     reach = max(1, round(WINDOW / hop_s))
-    trains = [_on_beat(ticks.time, t) for t in trains]
     owners, beats, predicted = [], [], []
     for m, train in enumerate(trains):
         n, p = _predictions(ticks.time, train)
@@ -128,12 +162,13 @@ def recover(recording, scan, ticks, trains: list[Train]):
         beats.append(n)
         predicted.append(p)
     if not trains:
-        return ticks, trains, 0
+        return ticks, trains, 0, 0
     owner, beat, pred = (np.concatenate(x) for x in (owners, beats, predicted))
     trains, met = _take_unheld(ticks.time, trains, owner, beat, pred)
+    taken = int(met.sum())
     owner, beat, pred = owner[~met], beat[~met], pred[~met]
     if pred.size == 0:
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     centre = np.round(pred / hop_s).astype(np.int64)
     offsets = np.arange(-reach, reach + 1)
     cols = np.clip(centre[:, None] + offsets[None, :], 0, scan.curve.size - 1)
@@ -141,7 +176,7 @@ def recover(recording, scan, ticks, trains: list[Train]):
     ok = scan.curve[best] >= MIN_RISE
     owner, beat, pred, best = owner[ok], beat[ok], pred[ok], best[ok]
     if best.size == 0:
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     order = np.argsort(best, kind="stable")
     owner, beat, pred, best = owner[order], beat[order], pred[order], best[order]
     found = det.refine(recording, scan, best)
@@ -150,7 +185,7 @@ def recover(recording, scan, ticks, trains: list[Train]):
     gap = np.minimum(np.abs(ticks.time[j] - found.time), np.abs(ticks.time[j - 1] - found.time))
     near &= gap > det.RESOLUTION
     if not near.any():
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     fields = det.Ticks.__dataclass_fields__
     merged = {f: np.concatenate([getattr(ticks, f), getattr(found, f)[near]]) for f in fields}
     order = np.argsort(merged["time"], kind="stable")
@@ -167,4 +202,51 @@ def recover(recording, scan, ticks, trains: list[Train]):
         masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
         k = np.argsort(number, kind="stable")
         new_trains.append(Train(where[index[k]], number[k], train.period, masked[k]))
-    return new_ticks, new_trains, int(near.sum())
+    return new_ticks, new_trains, int(near.sum()), taken
+
+
+def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
+    """(M,) each tick's distance (s) from its beat as the train's neighbouring heard beats
+    of the same kind put it (the one before and the one after; at an end, the next
+    two); NaN where a kind has fewer than three ticks."""
+    out = np.full(train.index.size, np.nan)
+    t = times[train.index]
+    for parity in (0, 1):
+        sel = np.flatnonzero(train.beat % 2 == parity)
+        if sel.size < 3:
+            continue
+        b, tb = train.beat[sel].astype(float), t[sel]
+        pos = np.arange(sel.size)
+        lo, hi = pos - 1, pos + 1
+        lo[0], hi[0] = 1, 2
+        lo[-1], hi[-1] = sel.size - 3, sel.size - 2
+        slope = (tb[hi] - tb[lo]) / (b[hi] - b[lo])
+        out[sel] = tb - (tb[lo] + slope * (b - b[lo]))
+    return out
+
+
+def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) -> np.ndarray:
+    """(K,) ``label`` (the metronome of each tick, −1 for none) with −1 for each tick
+    that lies nearer another train's beat (a tick it heard, or one it missed, where
+    predicted) than its own train's beat puts it, within the detector's resolution: two
+    metronomes ticked together there and the tick's onset may be either's."""
+    out = label.copy()
+    beats = []
+    for train in trains:
+        _, predicted = _predictions(times, train)
+        beats.append(np.sort(np.concatenate([times[train.index], predicted])))
+    for m, train in enumerate(trains):
+        mine = train.index[label[train.index] == m]
+        if mine.size == 0 or len(trains) < 2:
+            continue
+        own = np.abs(_own_offset(times, train))[label[train.index] == m]
+        x = times[mine]
+        other = np.full(x.size, np.inf)
+        for j, grid in enumerate(beats):
+            if j == m or grid.size == 0:
+                continue
+            q = np.clip(np.searchsorted(grid, x), 1, max(grid.size - 1, 1))
+            d = np.minimum(np.abs(grid[q - 1] - x), np.abs(grid[np.minimum(q, grid.size - 1)] - x))
+            other = np.minimum(other, d)
+        out[mine[(other < own) & (other <= det.RESOLUTION)]] = -1
+    return out
