@@ -44,6 +44,10 @@ TOLERANCE = 1.5e-3
 REACH = 16
 #: Passes of `recover`: each predicts from the ticks the last one added.
 PASSES = 3
+#: How long after a tick its later impacts and ring can move another's onset, s.
+RING = 0.04
+#: A tick in another's ring this many robust spreads off its beat is unattributed.
+RING_OFF_BEAT = 1.5
 
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
@@ -228,25 +232,42 @@ def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
 def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) -> np.ndarray:
     """(K,) ``label`` (the metronome of each tick, −1 for none) with −1 for each tick
     that lies nearer another train's beat (a tick it heard, or one it missed, where
-    predicted) than its own train's beat puts it, within the detector's resolution: two
-    metronomes ticked together there and the tick's onset may be either's."""
+    predicted) than its own train's beat puts it, within the detector's resolution
+    (two metronomes ticked together there and the tick's onset may be either's); and
+    for each tick that falls within `RING` after another train's tick and lies off its
+    own beat by more than `RING_OFF_BEAT` of its train's robust spread (at least a
+    millisecond): its onset is timed by the other's later impacts and ring."""
     out = label.copy()
-    beats = []
+    if len(trains) < 2:
+        return out
+    beats, heard = [], []
     for train in trains:
         _, predicted = _predictions(times, train)
         beats.append(np.sort(np.concatenate([times[train.index], predicted])))
+        heard.append(np.sort(times[train.index]))
     for m, train in enumerate(trains):
-        mine = train.index[label[train.index] == m]
-        if mine.size == 0 or len(trains) < 2:
+        held = label[train.index] == m
+        mine = train.index[held]
+        if mine.size == 0:
             continue
-        own = np.abs(_own_offset(times, train))[label[train.index] == m]
+        offset = _own_offset(times, train)
+        own = np.abs(offset)[held]
         x = times[mine]
         other = np.full(x.size, np.inf)
-        for j, grid in enumerate(beats):
-            if j == m or grid.size == 0:
+        since = np.full(x.size, np.inf)
+        for j in range(len(trains)):
+            if j == m or beats[j].size == 0:
                 continue
+            grid = beats[j]
             q = np.clip(np.searchsorted(grid, x), 1, max(grid.size - 1, 1))
             d = np.minimum(np.abs(grid[q - 1] - x), np.abs(grid[np.minimum(q, grid.size - 1)] - x))
             other = np.minimum(other, d)
-        out[mine[(other < own) & (other <= det.RESOLUTION)]] = -1
+            q = np.searchsorted(heard[j], x)
+            before = x - heard[j][np.maximum(q - 1, 0)]
+            since = np.minimum(since, np.where((q > 0) & (before > 0), before, np.inf))
+        spread = 1.4826 * np.nanmedian(np.abs(offset - np.nanmedian(offset)))
+        limit = max(1e-3, RING_OFF_BEAT * spread) if np.isfinite(spread) else np.inf
+        drop = (other < own) & (other <= det.RESOLUTION)
+        drop |= (since <= RING) & (own > limit)
+        out[mine[drop]] = -1
     return out
