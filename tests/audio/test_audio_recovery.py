@@ -142,13 +142,17 @@ def test_a_tick_on_its_own_beat_keeps_its_metronome_beside_another():
     assert np.array_equal(out, label)
 
 
-@pytest.mark.parametrize(("after_other", "shift", "kept"),
-                         [(0.030, -2.5e-3, False),   # in the other's ring, off its beat
-                          (0.030, -0.3e-3, True),    # in the ring, on its beat
-                          (0.060, -2.5e-3, True)])   # off its beat, but clear of the ring
+RING_CASES = [
+    (0.030, -2.5e-3, False),  # in the other's ring, off its beat
+    (0.030, -0.3e-3, True),  # in the ring, on its beat
+    (0.060, -2.5e-3, True),  # off its beat, but clear of the ring
+]
+
+
+@pytest.mark.parametrize(("after_other", "shift", "kept"), RING_CASES)
 def test_a_tick_in_another_metronomes_ring_off_its_own_beat_is_unattributed(
     after_other, shift, kept
-):  # fmt: skip
+):
     a = limping(40) + np.random.default_rng(8).normal(0, 0.05e-3, 40)
     b = a[20] - after_other + 0.45 * (np.arange(36) - 17)
     a[20] += shift
