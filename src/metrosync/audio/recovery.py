@@ -52,13 +52,16 @@ RING_OFF_BEAT = 1.5
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
     """(beats missed, their predicted times) of one train: from the nearest heard beats
-    of the same kind (tick or tock) before and after, at most `REACH` beats away,
+    of the same kind (tick or tock) before and after (not a masked tick: the tick that
+    hid it timed it), at most `REACH` beats away,
     interpolated (exact for an uneven beat and a steady drift); from one side only, on
     the beat of the two nearest heard beats of the kind there (within 5 % of the
     train's mean beat, else the mean)."""
-    beat = train.beat
-    t = times[train.index]
-    missing = np.setdiff1d(np.arange(beat[0], beat[-1] + 1), beat)
+    heard = ~train.masked  # a masked tick is timed by the tick that hid it
+    beat, t = train.beat[heard], times[train.index[heard]]
+    if beat.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    missing = np.setdiff1d(np.arange(train.beat[0], train.beat[-1] + 1), train.beat)
     swing = 2 * train.period
     out_n, out_t = [], []
     for parity in (0, 1):
