@@ -8,8 +8,9 @@ recovered tick in its beat, and how many ticks were added.
 First, a tick that lies off its train's beat (`trains.off_the_beat`: a later impact
 of a tick whose first impact another tick hid) leaves the train: its beat counts as
 missed. For each beat a train missed, its time is predicted from the nearest heard
-beats of the same kind (tick or tock), up to `REACH` beats before and after:
-interpolated when both were heard (exact for an uneven beat and a steady drift), on
+beats of the same kind (tick or tock), up to `REACH` beats before and after: on a
+line fitted to up to `SIDE` of them on each side when both sides were heard (an
+uneven beat is exact; one neighbour mistimed by another's ring moves it little), on
 the local beat when one side was. A tick already heard that no train holds
 (the tracker lost the train there and took it up again further on) and that lies
 within `TOLERANCE` of one prediction, and of no other, joins that train.
@@ -44,6 +45,8 @@ TOLERANCE = 1.5e-3
 REACH = 16
 #: Passes of `recover`: each predicts from the ticks the last one added.
 PASSES = 3
+#: Heard beats of a kind on each side a missed beat's time is fitted to.
+SIDE = 3
 #: How long after a tick its later impacts and ring can move another's onset, s.
 RING = 0.04
 #: A tick in another's ring this many robust spreads off its beat is unattributed.
@@ -53,10 +56,10 @@ RING_OFF_BEAT = 1.5
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
     """(beats missed, their predicted times) of one train: from the nearest heard beats
     of the same kind (tick or tock) before and after (not a masked tick: the tick that
-    hid it timed it), at most `REACH` beats away,
-    interpolated (exact for an uneven beat and a steady drift); from one side only, on
-    the beat of the two nearest heard beats of the kind there (within 5 % of the
-    train's mean beat, else the mean)."""
+    hid it timed it), at most `REACH` beats away, on a line fitted to up to `SIDE` on
+    each side (`_fit_between`); from one side only, on the beat of the two nearest
+    heard beats of the kind there (within 5 % of the train's mean beat, else the
+    mean)."""
     heard = ~train.masked  # a masked tick is timed by the tick that hid it
     beat, t = train.beat[heard], times[train.index[heard]]
     if beat.size == 0:
@@ -76,8 +79,8 @@ def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarra
         has_hi = (j < b.size) & (b[hi] - want <= REACH)
         both = has_lo & has_hi
         p = np.full(want.size, np.nan)
-        span = np.where(both, b[hi] - b[lo], 1)
-        p[both] = (tb[lo] + (tb[hi] - tb[lo]) * (want - b[lo]) / span)[both]
+        for w in np.flatnonzero(both):
+            p[w] = _fit_between(b, tb, lo[w], hi[w], want[w])
         # from one side: the swing of the two nearest heard beats of the kind there
         # (a metronome that speeds up), or the train's mean
         before = np.maximum(lo - 1, 0)
@@ -98,6 +101,19 @@ def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarra
     n, p = np.concatenate(out_n), np.concatenate(out_t)
     order = np.argsort(n)
     return n[order].astype(np.int64), p[order]
+
+
+def _fit_between(b: np.ndarray, tb: np.ndarray, lo: int, hi: int, want: int) -> float:
+    """The time of beat ``want`` on a line fitted to up to `SIDE` heard beats of its
+    kind on each side (``b``, ``tb``: their numbers and times; ``lo``, ``hi``: the
+    nearest before and after), within `REACH` of it: one of them mistimed by another's
+    ring moves the prediction by a fraction of its error."""
+    left = np.arange(max(lo - SIDE + 1, 0), lo + 1)
+    right = np.arange(hi, min(hi + SIDE, b.size))
+    use = np.concatenate([left[want - b[left] <= REACH], right[b[right] - want <= REACH]])
+    x = b[use] - want
+    slope, intercept = np.polyfit(x.astype(float), tb[use], 1)
+    return float(intercept)
 
 
 def _near_mean(beat: np.ndarray, mean: float) -> np.ndarray:
