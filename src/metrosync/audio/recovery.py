@@ -50,7 +50,7 @@ SIDE = 3
 #: How long after a tick its later impacts and ring can move another's onset, s.
 RING = 0.04
 #: A tick in another's ring this many robust spreads off its beat is unattributed.
-RING_OFF_BEAT = 1.5
+RING_OFF_BEAT = 1.0
 
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
