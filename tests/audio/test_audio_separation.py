@@ -123,10 +123,10 @@ def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
     recall, precision, timing, bpm = table.T
     assert np.all(timing <= 1e-3)
     assert np.all(bpm <= 0.1)
-    # most metronomes hear every tick no other hid; a few lose stretches where another
-    # of nearly the same tempo ticks on theirs for many beats
-    assert np.median(recall) >= 0.99 and np.mean(recall >= 0.95) >= 0.8
-    assert np.median(precision) >= 0.98 and np.mean(precision >= 0.95) >= 0.8
+    # most metronomes hear every tick no other hid; a few lose a tick or two where
+    # another's impacts and ring mask theirs, or one tick is given to the wrong one
+    assert np.all(recall >= 0.98) and np.mean(recall >= 0.99) >= 0.9
+    assert np.all(precision >= 0.97) and np.mean(precision >= 0.99) >= 0.8
 
 
 @pytest.mark.parametrize("same_voice", [False, True], ids=["two makes", "one make"])

@@ -51,7 +51,7 @@ from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
-from .recovery import recover
+from .recovery import nearer_another, recover
 from .separation import separate, sureness, tick_length_words
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
@@ -182,7 +182,7 @@ def analyze_audio(
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
-    label = _labels(k, trains)
+    label = nearer_another(ticks.time, trains, _labels(k, trains))
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)

@@ -3,17 +3,32 @@
 Contract: `recover(recording, scan, ticks, trains)` takes the ticks (`detection.Ticks`,
 sorted) and the metronomes' trains over them (`trains.Train`), and returns (ticks,
 trains, found): the ticks with those it recovered added, the trains with each
-recovered tick in its beat, and how many were recovered.
+recovered tick in its beat, and how many ticks were added.
+
+First, a tick that lies off its train's beat (`trains.off_the_beat`: a later impact
+of a tick whose first impact another tick hid) leaves the train: its beat counts as
+missed. For each beat a train missed, its time is predicted from the nearest heard
+beats of the same kind (tick or tock), up to `REACH` beats before and after: on a
+line fitted to up to `SIDE` of them on each side when both sides were heard (an
+uneven beat is exact; one neighbour mistimed by another's ring moves it little), on
+the local beat when one side was. A tick already heard that no train holds
+(the tracker lost the train there and took it up again further on) and that lies
+within `TOLERANCE` of one prediction, and of no other, joins that train.
 
 A tick that falls a few milliseconds after another metronome's, or on its ringing,
 barely raises the detection curve: the detector's threshold, set for the whole
-recording, misses it. Its metronome's beat says where it is. For each beat a train
-missed, its time is predicted from the ticks a full swing before and after (their
-mean when both were heard: exact for an uneven beat and a steady drift); the
-detection curve's highest point within `WINDOW` of it, if it rises at least
-`MIN_RISE` dB, is timed on the waveform like any tick (`detection.refine`), and kept
-when its onset lies within `TOLERANCE` of the prediction and no tick is within the
-detector's resolution (`detection.RESOLUTION`) of it.
+recording, misses it. For the beats still missed, the detection curve's highest
+point within `WINDOW` of the prediction, if it rises at least `MIN_RISE` dB, is
+timed on the waveform like any tick (`detection.refine`), and kept when its onset
+lies within `TOLERANCE` of the prediction and no tick is within the detector's
+resolution (`detection.RESOLUTION`) of it. Up to `PASSES` passes: each predicts
+from the ticks the last one added, so that a long run of missed beats is filled from
+both ends inwards.
+
+`nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
+tick lies nearer another train's beat than its own train's beat puts it, within the
+detector's resolution: two metronomes ticked together there and its onset may be
+either's.
 """
 
 from __future__ import annotations
@@ -21,38 +36,145 @@ from __future__ import annotations
 import numpy as np
 
 from . import detection as det
-from .trains import Train
+from .trains import Train, off_the_beat
 
 WINDOW = 3e-3
 MIN_RISE = 1.0
 TOLERANCE = 1.5e-3
+#: Farthest heard beat of the same kind a missed beat is predicted from.
+REACH = 16
+#: Passes of `recover`: each predicts from the ticks the last one added.
+PASSES = 3
+#: Heard beats of a kind on each side a missed beat's time is fitted to.
+SIDE = 3
+#: How long after a tick its later impacts and ring can move another's onset, s.
+RING = 0.04
+#: A tick in another's ring this many robust spreads off its beat is unattributed.
+RING_OFF_BEAT = 1.0
 
 
 def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
-    """(beats missed, their predicted times) of one train."""
-    beat = train.beat
-    t = times[train.index]
-    at = dict(zip(beat.tolist(), t.tolist(), strict=True))
-    missing = np.setdiff1d(np.arange(beat[0], beat[-1] + 1), beat)
+    """(beats missed, their predicted times) of one train: from the nearest heard beats
+    of the same kind (tick or tock) before and after (not a masked tick: the tick that
+    hid it timed it), at most `REACH` beats away, on a line fitted to up to `SIDE` on
+    each side (`_fit_between`); from one side only, on the beat of the two nearest
+    heard beats of the kind there (within 5 % of the train's mean beat, else the
+    mean)."""
+    heard = ~train.masked  # a masked tick is timed by the tick that hid it
+    beat, t = train.beat[heard], times[train.index[heard]]
+    if beat.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    missing = np.setdiff1d(np.arange(train.beat[0], train.beat[-1] + 1), train.beat)
     swing = 2 * train.period
     out_n, out_t = [], []
-    for n in missing.tolist():
-        before, after = at.get(n - 2), at.get(n + 2)
-        if before is not None and after is not None:
-            p = 0.5 * (before + after)
-        elif before is not None:
-            p = before + swing
-        elif after is not None:
-            p = after - swing
-        else:
+    for parity in (0, 1):
+        mine = beat % 2 == parity
+        b, tb = beat[mine], t[mine]
+        want = missing[missing % 2 == parity]
+        if b.size == 0 or want.size == 0:
             continue
-        out_n.append(n)
-        out_t.append(p)
-    return np.array(out_n, dtype=np.int64), np.array(out_t)
+        j = np.searchsorted(b, want)
+        lo, hi = np.maximum(j - 1, 0), np.minimum(j, b.size - 1)
+        has_lo = (j > 0) & (want - b[lo] <= REACH)
+        has_hi = (j < b.size) & (b[hi] - want <= REACH)
+        both = has_lo & has_hi
+        p = np.full(want.size, np.nan)
+        for w in np.flatnonzero(both):
+            p[w] = _fit_between(b, tb, lo[w], hi[w], want[w])
+        # from one side: the swing of the two nearest heard beats of the kind there
+        # (a metronome that speeds up), or the train's mean
+        before = np.maximum(lo - 1, 0)
+        after = np.minimum(hi + 1, b.size - 1)
+        beat_lo = (tb[lo] - tb[before]) / np.maximum(b[lo] - b[before], 1)
+        beat_hi = (tb[after] - tb[hi]) / np.maximum(b[after] - b[hi], 1)
+        step_lo = _near_mean(np.where(lo > before, beat_lo, 0.0), 0.5 * swing)
+        step_hi = _near_mean(np.where(after > hi, beat_hi, 0.0), 0.5 * swing)
+        only_lo = has_lo & ~has_hi
+        p[only_lo] = (tb[lo] + (want - b[lo]) * step_lo)[only_lo]
+        only_hi = has_hi & ~has_lo
+        p[only_hi] = (tb[hi] - (b[hi] - want) * step_hi)[only_hi]
+        ok = np.isfinite(p)
+        out_n.append(want[ok])
+        out_t.append(p[ok])
+    if not out_n:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    n, p = np.concatenate(out_n), np.concatenate(out_t)
+    order = np.argsort(n)
+    return n[order].astype(np.int64), p[order]
+
+
+def _fit_between(b: np.ndarray, tb: np.ndarray, lo: int, hi: int, want: int) -> float:
+    """The time of beat ``want`` on a line fitted to up to `SIDE` heard beats of its
+    kind on each side (``b``, ``tb``: their numbers and times; ``lo``, ``hi``: the
+    nearest before and after), within `REACH` of it: one of them mistimed by another's
+    ring moves the prediction by a fraction of its error."""
+    left = np.arange(max(lo - SIDE + 1, 0), lo + 1)
+    right = np.arange(hi, min(hi + SIDE, b.size))
+    use = np.concatenate([left[want - b[left] <= REACH], right[b[right] - want <= REACH]])
+    x = b[use] - want
+    slope, intercept = np.polyfit(x.astype(float), tb[use], 1)
+    return float(intercept)
+
+
+def _near_mean(beat: np.ndarray, mean: float) -> np.ndarray:
+    """A local beat (s) where it is within 5 % of the train's mean beat, else the mean."""
+    return np.where(np.abs(beat / mean - 1) < 0.05, beat, mean)
+
+
+def _on_beat(times: np.ndarray, train: Train) -> Train:
+    """The train without its ticks that lie off its beat (`trains.off_the_beat`): a
+    later impact taken for a tick whose first another tick hid is not the tick; its
+    beat is sought again as missed."""
+    off = off_the_beat(times[train.index], train.beat)
+    if not off.any() or (~off).sum() < 2:
+        return train
+    beat = train.beat[~off]
+    return Train(train.index[~off], beat - beat[0], train.period, train.masked[~off])
+
+
+def _take_unheld(times: np.ndarray, trains: list[Train], owner, beat, pred):
+    """(trains with the ticks no train holds that lie within `TOLERANCE` of one of their
+    predicted beats added, mask of the predictions so met): a tick the tracker lost
+    where its metronome's beat was followed again from elsewhere."""
+    held = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        held[t.index] = True
+    free = np.flatnonzero(~held)
+    met = np.zeros(pred.size, dtype=bool)
+    if free.size == 0 or pred.size == 0:
+        return trains, met
+    j = np.clip(np.searchsorted(times[free], pred), 1, max(free.size - 1, 1))
+    left, right = free[j - 1], free[np.minimum(j, free.size - 1)]
+    nearest = np.where(np.abs(times[left] - pred) <= np.abs(times[right] - pred), left, right)
+    close = np.abs(times[nearest] - pred) <= TOLERANCE
+    # a tick two beats want is neither's
+    wanted, counts = np.unique(nearest[close], return_counts=True)
+    close &= np.isin(nearest, wanted[counts == 1])
+    out = []
+    for m, train in enumerate(trains):
+        mine = close & (owner == m)
+        index = np.concatenate([train.index, nearest[mine]])
+        number = np.concatenate([train.beat, beat[mine]])
+        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
+        k = np.argsort(number, kind="stable")
+        out.append(Train(index[k], number[k], train.period, masked[k]))
+    return out, close
 
 
 def recover(recording, scan, ticks, trains: list[Train]):
     """(ticks, trains, recovered): see the module docstring."""
+    trains = [_on_beat(ticks.time, t) for t in trains]
+    recovered = 0
+    for _ in range(PASSES):
+        ticks, trains, added, taken = _pass(recording, scan, ticks, trains)
+        recovered += added
+        if added + taken == 0:
+            break
+    return ticks, trains, recovered
+
+
+def _pass(recording, scan, ticks, trains: list[Train]):
+    """(ticks, trains, ticks added, heard ticks taken) after one pass of `recover`."""
     rate = recording.sample_rate
     hop_s = scan.hop / rate
     reach = max(1, round(WINDOW / hop_s))
@@ -63,10 +185,13 @@ def recover(recording, scan, ticks, trains: list[Train]):
         beats.append(n)
         predicted.append(p)
     if not trains:
-        return ticks, trains, 0
+        return ticks, trains, 0, 0
     owner, beat, pred = (np.concatenate(x) for x in (owners, beats, predicted))
+    trains, met = _take_unheld(ticks.time, trains, owner, beat, pred)
+    taken = int(met.sum())
+    owner, beat, pred = owner[~met], beat[~met], pred[~met]
     if pred.size == 0:
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     centre = np.round(pred / hop_s).astype(np.int64)
     offsets = np.arange(-reach, reach + 1)
     cols = np.clip(centre[:, None] + offsets[None, :], 0, scan.curve.size - 1)
@@ -74,7 +199,7 @@ def recover(recording, scan, ticks, trains: list[Train]):
     ok = scan.curve[best] >= MIN_RISE
     owner, beat, pred, best = owner[ok], beat[ok], pred[ok], best[ok]
     if best.size == 0:
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     order = np.argsort(best, kind="stable")
     owner, beat, pred, best = owner[order], beat[order], pred[order], best[order]
     found = det.refine(recording, scan, best)
@@ -83,7 +208,7 @@ def recover(recording, scan, ticks, trains: list[Train]):
     gap = np.minimum(np.abs(ticks.time[j] - found.time), np.abs(ticks.time[j - 1] - found.time))
     near &= gap > det.RESOLUTION
     if not near.any():
-        return ticks, trains, 0
+        return ticks, trains, 0, taken
     fields = det.Ticks.__dataclass_fields__
     merged = {f: np.concatenate([getattr(ticks, f), getattr(found, f)[near]]) for f in fields}
     order = np.argsort(merged["time"], kind="stable")
@@ -100,4 +225,68 @@ def recover(recording, scan, ticks, trains: list[Train]):
         masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
         k = np.argsort(number, kind="stable")
         new_trains.append(Train(where[index[k]], number[k], train.period, masked[k]))
-    return new_ticks, new_trains, int(near.sum())
+    return new_ticks, new_trains, int(near.sum()), taken
+
+
+def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
+    """(M,) each tick's distance (s) from its beat as the train's neighbouring heard beats
+    of the same kind put it (the one before and the one after; at an end, the next
+    two); NaN where a kind has fewer than three ticks."""
+    out = np.full(train.index.size, np.nan)
+    t = times[train.index]
+    for parity in (0, 1):
+        sel = np.flatnonzero(train.beat % 2 == parity)
+        if sel.size < 3:
+            continue
+        b, tb = train.beat[sel].astype(float), t[sel]
+        pos = np.arange(sel.size)
+        lo, hi = pos - 1, pos + 1
+        lo[0], hi[0] = 1, 2
+        lo[-1], hi[-1] = sel.size - 3, sel.size - 2
+        slope = (tb[hi] - tb[lo]) / (b[hi] - b[lo])
+        out[sel] = tb - (tb[lo] + slope * (b - b[lo]))
+    return out
+
+
+def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) -> np.ndarray:
+    """(K,) ``label`` (the metronome of each tick, −1 for none) with −1 for each tick
+    that lies nearer another train's beat (a tick it heard, or one it missed, where
+    predicted) than its own train's beat puts it, within the detector's resolution
+    (two metronomes ticked together there and the tick's onset may be either's); and
+    for each tick that falls within `RING` after another train's tick and lies off its
+    own beat by more than `RING_OFF_BEAT` of its train's robust spread (at least a
+    millisecond): its onset is timed by the other's later impacts and ring."""
+    out = label.copy()
+    if len(trains) < 2:
+        return out
+    beats, heard = [], []
+    for train in trains:
+        _, predicted = _predictions(times, train)
+        beats.append(np.sort(np.concatenate([times[train.index], predicted])))
+        heard.append(np.sort(times[train.index]))
+    for m, train in enumerate(trains):
+        held = label[train.index] == m
+        mine = train.index[held]
+        if mine.size == 0:
+            continue
+        offset = _own_offset(times, train)
+        own = np.abs(offset)[held]
+        x = times[mine]
+        other = np.full(x.size, np.inf)
+        since = np.full(x.size, np.inf)
+        for j in range(len(trains)):
+            if j == m or beats[j].size == 0:
+                continue
+            grid = beats[j]
+            q = np.clip(np.searchsorted(grid, x), 1, max(grid.size - 1, 1))
+            d = np.minimum(np.abs(grid[q - 1] - x), np.abs(grid[np.minimum(q, grid.size - 1)] - x))
+            other = np.minimum(other, d)
+            q = np.searchsorted(heard[j], x)
+            before = x - heard[j][np.maximum(q - 1, 0)]
+            since = np.minimum(since, np.where((q > 0) & (before > 0), before, np.inf))
+        spread = 1.4826 * np.nanmedian(np.abs(offset - np.nanmedian(offset)))
+        limit = max(1e-3, RING_OFF_BEAT * spread) if np.isfinite(spread) else np.inf
+        drop = (other < own) & (other <= det.RESOLUTION)
+        drop |= (since <= RING) & (own > limit)
+        out[mine[drop]] = -1
+    return out

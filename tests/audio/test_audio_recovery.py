@@ -1,0 +1,188 @@
+"""Missed beats of a train: predicted from its own beat, filled from ticks no train
+holds, and a later impact taken for a tick let go."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from metrosync.audio import recovery as rc
+from metrosync.audio.trains import Train
+
+
+def limping(beats: int, period=0.4, limp=0.02, drift=-1e-6, start=1.0) -> np.ndarray:
+    """Tick times of an uneven beat (tocks ``limp`` of a period late) that speeds up
+    (by default 0.1 BPM a minute, like the corpus's unwinding springs)."""
+    n = np.arange(beats)
+    return start + n * period + drift * n**2 + limp * period * (n % 2)
+
+
+def train_of(times: np.ndarray, keep: np.ndarray) -> Train:
+    index = np.flatnonzero(keep)
+    return Train(index, index.copy(), float(np.diff(times).mean()), np.zeros(index.size, bool))
+
+
+def test_a_run_of_missed_beats_is_predicted_on_the_limping_beat():
+    t = limping(40)
+    keep = np.ones(t.size, dtype=bool)
+    keep[[3, 17, 18, 19, 20, 21]] = False  # one beat, then five in a row
+    beats, predicted = rc._predictions(t, train_of(t, keep))
+    assert beats.tolist() == [3, 17, 18, 19, 20, 21]
+    # the drift's curvature over a few swings is far below a millisecond
+    assert np.abs(predicted - t[beats]).max() < 2e-4
+
+
+def test_a_masked_tick_does_not_time_a_missed_beat():
+    t = limping(40)
+    keep = np.ones(t.size, dtype=bool)
+    keep[10] = False
+    train = train_of(t, keep)
+    heard_at = t.copy()
+    heard_at[[8, 12]] -= 3e-3  # taken from the metronome whose tick hid them
+    masked = np.isin(train.index, [8, 12])
+    train = Train(train.index, train.beat, train.period, masked)
+    beats, predicted = rc._predictions(heard_at, train)
+    assert beats.tolist() == [10]
+    assert abs(predicted[0] - t[10]) < 2e-4
+
+
+def test_one_mistimed_neighbour_moves_a_prediction_little():
+    t = limping(40)
+    keep = np.ones(t.size, dtype=bool)
+    keep[20] = False
+    heard_at = t.copy()
+    heard_at[22] += 2e-3  # its onset moved by another metronome's ring
+    beats, predicted = rc._predictions(heard_at, train_of(t, keep))
+    assert beats.tolist() == [20]
+    assert abs(predicted[0] - t[20]) < 0.5e-3  # the two nearest alone: 1 ms off
+
+
+def test_a_beat_beyond_reach_is_not_predicted():
+    t = limping(60)
+    keep = np.ones(t.size, dtype=bool)
+    keep[20:40] = False
+    beats, _ = rc._predictions(t, train_of(t, keep))
+    far = (beats - 19 > rc.REACH) & (40 - beats > rc.REACH)
+    assert not far.any() and beats.size > 0
+
+
+def test_a_tick_no_train_holds_joins_the_train_whose_beat_it_falls_on():
+    t = limping(30)
+    other = 0.5 + 0.33 * np.arange(35)  # another metronome, also not held at its beat
+    times = np.concatenate([t, other])
+    order = np.argsort(times)
+    times = times[order]
+    mine = np.isin(order, np.arange(t.size))
+    held = mine.copy()
+    lost = np.flatnonzero(mine)[[10, 11, 12]]
+    held[lost] = False
+    index = np.flatnonzero(held)
+    beat = np.flatnonzero(np.isin(np.flatnonzero(mine), index))
+    train = Train(index, beat, 0.4, np.zeros(index.size, bool))
+    n, p = rc._predictions(times, train)
+    owner = np.zeros(n.size, dtype=np.int64)
+    (joined,), met = rc._take_unheld(times, [train], owner, n, p)
+    assert met[np.isin(n, [10, 11, 12])].all() and met.sum() == 3
+    assert sorted(joined.index.tolist()) == np.flatnonzero(mine).tolist()
+    assert joined.beat.tolist() == list(range(t.size))
+    # a tick of the other metronome is never taken
+    assert not np.isin(joined.index, np.flatnonzero(~mine)).any()
+
+
+def test_a_tick_two_predictions_want_is_neither_trains():
+    times = limping(30)
+    keep = np.ones(times.size, dtype=bool)
+    keep[10] = False
+    a = train_of(times, keep)
+    n, p = rc._predictions(times, a)
+    owner = np.array([0, 1])
+    out, met = rc._take_unheld(times, [a, a], owner, np.repeat(n, 2), np.repeat(p, 2))
+    assert not met.any()
+    assert all(t.index.size == a.index.size for t in out)
+
+
+@pytest.mark.parametrize("late", [0.025, 0.033])
+def test_a_later_impact_taken_for_a_tick_leaves_the_train(late):
+    t = limping(40)
+    t[15] += late  # its first impact was hidden: the next impact of the tick stood in
+    train = train_of(t, np.ones(t.size, dtype=bool))
+    kept = rc._on_beat(t, train)
+    assert 15 not in kept.index and kept.index.size == t.size - 1
+    beats, predicted = rc._predictions(t, kept)
+    assert beats.tolist() == [15]
+    assert abs(predicted[0] - limping(40)[15]) < 2e-4
+
+
+def test_a_train_on_its_beat_is_kept_whole():
+    t = limping(40) + np.random.default_rng(3).normal(0, 0.5e-3, 40)
+    train = train_of(t, np.ones(t.size, dtype=bool))
+    assert rc._on_beat(t, train) is train
+
+
+def test_beats_heard_on_one_side_only_are_predicted_with_the_local_swing():
+    t = limping(100, drift=-5e-6)  # speeding up: the mean beat is off by 0.3 ms a beat
+    keep = np.ones(t.size, dtype=bool)
+    keep[20:70] = False
+    beats, predicted = rc._predictions(t, train_of(t, keep))
+    one_side = beats < 70 - rc.REACH - 1
+    assert one_side.sum() == rc.REACH
+    n = beats[one_side]
+    err = np.abs(predicted[one_side] - t[n])
+    last = np.where(n % 2 == 0, 18, 19)  # the last heard beat of each kind
+    by_mean = np.abs(t[last] + (n - last) * np.diff(t).mean() - t[n])
+    assert err.max() < 1.5e-3
+    assert np.all(err[-4:] < 0.7 * by_mean[-4:])
+
+
+def _two(times_a, times_b):
+    times = np.concatenate([times_a, times_b])
+    order = np.argsort(times, kind="stable")
+    where = np.empty(order.size, dtype=np.int64)
+    where[order] = np.arange(order.size)
+    a = where[: times_a.size]
+    b = where[times_a.size :]
+    trains = [Train(a, np.arange(a.size), 0.4, np.zeros(a.size, bool)),
+              Train(b, np.arange(b.size), 0.45, np.zeros(b.size, bool))]  # fmt: skip
+    label = np.empty(times.size, dtype=np.int8)
+    label[a], label[b] = 0, 1
+    return times[order], trains, label, a
+
+
+def test_a_tick_nearer_another_metronomes_beat_is_neithers():
+    a = limping(40)
+    b = 0.73 + 0.45 * np.arange(36)
+    a[20] = b[np.argmin(np.abs(b - a[20]))] + 0.2e-3  # heard at the other's onset
+    true_20 = limping(40)[20]
+    assert abs(a[20] - true_20) > 1e-3
+    times, trains, label, ia = _two(a, b)
+    out = rc.nearer_another(times, trains, label)
+    assert out[ia[20]] == -1
+    assert (out == label).sum() == label.size - 1
+
+
+def test_a_tick_on_its_own_beat_keeps_its_metronome_beside_another():
+    a = limping(40)
+    b = a[20] + 3e-3 + 0.45 * (np.arange(36) - 17)  # the other ticks 3 ms after a[20]
+    times, trains, label, _ = _two(a, b)
+    out = rc.nearer_another(times, trains, label)
+    assert np.array_equal(out, label)
+
+
+RING_CASES = [
+    (0.030, -2.5e-3, False),  # in the other's ring, off its beat
+    (0.030, -0.3e-3, True),  # in the ring, on its beat
+    (0.060, -2.5e-3, True),  # off its beat, but clear of the ring
+]
+
+
+@pytest.mark.parametrize(("after_other", "shift", "kept"), RING_CASES)
+def test_a_tick_in_another_metronomes_ring_off_its_own_beat_is_unattributed(
+    after_other, shift, kept
+):
+    a = limping(40) + np.random.default_rng(8).normal(0, 0.05e-3, 40)
+    b = a[20] - after_other + 0.45 * (np.arange(36) - 17)
+    a[20] += shift
+    times, trains, label, ia = _two(a, b)
+    out = rc.nearer_another(times, trains, label)
+    assert (out[ia[20]] == 0) == kept
+    assert (out != label).sum() == (0 if kept else 1)
