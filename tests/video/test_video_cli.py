@@ -25,7 +25,7 @@ def test_track_writes_the_dataset_plot_and_preview(three_rods, tmp_path, capsys)
     code, out, err = run(capsys, path, "--out", files[0], "--plot", files[1], "--preview",
                          files[2])  # fmt: skip
     assert code == 0, err
-    assert "3 metronome(s)" in out and "equilibrium r" in out
+    assert "3 metronomes" in out and "equilibrium r" in out
     assert "about 590 frames" in err and "expect about" in err  # before the work
     assert all(f.stat().st_size > 0 for f in files)
 
