@@ -27,7 +27,30 @@ def main(argv: list[str] | None = None) -> int:
     # The work is over and its outputs are whole: a Ctrl-C while the interpreter shuts
     # down would only turn a finished command into one killed by SIGINT.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if code == 130:
+        _end_interrupted()
     return code
+
+
+def _end_interrupted() -> None:
+    """Exit with status 130 now, the interrupt handled and its line printed.
+
+    CPython remembers a KeyboardInterrupt that escaped code it ran through its C API
+    (as some extensions do), and at a normal exit kills itself with SIGINT, so the
+    status would read as killed although the interrupt was handled. The exit handlers
+    run and the standard streams are flushed first; every output was written and
+    closed before the line was printed.
+    """
+    import atexit
+    import os
+
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(130)
 
 
 if __name__ == "__main__":

@@ -119,6 +119,9 @@ def _run(argv: list[str] | None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
+            # An unclosed file is a note for developers (an import cut short by Ctrl-C
+            # leaves one), never a line for the user.
+            warnings.simplefilter("ignore", ResourceWarning)
             warnings.showwarning = show_warning
             code = int(args.func(args) or 0)
             # Flush here, not at exit: a reader that went away must meet the handler below
