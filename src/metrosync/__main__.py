@@ -15,21 +15,24 @@ def main(argv: list[str] | None = None) -> int:
     try:
         from .cli import main as run
     except KeyboardInterrupt:
-        command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
-        print(f"metrosync {command}: interrupted: nothing was written", file=sys.stderr)
-        return 130
+        return _interrupted(argv, "nothing was written")
     try:
         code = run(argv)
     except KeyboardInterrupt:  # in the instant after `run` restored Python's handler
-        command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
-        print(f"metrosync {command}: interrupted: its work had ended", file=sys.stderr)
-        return 130
+        return _interrupted(argv, "its work had ended")
     # The work is over and its outputs are whole: a Ctrl-C while the interpreter shuts
     # down would only turn a finished command into one killed by SIGINT.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if code == 130:
         _end_interrupted()
     return code
+
+
+def _interrupted(argv: list[str] | None, what: str) -> int:
+    """Say, in the command's one line, that Ctrl-C ended it and ``what`` was kept."""
+    command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
+    print(f"metrosync {command}: interrupted: {what}", file=sys.stderr)
+    return 130
 
 
 def _end_interrupted() -> None:
