@@ -63,15 +63,16 @@ def disk_torque(sys: SystemArrays, phi_dot, kick, t=0.0):
     return -sys.c_phi * phi_dot - reaction + applied_torque(sys, t)
 
 
-def escapement(sys: SystemArrays, theta, theta_next, dt: float) -> np.ndarray:
-    """The paper's discrete escapement over a step ``dt`` from ``theta`` to
-    ``theta_next``, (B, N): 𝕄_i = +M/dt when θ_i rises through its escapement angle
-    δ_i (``escapement_offset``, 0 in the paper), −M/dt when it falls through it, else 0."""
+def escapement(sys: SystemArrays, theta, theta_next) -> np.ndarray:
+    """Where and which way each escapement acts over a step from ``theta`` to
+    ``theta_next``, (B, N): +1 when θ_i rises through its escapement angle δ_i
+    (``escapement_offset``, 0 in the paper), −1 when it falls through it, else 0. Its
+    impulse is M (``drive``); a scheme makes it a torque over the step (the paper's
+    ±M/dt) or an impulse at the crossing (the twin of `_physics.escapement`)."""
     at = sys.escapement_offset
-    rate = sys.drive / dt
     up = (theta < at) & (theta_next > at)
     down = (theta > at) & (theta_next < at)
-    return np.where(up, rate, np.where(down, -rate, 0.0))
+    return np.where(up, 1.0, np.where(down, -1.0, 0.0))
 
 
 def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, friction=None):

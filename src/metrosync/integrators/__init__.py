@@ -41,7 +41,8 @@ class Integrator:
     summary : one line for help texts.
     order : global order of accuracy in dt without kicks (smooth dynamics).
     order_with_kicks : the same with the escapement's impulses.
-    modules : backend name → module implementing it (the first is the default).
+    modules : backend name → where it is implemented, ``module`` or ``module:object``
+        (the first is the default).
     trajectories : the backends that can record θ, θ̇, φ, φ̇.
     fixed_step : True for a scheme driven step by step (see the module docstring).
     """
@@ -74,13 +75,13 @@ class Integrator:
                 f"`backend` {backend!r} does not record trajectories yet; use "
                 f"backend={self.trajectories[0]!r} with `trajectories=True` (or `--save-every`)."
             )
-        return importlib.import_module(self.modules[backend])
+        return _load(self.modules[backend])
 
     def integrate(self, *args, **kwargs):
         """Run a whole-run integrator (see the module docstring for the arguments)."""
         if self.fixed_step:
             raise TypeError(f"{self.name!r} is a fixed-step scheme: drive its `stepper`.")
-        return importlib.import_module(self.modules[self.backends[0]]).integrate(*args, **kwargs)
+        return _load(self.modules[self.backends[0]]).integrate(*args, **kwargs)
 
 
 REGISTRY: dict[str, Integrator] = {
@@ -91,7 +92,7 @@ REGISTRY: dict[str, Integrator] = {
         order_with_kicks=1,  # the kick is quantised to the step; measured there too
         modules={
             "numba": "metrosync.integrators.verlet",
-            "numpy": "metrosync.integrators.reference",
+            "numpy": "metrosync.integrators.twin:VERLET",
             "gpu": "metrosync.integrators.kernel_cuda",
         },
         trajectories=("numba", "numpy"),
@@ -105,7 +106,7 @@ REGISTRY: dict[str, Integrator] = {
         order_with_kicks=2,
         modules={
             "numba": "metrosync.integrators.located",
-            "numpy": "metrosync.integrators.reference_located",
+            "numpy": "metrosync.integrators.twin:LOCATED",
         },
         trajectories=("numba", "numpy"),
         fixed_step=True,
@@ -136,6 +137,13 @@ def get_integrator(name: str) -> Integrator:
         raise ParameterError(
             f"unknown `integrator` {name!r}; choose one of {list(REGISTRY)}."
         ) from None
+
+
+def _load(where: str):
+    """The module ``package.module``, or the object ``package.module:name`` in it."""
+    module, _, name = where.partition(":")
+    loaded = importlib.import_module(module)
+    return getattr(loaded, name) if name else loaded
 
 
 def _require_gpu() -> None:

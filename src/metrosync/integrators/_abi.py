@@ -7,10 +7,10 @@ nothing over positional arguments.
 ``State``      what a step changes, (B, N) and (B,) arrays, updated in place.
 ``Constants``  every field of `SystemArrays` (so a new model constant reaches the
                kernels without touching this file), plus what each step reuses:
-               ``inv_inertia`` = 1/(m h² + J_i) and ``kick_rate`` = M/dt, the
-               escapement torque of the paper's discrete scheme. Per-metronome
+               ``inv_inertia`` = 1/(m h² + J_i). Nothing here depends on the step:
+               a scheme makes its own use of ``drive`` (`layouts`). Per-metronome
                fields are (B, N), per-run fields (B,); a layout may rearrange them
-               (`kernel_runs.arrange`), never rename them.
+               (`layout_runs.arrange`), never rename them.
 ``Settings``   the scalars of one call: step, first step, step count, record spacing,
                overturn angle.
 ``Recording``  the record buffers, (B, n_rec) and trajectories (B, n_rec, N), or
@@ -54,7 +54,7 @@ class State(NamedTuple):
 
 
 #: Fields of `Constants` that are not in `SystemArrays`: derived once per call.
-DERIVED_CONSTANTS = ("inv_inertia", "kick_rate")
+DERIVED_CONSTANTS = ("inv_inertia",)
 
 #: The model's constants as the kernels read them (generated from `SystemArrays`).
 Constants = namedtuple(
@@ -83,12 +83,11 @@ class Recording(NamedTuple):
     group_start: np.ndarray
 
 
-def constants_of(sys: SystemArrays, dt: float):
-    """The kernels' `Constants` for a step ``dt``: C-contiguous float arrays."""
+def constants_of(sys: SystemArrays):
+    """The kernels' `Constants`: C-contiguous float arrays."""
     arrays = {f.name: np.ascontiguousarray(getattr(sys, f.name), dtype=float) for f in fields(sys)}
-    # The same expressions as the NumPy reference (1/I is exact to rounding; M/dt too).
+    # The same expression as the NumPy twin (1/I is exact to rounding).
     arrays["inv_inertia"] = 1.0 / arrays["inertia"]
-    arrays["kick_rate"] = arrays["drive"] / dt
     return Constants(**arrays)
 
 

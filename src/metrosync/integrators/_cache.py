@@ -49,10 +49,10 @@ STAMPED_OUTSIDE = ("status.py", "equations.py", "model/system.py")
 #: signature), by `kernel_name`, measured with an empty cache on the 2-core x86-64
 #: development machine (numba 0.68.1, 2026-11-25).
 COMPILE_SECONDS = {
-    "kernel_runs.advance": 20.0,
-    "kernel_oscillators.advance": 12.0,
-    "kernel_located_runs.advance": 26.0,
-    "kernel_located_oscillators.advance": 17.0,
+    "verlet.advance_runs": 20.0,
+    "verlet.advance_metronomes": 12.0,
+    "located.advance_runs": 26.0,
+    "located.advance_metronomes": 17.0,
     "reduced._advance_runs": 6.0,
     "reduced._advance_serial": 3.0,
     "reduced._advance_threads": 3.0,

@@ -53,15 +53,16 @@ import numba as nb
 
 @nb.njit(cache=True, inline="always")
 def escapement(c, m, theta, theta_next):
-    """The paper's discrete escapement over one step from ``theta`` to ``theta_next``:
-    the torque 𝕄 = +M/dt when θ rises through the escapement's angle δ, −M/dt when it
+    """Where and which way metronome ``m``'s escapement acts over a step from ``theta``
+    to ``theta_next``: +1 when θ rises through the escapement's angle δ, −1 when it
     falls through it, else 0 (selects, not branches, so that it vectorizes). δ is
-    ``escapement_offset``, 0 in the paper."""
+    ``escapement_offset``, 0 in the paper. Its impulse is M (``drive``); the scheme
+    makes it a torque over the step (``verlet``: the paper's ±M/dt) or an impulse at
+    the crossing (``located``), so the physics knows nothing of the step."""
     at = c.escapement_offset[m]
     up = (theta < at) & (theta_next > at)
     down = (theta > at) & (theta_next < at)
-    rate = c.kick_rate[m]
-    return rate if up else (-rate if down else 0.0)
+    return 1.0 if up else (-1.0 if down else 0.0)
 
 
 @nb.njit(cache=True, inline="always")

@@ -122,8 +122,9 @@ def advance(st, c, settings, rec, scratch):
         for i in range(tid, n, nt):
             th = theta[b, i]
             tn, vp = drift(th, theta_dot[b, i], acc_theta[b, i], dt, dt2)
-            kick = escapement(c, (b, i), th, tn)
-            if kick != 0.0:
+            fires = escapement(c, (b, i), th, tn)
+            kick = fires * (c.drive[b, i] * (1.0 / dt))  # ``verlet``'s torque ±M/dt
+            if fires != 0.0:
                 last_kick[b, i] = (s + 1) * dt
             if upward(th, tn):
                 t_cross = t_old + dt * th / (th - tn)
@@ -240,7 +241,7 @@ def advance_state(
     )
     b, n = state.theta.shape
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
-    constants = Constants(*(cuda.to_device(a) for a in constants_of(sys, dt)))
+    constants = Constants(*(cuda.to_device(a) for a in constants_of(sys)))
     kept = state.kernel_recording()
     grouped = state.group_start.size > 2
     # Trajectory fields, and r_group of one group: placeholders the kernel never reads.

@@ -29,21 +29,60 @@ R²m²h²/(I (J + R²Σm)) (3×10⁻³ for the default metronomes), and they alt
 sign with the kicks; the measured order stays 2.0 down to dt = 10⁻⁵ s.
 
 The cost is a scalar pass over the impulses of a step and, in a step that has any,
-two more terms per metronome in the second pass. The layouts are
-`kernel_located_runs` and `kernel_located_oscillators`, picked as for ``verlet``;
-`reference_located` is the NumPy twin. The scheme takes the forcing torque and the
-escapement's offset and reaction from `_physics` like ``verlet``; it refuses dry
-friction on the disk (`refuse_dry_friction`).
+two more terms per metronome in the second pass. The scheme is two hooks (`begin`:
+the escapement as an impulse, no torque; `impulse`: where in the step it acts and
+what it changes, from `_located_parts`) that the same loops as ``verlet``'s call
+(`layout_runs`, `layout_metronomes`); `twin` is its NumPy twin. It takes the forcing
+torque and the escapement's offset and reaction from `_physics` like ``verlet``; it
+refuses dry friction on the disk (`refuse_dry_friction`).
 """
 
 from __future__ import annotations
 
-from . import kernel_located_oscillators, kernel_located_runs
-from ._state import StepState
-from .verlet import advance_in_layout
+import numba as nb
 
-#: Kernel modules by memory layout, picked as for ``verlet`` (`verlet.choose_layout`).
-LAYOUTS = {"runs": kernel_located_runs, "oscillators": kernel_located_oscillators}
+from . import layout_metronomes, layout_runs
+from ._kernel_parts import drift
+from ._located_parts import crossing_fraction, kick
+from ._physics import escapement
+from ._state import StepState
+from .layouts import advance_in_layout
+
+
+@nb.njit(cache=True, inline="always")
+def begin(c, m, theta, theta_dot, acc, dt, dt2):
+    """The step's start for metronome ``m``: the new angle, the predicted velocity,
+    whether the escapement fires (±1, 0), no torque, and its impulse ±M (N m s)."""
+    theta_next, predicted = drift(theta, theta_dot, acc, dt, dt2)
+    fires = escapement(c, m, theta, theta_next)
+    return theta_next, predicted, fires, 0.0, fires * c.drive[m]
+
+
+@nb.njit(cache=True, inline="always")
+def impulse(c, m, r, kick_, theta, theta_next, theta_dot, dt):
+    """Steps 1–3 of the module docstring for one impulse ``kick_`` (N m s): the time
+    left after it, and `_located_parts.kick`'s jumps."""
+    after = dt - crossing_fraction(c, m, theta, theta_next) * dt
+    dv, dnum, dforce, jrest, jnum = kick(c, m, r, kick_, theta_dot)
+    return after, dv, dnum, dforce, jrest, jnum
+
+
+# Reassociated and contracted in both layouts (within 1e-10 of the NumPy twin, as
+# tested): without it the scalar impulse pass costs 0.80 of verlet's rate at (100, 7).
+@nb.njit(parallel=True, cache=True, fastmath=layout_metronomes.FASTMATH)
+def advance_runs(st, c, settings, rec):
+    """The scheme in the runs-innermost loop (`layout_runs`)."""
+    layout_runs.loop(st, c, settings, rec, begin, impulse)
+
+
+@nb.njit(parallel=True, cache=True, fastmath=layout_metronomes.FASTMATH)
+def advance_metronomes(st, c, settings, rec):
+    """The scheme in the metronomes-innermost loop (`layout_metronomes`)."""
+    layout_metronomes.loop(st, c, settings, rec, begin, impulse)
+
+
+#: The compiled kernel of each memory layout.
+LAYOUTS = {"runs": advance_runs, "metronomes": advance_metronomes}
 
 
 def advance_state(

@@ -4,7 +4,8 @@ The scheme, per step of length dt (state x = (φ, θ), velocities v, acceleratio
 
 1. positions   x' = x + v dt + a dt²/2
 2. kick        𝕄_i = +M/dt if θ_i < 0 < θ_i', −M/dt if θ_i > 0 > θ_i', else 0
-               (the paper's discrete escapement, §4)
+               (the paper's discrete escapement, §4: `_physics.escapement` says
+               where and in which direction it acts, this scheme makes it a torque)
 3. forces      a' = f(x', v*, 𝕄), eqs. (eqm1)–(eqm2), evaluated with the *predicted*
                velocities v* = v + a dt: that is how the velocity-dependent terms
                (friction, the θ̇² sin θ term, c_φ φ̇) enter the explicit scheme
@@ -45,61 +46,60 @@ reversals are resolved to the step (first order, like the kicks). Note that the
 escapement's kick is a torque ±M/dt here: the disk slips at a kick when that torque
 (with the pendulum's recoil) beats T, which, as dt → 0, it always does: `exact` treats
 the kick as an impulse, which no finite friction can hold.
+
+The scheme is two hooks (`begin`, `impulse`; the contract is in `layouts`) that each
+memory layout's loop calls (`layout_runs`, `layout_metronomes`); `twin` is its NumPy
+twin.
 """
 
 from __future__ import annotations
 
-from . import kernel_oscillators, kernel_runs
-from ._abi import constants_of, settings_of
-from ._cache import compile_kernel, heal_compile_cache
+import numba as nb
+
+from . import layout_metronomes, layout_runs
+from ._kernel_parts import drift
+from ._physics import escapement
 from ._state import StepState
-
-#: Kernel modules by memory layout (see each module's docstring): each has
-#: ``arrange(constants)`` and ``advance(state, constants, settings, recording)``.
-LAYOUTS = {"runs": kernel_runs, "oscillators": kernel_oscillators}
-#: Runs go innermost when a run has too few metronomes to fill vector registers and
-#: there are enough runs to fill a block; otherwise metronomes do. Both thresholds
-#: were measured with benchmarks/kernel.py on the 2-core AVX-512 machine.
-RUNS_INNERMOST_BELOW_N = 10
-RUNS_INNERMOST_FROM_B = 16
+from .layouts import advance_in_layout
 
 
-def choose_layout(n: int, runs: int) -> str:
-    """The kernel layout for ``runs`` runs of ``n`` metronomes (a function of the
-    problem only, never of the thread count, so results do not depend on it)."""
-    if n < RUNS_INNERMOST_BELOW_N and runs >= RUNS_INNERMOST_FROM_B:
-        return "runs"
-    return "oscillators"
+@nb.njit(cache=True, inline="always")
+def begin(c, m, theta, theta_dot, acc, dt, dt2):
+    """Steps 1–2 for metronome ``m``: the new angle, the predicted velocity, whether the
+    escapement fires (±1, 0), and its torque ±M/dt over the step; no impulse."""
+    theta_next, predicted = drift(theta, theta_dot, acc, dt, dt2)
+    fires = escapement(c, m, theta, theta_next)
+    return theta_next, predicted, fires, fires * (c.drive[m] * (1.0 / dt)), 0.0
+
+
+@nb.njit(cache=True, inline="always")
+def impulse(c, m, r, kick, theta, theta_next, theta_dot, dt):
+    """Never called: this scheme has no impulses inside the step (`begin` gives none)."""
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@nb.njit(parallel=True, cache=True)
+def advance_runs(st, c, settings, rec):
+    """The scheme in the runs-innermost loop (`layout_runs`)."""
+    layout_runs.loop(st, c, settings, rec, begin, impulse)
+
+
+@nb.njit(parallel=True, cache=True, fastmath=layout_metronomes.FASTMATH)
+def advance_metronomes(st, c, settings, rec):
+    """The scheme in the metronomes-innermost loop (`layout_metronomes`)."""
+    layout_metronomes.loop(st, c, settings, rec, begin, impulse)
+
+
+#: The compiled kernel of each memory layout.
+LAYOUTS = {"runs": advance_runs, "metronomes": advance_metronomes}
 
 
 def advance_state(
     state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle, layout=None
 ):
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
-    ``layout`` (default: chosen from the problem's size)."""
+    ``layout`` (default: chosen from the problem's size, `layouts.choose_layout`)."""
     advance_in_layout(
         LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
         overturn_angle=overturn_angle, layout=layout,
     )  # fmt: skip
-
-
-def advance_in_layout(
-    layouts, state: StepState, sys, *, dt, step0, n_steps, record_every, overturn_angle, layout
-):
-    """`advance_state` for a scheme whose kernel modules by layout are ``layouts``."""
-    heal_compile_cache()
-    kernel = layouts[layout or choose_layout(state.theta.shape[1], state.theta.shape[0])]
-    args = (
-        state.kernel_state(),
-        kernel.arrange(constants_of(sys, dt)),
-        settings_of(
-            dt=dt,
-            step0=step0,
-            n_steps=n_steps,
-            record_every=record_every,
-            overturn_angle=overturn_angle,
-        ),
-        state.kernel_recording(),
-    )
-    compile_kernel(kernel.advance, *args)
-    kernel.advance(*args)

@@ -1,15 +1,16 @@
-"""Fixed-step kernel with the runs innermost: for small N.
+"""The fixed-step loop nest with the runs innermost: for small N.
 
 With N = 2…10 a loop over the metronomes is too short to fill a vector register, so
 runs are grouped in blocks of `LANES` and each vector lane holds one run: the state
 is transposed to (block, N, LANES) and every arithmetic line of a step acts on a
 whole block at once. Sums over metronomes are per lane, so they are not reassociated
 and each run gets exactly the arithmetic of a scalar loop. Blocks are spread over
-threads. Rare events (crossings, overturns, far-wound angles) are detected by
-per-block reductions and handled in a scalar pass.
+threads. Rare events (crossings, impulses, overturns, far-wound angles) are detected
+by per-block reductions and handled in a scalar pass over the lanes that have them.
 
-Only loops and memory order live here: the forces come from `_physics`, the scheme's
-updates and the bookkeeping from `_kernel_parts`. The constants are blocked once per
+Only loops and memory order live here: the forces come from `_physics`, the
+bookkeeping from `_kernel_parts`, and the scheme as the hooks ``begin`` and
+``impulse`` (`schemes`), as in `layout_metronomes`. The constants are blocked once per
 call by `arrange`, (block, N, LANES) and (block, LANES), so that `_physics` reads them
 at (block, i, lane) and (block, lane) with unit stride across the lanes.
 """
@@ -38,12 +39,12 @@ from ._physics import (
     disk_friction_stop,
     disk_torque,
     disk_velocity,
-    escapement,
     forced,
     momentum_at_rest,
     pendulum_terms,
     theta_ddot,
 )
+from .layout_metronomes import add_jump
 from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 #: Runs per block: 8 doubles fill an AVX-512 register (two AVX2 registers).
@@ -68,10 +69,11 @@ def arrange(constants):
     return type(constants)(**blocked)
 
 
-@nb.njit(parallel=True, cache=True)
-def advance(st, c, settings, rec):
-    """Same contract as the other kernels; the state uses the usual (B, N) layout and is
-    transposed into blocks here, once per call; ``c`` comes from `arrange`."""
+@nb.njit(inline="always")
+def loop(st, c, settings, rec, begin, impulse):
+    """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place,
+    with the scheme's hooks; the state uses the usual (B, N) layout and is transposed
+    into blocks here, once per call; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
     r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
@@ -81,6 +83,7 @@ def advance(st, c, settings, rec):
     n_rec = r.shape[1]
     save = traj_theta.shape[0] > 0
     dt2 = dt * dt
+    half = 0.5 * dt
     grid_dt = record_every * dt
     for blk in nb.prange(n_blocks):
         b0 = blk * LANES
@@ -89,6 +92,7 @@ def advance(st, c, settings, rec):
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
+        kicks = np.empty((n, LANES))  # the step's impulses, 0 where none
         ph_new = np.empty(LANES)
         phd_pred = np.empty(LANES)
         s_num = np.empty(LANES)
@@ -101,7 +105,7 @@ def advance(st, c, settings, rec):
         block_forced = False
         for w in range(LANES):
             block_forced |= forced(c, (blk, w))
-        ups = np.empty(LANES, dtype=np.int64)  # per-lane counts: scan only lanes that need it
+        counts = np.empty((3, LANES), dtype=np.int64)  # per lane: crossings, impulses, overturns
         lk = load_last_kick(last_kick, b0, lanes)
         dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
@@ -110,7 +114,9 @@ def advance(st, c, settings, rec):
         others = np.empty(LANES)
         friction = np.empty(LANES)
         held = np.empty(LANES, dtype=np.bool_)
-        overs = np.empty(LANES, dtype=np.int64)
+        jump = np.zeros(LANES)  # the disk's jumps from the step's impulses, per lane
+        shift = np.zeros(LANES)
+        jump_p = np.zeros(LANES)
         until_record = record_every - step0 % record_every
         if step0 == 0:
             for w in range(lanes):
@@ -119,24 +125,9 @@ def advance(st, c, settings, rec):
         for s in range(step0, step0 + n_steps):
             t_old = s * dt
             t_new = (s + 1) * dt
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, sincos)  # fmt: skip  # noqa: E501
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, libm_sincos)  # fmt: skip  # noqa: E501
-            for w in range(lanes):
-                if ups[w] > 0 or overs[w] > 0:
-                    if alive[w] == 0.0:
-                        continue
-                    if overs[w] > 0:
-                        status[b0 + w] |= STATUS_OVERTURNED
-                    for i in range(n):
-                        if ups[w] == 0:
-                            break
-                        t0 = th[i, w]
-                        tn = tn_s[i, w]
-                        if upward(t0, tn):
-                            t_cross = t_old + dt * t0 / (t0 - tn)
-                            upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
-                            ups[w] -= 1
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -147,26 +138,78 @@ def advance(st, c, settings, rec):
                 s_p[w] = 0.0
             if dry:  # the block has a run with dry friction on the disk (`verlet`)
                 _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held)  # fmt: skip  # noqa: E501
+            any_impulse = False
             for w in range(lanes):
-                if alive[w] > 0.0 and not math.isfinite(phdd[w]):
+                if alive[w] == 0.0:
+                    continue
+                if counts[2, w] > 0:
+                    status[b0 + w] |= STATUS_OVERTURNED
+                if not math.isfinite(phdd[w]):
                     status[b0 + w] |= STATUS_DIVERGED
                     alive[w] = 0.0
-            for i in range(n):
-                for w in range(LANES):  # vectorized across runs
-                    keep = alive[w] > 0.0
-                    thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], phdd[w])
-                    v = velocity(thd[i, w], acc[i, w], thdd, dt)
-                    thd[i, w] = v if keep else thd[i, w]
-                    th[i, w] = tn_s[i, w] if keep else th[i, w]
-                    acc[i, w] = thdd if keep else acc[i, w]
-                    s_p[w] += q[i, w] * v
+                    continue
+                if counts[0, w] == 0 and counts[1, w] == 0:
+                    continue
+                # The scalar pass: crossings to book, impulses to apply (`layout_metronomes`).
+                impulses = counts[1, w] > 0
+                any_impulse |= impulses
+                jumps = (0.0, 0.0, 0.0, 0.0, 0.0)
+                for i in range(n):
+                    t0 = th[i, w]
+                    tn = tn_s[i, w]
+                    if upward(t0, tn):
+                        t_cross = t_old + dt * t0 / (t0 - tn)
+                        upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
+                        counts[0, w] -= 1
+                    if kicks[i, w] != 0.0:
+                        after, dv, dnum, dforce, jrest, jnum = impulse(c, (blk, i, w), (blk, w), kicks[i, w], t0, tn, thd[i, w], dt)  # fmt: skip  # noqa: E501
+                        thd[i, w] += dv + (after - half) * jrest
+                        tn_s[i, w] += after * dv
+                        rest[i, w] += jrest
+                        jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
+                        counts[1, w] -= 1
+                    if counts[0, w] == 0 and counts[1, w] == 0:
+                        break
+                if impulses:
+                    jump[w] = disk_acceleration(c, (blk, w), jumps[0], s_den[w], jumps[1])
+                    shift[w] = disk_acceleration(c, (blk, w), jumps[2], s_den[w], jumps[3])
+                    phdd[w] += disk_acceleration(c, (blk, w), jumps[4], s_den[w], 0.0)
+                    jump_p[w] = jumps[1]
+            if any_impulse:
+                for i in range(n):
+                    for w in range(LANES):  # vectorized across runs, with the disk's jumps
+                        keep = alive[w] > 0.0
+                        m = (blk, i, w)
+                        thdd = theta_ddot(c, m, (blk, w), rest[i, w], q[i, w], phdd[w])
+                        v = velocity(thd[i, w], acc[i, w], thdd, dt)
+                        v += theta_ddot(c, m, (blk, w), 0.0, q[i, w], jump[w])
+                        moved = tn_s[i, w] + theta_ddot(c, m, (blk, w), 0.0, q[i, w], shift[w])
+                        thd[i, w] = v if keep else thd[i, w]
+                        th[i, w] = moved if keep else th[i, w]
+                        acc[i, w] = thdd if keep else acc[i, w]
+                        s_p[w] += q[i, w] * v
+            else:
+                for i in range(n):
+                    for w in range(LANES):  # vectorized across runs
+                        keep = alive[w] > 0.0
+                        thdd = theta_ddot(c, (blk, i, w), (blk, w), rest[i, w], q[i, w], phdd[w])
+                        v = velocity(thd[i, w], acc[i, w], thdd, dt)
+                        thd[i, w] = v if keep else thd[i, w]
+                        th[i, w] = tn_s[i, w] if keep else th[i, w]
+                        acc[i, w] = thdd if keep else acc[i, w]
+                        s_p[w] += q[i, w] * v
             for w in range(LANES):
                 if alive[w] > 0.0:
-                    ph[w] = ph_new[w]
-                    pp[w] = momentum(pp[w], fph[w], force[w], dt, math.isinf(c.total_inertia[blk, w]))  # fmt: skip  # noqa: E501
+                    pinned = math.isinf(c.total_inertia[blk, w])
+                    ph[w] = ph_new[w] + shift[w]
+                    pp[w] = momentum(pp[w], fph[w], force[w], dt, pinned)
+                    pp[w] += 0.0 if pinned else jump_p[w]
                     phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                     fph[w] = force[w]
                     aph[w] = phdd[w]
+                jump[w] = 0.0
+                shift[w] = 0.0
+                jump_p[w] = 0.0
             if dry:
                 _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0)  # fmt: skip  # noqa: E501
             until_record -= 1
@@ -182,6 +225,43 @@ def advance(st, c, settings, rec):
                 last_kick[b0 + w, i] = lk[i, w]
 
 
+@nb.njit(inline="always")
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
+    """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
+    ``blk``, with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's;
+    ``t_new`` into ``lk`` where a live lane's escapement fires. Fills the per-lane
+    counts of upward crossings, impulses and overturns; returns the number of
+    far-wound angles."""
+    n_far = 0
+    for w in range(th.shape[1]):
+        counts[0, w] = 0
+        counts[1, w] = 0
+        counts[2, w] = 0
+        s_num[w] = 0.0
+        s_den[w] = 0.0
+        s_kick[w] = 0.0
+    for i in range(th.shape[0]):
+        for w in range(th.shape[1]):  # vectorized across runs
+            t0 = th[i, w]
+            tn, vp, fires, torque, kick = begin(c, (blk, i, w), t0, thd[i, w], acc[i, w], dt, dt2)
+            counts[0, w] += 1 if upward(t0, tn) else 0
+            counts[1, w] += 1 if kick != 0.0 else 0
+            kicks[i, w] = kick
+            fired = (fires != 0.0) & (alive[w] > 0.0)
+            lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
+            counts[2, w] += 1 if abs(tn) > overturn_angle else 0
+            n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
+            sn, cs = trig(tn)
+            res, qi, num, den = pendulum_terms(c, (blk, i, w), torque, sn, cs, vp)
+            s_num[w] += num
+            s_den[w] += den
+            s_kick[w] += torque
+            tn_s[i, w] = tn
+            rest[i, w] = res
+            q[i, w] = qi
+    return n_far
+
+
 @nb.njit(cache=True, inline="always")
 def load_last_kick(last_kick, b0, lanes):
     """Block-local copy (n, LANES) of the runs' last impulse times (as `load_block`)."""
@@ -191,40 +271,6 @@ def load_last_kick(last_kick, b0, lanes):
         for w in range(LANES):
             lk[i, w] = last_kick[b0 + min(w, lanes - 1), i]
     return lk
-
-
-@nb.njit(cache=True, inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, overs, lk, alive, t_new, trig):  # fmt: skip  # noqa: E501
-    """New angles, kicks and the per-lane sums of eqs. (eqm1)–(eqm2) for block ``blk``,
-    with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's; ``t_new``
-    into ``lk`` where a live lane's escapement fires. Fills the per-lane counts of upward
-    crossings and overturns; returns the number of far-wound angles."""
-    n_far = 0
-    for w in range(th.shape[1]):
-        ups[w] = 0
-        overs[w] = 0
-        s_num[w] = 0.0
-        s_den[w] = 0.0
-        s_kick[w] = 0.0
-    for i in range(th.shape[0]):
-        for w in range(th.shape[1]):  # vectorized across runs
-            t0 = th[i, w]
-            tn, vp = drift(t0, thd[i, w], acc[i, w], dt, dt2)
-            kick = escapement(c, (blk, i, w), t0, tn)
-            ups[w] += 1 if upward(t0, tn) else 0
-            fired = (kick != 0.0) & (alive[w] > 0.0)
-            lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
-            overs[w] += 1 if abs(tn) > overturn_angle else 0
-            n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
-            sn, cs = trig(tn)
-            res, qi, num, den = pendulum_terms(c, (blk, i, w), kick, sn, cs, vp)
-            s_num[w] += num
-            s_den[w] += den
-            s_kick[w] += kick
-            tn_s[i, w] = tn
-            rest[i, w] = res
-            q[i, w] = qi
-    return n_far
 
 
 @nb.njit(cache=True)
