@@ -32,7 +32,7 @@ import numba
 from kernel_scalar import advance_state as previous_kernel
 
 from metrosync import build_ensemble, get_preset
-from metrosync.integrators import reference, verlet
+from metrosync.integrators import layouts, twin, verlet
 from metrosync.integrators._state import StepState
 
 #: The clock the rates are timed with (`main` switches it for ``--cpu-time``).
@@ -49,7 +49,7 @@ def rate(ensemble, steps: int, dt: float, layout: str | None) -> float:
     options = dict(dt=dt, step0=0, n_steps=steps, record_every=10, overturn_angle=math.pi / 2)
     start = clock()
     if layout is None:
-        reference.advance_state(state, ensemble.system, **options)
+        twin.VERLET.advance_state(state, ensemble.system, **options)
     elif layout == "previous":
         previous_kernel(state, ensemble.system, **options)
     else:
@@ -94,7 +94,7 @@ def main() -> None:
     for size in args.sizes:
         b, n = (int(x) for x in size.lower().split("x"))
         ens = ensemble_of(b, n)
-        layout = verlet.choose_layout(n, b)
+        layout = layouts.choose_layout(n, b)
         fast = best(ens, steps, args.dt, layout, args.repeats)
         previous = best(ens, steps, args.dt, "previous", args.repeats)
         slow = rate(ens, args.baseline_steps, args.dt, None)
@@ -113,7 +113,7 @@ def main() -> None:
             for b, n in sizes:
                 ens = ensemble_of(b, n)
                 count = max(10, int(work / (b * n)))
-                r = best(ens, count, args.dt, verlet.choose_layout(n, b), args.repeats)
+                r = best(ens, count, args.dt, layouts.choose_layout(n, b), args.repeats)
                 print(f"    B = {b:>6}  N = {n:>6}  {1e9 / r:7.2f} ns  ({r:.3e} osc-steps/s)")
 
 

@@ -9,6 +9,7 @@ and in *CPU time* of the process: on a shared, loaded machine wall-clock rates s
     git worktree add /tmp/before <commit>        # or: git archive <commit> | tar -x -C DIR
     python benchmarks/kernel_ab.py --before /tmp/before --after .
     python benchmarks/kernel_ab.py --before /tmp/before --after . --sizes 100x7 --rounds 8
+    python benchmarks/kernel_ab.py --before /tmp/before --after . --scheme located
 """
 
 from __future__ import annotations
@@ -24,17 +25,18 @@ CHILD = """
 import math, sys, time
 import numpy as np
 from metrosync import build_ensemble, get_preset
-from metrosync.integrators import verlet
+import importlib
 from metrosync.integrators._state import StepState
 
 b, n, steps, repeats = (int(x) for x in sys.argv[1:5])
+scheme = importlib.import_module("metrosync.integrators." + sys.argv[5])
 ens = build_ensemble(n, 192.0, params=get_preset("default"), sigma_bpm=0.75, runs=b, seed=1)
 
 def once(k):
     st = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                          n_records=k // 10 + 1, trajectories=False)
     start = time.process_time()
-    verlet.advance_state(st, ens.system, dt=0.01, step0=0, n_steps=k, record_every=10,
+    scheme.advance_state(st, ens.system, dt=0.01, step0=0, n_steps=k, record_every=10,
                          overturn_angle=math.pi / 2)
     return b * n * k / (time.process_time() - start)
 
@@ -44,11 +46,11 @@ print(max(rates), float(np.median(rates)))
 """
 
 
-def rate(tree: Path, b: int, n: int, work: float, repeats: int) -> tuple[float, float]:
+def rate(tree: Path, b: int, n: int, work: float, repeats: int, scheme: str) -> tuple[float, float]:
     env = {**os.environ, "PYTHONPATH": str(tree / "src"), "NUMBA_NUM_THREADS": "1"}
     steps = max(10, int(work / (b * n)))
     done = subprocess.run(
-        [sys.executable, "-c", CHILD, str(b), str(n), str(steps), str(repeats)],
+        [sys.executable, "-c", CHILD, str(b), str(n), str(steps), str(repeats), scheme],
         env=env, capture_output=True, text=True, check=False,
     )  # fmt: skip
     if done.returncode != 0:
@@ -67,6 +69,9 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=6, help="interleaved rounds")
     parser.add_argument("--repeats", type=int, default=12, help="timings per figure")
     parser.add_argument("--work", type=float, default=2e6, help="oscillator-steps per timing")
+    parser.add_argument(
+        "--scheme", default="verlet", choices=["verlet", "located"], help="fixed-step scheme"
+    )
     args = parser.parse_args()
     for tree in (args.before, args.after):
         if not (tree / "src" / "metrosync").is_dir():
@@ -74,12 +79,12 @@ def main() -> None:
     sizes = [tuple(int(x) for x in size.lower().split("x")) for size in args.sizes]
     for b, n in sizes:  # compile both once, outside the rounds
         for tree in (args.before, args.after):
-            rate(tree, b, n, 1e4, 1)
+            rate(tree, b, n, 1e4, 1, args.scheme)
     best = {(tree, size): [] for tree in ("before", "after") for size in sizes}
     for k in range(args.rounds):
         for b, n in sizes:
             for name, tree in (("before", args.before), ("after", args.after)):
-                top, median = rate(tree, b, n, args.work, args.repeats)
+                top, median = rate(tree, b, n, args.work, args.repeats, args.scheme)
                 best[name, (b, n)].append(top)
                 print(f"round {k + 1}  {b:>5}x{n:<5} {name:>6}: best {top:.3e}  "
                       f"median {median:.3e} osc-steps/CPU-s", flush=True)  # fmt: skip

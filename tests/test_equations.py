@@ -135,13 +135,12 @@ def test_applied_torque_is_a_sine_at_the_forcing_bpm():
 
 def test_escapement_kicks_where_theta_crosses_its_offset(random_system):
     sys = replace(random_system(b=1, n=1), escapement_offset=np.full((1, 1), 0.05))
-    rate = sys.drive[0, 0] / 0.01
     for before, after, want in [
-        (0.04, 0.06, rate), (0.06, 0.04, -rate),
+        (0.04, 0.06, 1.0), (0.06, 0.04, -1.0),
         (-0.01, 0.01, 0.0), (0.01, -0.01, 0.0),  # crossing 0 is no longer a kick
         (0.05, 0.06, 0.0), (0.04, 0.05, 0.0),  # touching δ is not crossing it
     ]:  # fmt: skip
-        kick = escapement(sys, np.array([[before]]), np.array([[after]]), 0.01)
+        kick = escapement(sys, np.array([[before]]), np.array([[after]]))
         assert kick[0, 0] == want, (before, after)
 
 

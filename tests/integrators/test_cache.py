@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import numba as nb
 import pytest
 
-from metrosync.integrators import _cache, kernel_oscillators, kernel_runs
+from metrosync.integrators import _cache, layout_metronomes, layout_runs, located, verlet
 
 
 def modules_compiled_into(module, seen=None) -> set[str]:
@@ -34,7 +34,7 @@ def modules_compiled_into(module, seen=None) -> set[str]:
 
 def test_stamp_covers_every_module_the_kernels_use():
     stamped = {path.resolve() for path in _cache.stamped_sources()}
-    for kernel in (kernel_runs, kernel_oscillators):
+    for kernel in (verlet, located, layout_runs, layout_metronomes):
         for name in modules_compiled_into(kernel):
             path = Path(sys.modules[name].__file__).resolve()
             assert path in stamped, f"{kernel.__name__} uses {name}, which the stamp misses"
@@ -43,7 +43,7 @@ def test_stamp_covers_every_module_the_kernels_use():
 def test_every_module_of_the_package_counts_as_ours(tmp_path):
     folder = tmp_path / "__pycache__"
     folder.mkdir()
-    for name in ("_physics.pendulum_terms-60.py311.nbi", "kernel_runs.advance-57.py311.1.nbc",
+    for name in ("_physics.pendulum_terms-60.py311.nbi", "verlet.advance_runs-57.py311.1.nbc",
                  "trig.sincos-53.py311.nbi"):  # fmt: skip
         assert _cache._ours(folder / name)
     assert not _cache._ours(folder / "somebody_else.f-1.py311.nbi")
@@ -86,13 +86,13 @@ def test_the_kernel_folder_is_numba_s_own_for_this_package(tmp_path, monkeypatch
     monkeypatch.setattr(nb.config, "CACHE_DIR", str(tmp_path))
     folder = _cache.kernel_cache_dir()
     assert folder.parent == tmp_path and folder.name.startswith("integrators_")
-    assert _cache._folder_of(kernel_runs.advance) == folder
-    assert _cache.kernel_name(kernel_runs.advance) == "kernel_runs.advance"
-    assert not _cache.is_cached(kernel_runs.advance)
+    assert _cache._folder_of(verlet.advance_runs) == folder
+    assert _cache.kernel_name(verlet.advance_runs) == "verlet.advance_runs"
+    assert not _cache.is_cached(verlet.advance_runs)
     folder.mkdir()
-    (folder / "kernel_runs.advance-72.py311.nbi").write_bytes(b"")
-    assert _cache.is_cached(kernel_runs.advance)
-    assert not _cache.is_cached(kernel_oscillators.advance)
+    (folder / "verlet.advance_runs-72.py311.nbi").write_bytes(b"")
+    assert _cache.is_cached(verlet.advance_runs)
+    assert not _cache.is_cached(verlet.advance_metronomes)
 
 
 def test_a_sweep_point_s_seconds_leave_out_compiling(monkeypatch):

@@ -8,7 +8,7 @@ import pytest
 
 from metrosync import ParameterError, build_ensemble, get_preset, simulate
 from metrosync.equations import SystemArrays, accelerations, dry_friction, holding_torque
-from metrosync.integrators import kernel_cuda, reference, verlet
+from metrosync.integrators import kernel_cuda, twin, verlet
 from metrosync.integrators._abi import constants_of
 from metrosync.integrators._physics import disk_friction, disk_friction_stop, pendulum_terms
 from metrosync.integrators._state import StepState
@@ -16,8 +16,8 @@ from metrosync.integrators._state import StepState
 DT = 0.01
 BACKENDS = {
     "runs": lambda *a, **k: verlet.advance_state(*a, layout="runs", **k),
-    "oscillators": lambda *a, **k: verlet.advance_state(*a, layout="oscillators", **k),
-    "numpy": reference.advance_state,
+    "metronomes": lambda *a, **k: verlet.advance_state(*a, layout="metronomes", **k),
+    "numpy": twin.VERLET.advance_state,
 }
 
 
@@ -132,7 +132,7 @@ def test_scalar_friction_law_equals_the_vectorised_one(rng, random_system):
     # Thresholds from well below to well above each run's holding torque.
     sys = SystemArrays(**{**vars(sys), "dry_friction": np.abs(holding) * rng.uniform(0.3, 3, 40)})
     want = dry_friction(sys, phi_dot, holding)
-    c = constants_of(sys, DT)
+    c = constants_of(sys)
     for b in range(40):
         sum_num = sum(
             pendulum_terms(c, (b, i), kick[b, i], math.sin(theta[b, i]), math.cos(theta[b, i]),
@@ -168,7 +168,7 @@ def test_friction_at_a_stop_brings_the_step_to_rest(rng, random_system):
         return (p - coupling) / sys.total_inertia
 
     start = -1e-3 * np.sign(phi_dot)
-    c = constants_of(sys, DT)
+    c = constants_of(sys)
     sum_den = np.sum(sys.mh**2 * np.cos(theta) ** 2 / sys.inertia, axis=1)
     for b, v in enumerate(end_velocity(start)):
         stop, held = disk_friction_stop(c, b, start[b], v, sum_den[b], DT)

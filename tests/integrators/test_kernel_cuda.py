@@ -14,7 +14,7 @@ SIMULATED_CHECK = """
 import math
 import numpy as np
 from metrosync import build_ensemble, get_preset
-from metrosync.integrators import kernel_cuda, reference
+from metrosync.integrators import kernel_cuda, twin
 from metrosync.integrators._state import StepState
 
 def run(advance, **kw):
@@ -39,7 +39,7 @@ for groups, changes, start in ((None, {}, {}), ([(2, 186.0), (3, 198.0)], {}, {}
     ens = build_ensemble(5, 192.0, params=params, sigma_bpm=2.0, runs=2, seed=3,
                          groups=groups, **start)
     gpu = run(kernel_cuda.advance_state, threads=4)
-    ref = run(reference.advance_state)
+    ref = run(twin.VERLET.advance_state)
     assert np.count_nonzero(ref.cross_count) > 0, "no crossing was booked"
     for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r", "r_group", "cross_count",
                  "last_kick"):
@@ -56,7 +56,7 @@ theta_dot0[1, 0] = 1e200
 ens = build_ensemble(3, 192.0, params=get_preset("default"), runs=2, seed=3,
                      theta0=np.full((2, 3), 0.3), theta_dot0=theta_dot0)
 gpu = run(kernel_cuda.advance_state, threads=4)
-ref = run(reference.advance_state)
+ref = run(twin.VERLET.advance_state)
 assert ref.status[1] & 2 and np.isnan(ref.r[1]).all()
 np.testing.assert_array_equal(gpu.status, ref.status)
 np.testing.assert_allclose(gpu.r, ref.r, rtol=0, atol=1e-9)  # NaN in the same places

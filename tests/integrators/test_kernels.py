@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from metrosync import build_ensemble, get_preset
-from metrosync.integrators import kernel_oscillators, kernel_runs, reference, verlet
+from metrosync.integrators import layout_metronomes, layout_runs, layouts, twin, verlet
 from metrosync.integrators._abi import constants_of, settings_of
 from metrosync.integrators._state import StepState
 from metrosync.integrators.trig import REDUCTION_LIMIT, sincos
@@ -78,7 +78,7 @@ FEATURES["all"] = lambda n: {
 def test_every_layout_matches_the_reference_over_1000_steps(layout, n, runs, feature):
     options = {"params": get_preset("default"), "sigma_bpm": 2.0, **FEATURES[feature](n)}
     ens = build_ensemble(n, 192.0, runs=runs, seed=7, **options)
-    ref = run(reference.advance_state, ens, 1000)
+    ref = run(twin.VERLET.advance_state, ens, 1000)
     got = run(verlet.advance_state, ens, 1000, layout=layout)
     for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "traj_theta", "r", "r_group"):
         np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=0, atol=1e-10)
@@ -107,7 +107,7 @@ def test_a_run_diverged_from_the_start_records_nothing_in_any_layout(layout):
     theta_dot0[1, 2] = 1e200  # θ̇² overflows in the very first force evaluation
     ens = build_ensemble(4, 192.0, params=get_preset("default"), runs=3, seed=2,
                          theta0=np.full((3, 4), 0.3), theta_dot0=theta_dot0)  # fmt: skip
-    ref = run(reference.advance_state, ens, 30)
+    ref = run(twin.VERLET.advance_state, ens, 30)
     got = run(verlet.advance_state, ens, 30, layout=layout)
     assert ref.status[1] & STATUS_DIVERGED and np.isnan(ref.r[1]).all()
     np.testing.assert_array_equal(got.status, ref.status)
@@ -116,9 +116,9 @@ def test_a_run_diverged_from_the_start_records_nothing_in_any_layout(layout):
 
 
 def test_layout_follows_the_problem():
-    assert verlet.choose_layout(7, 100) == "runs"
-    assert verlet.choose_layout(7, 4) == "oscillators"  # too few runs to fill a block
-    assert verlet.choose_layout(64, 100) == "oscillators"
+    assert layouts.choose_layout(7, 100) == "runs"
+    assert layouts.choose_layout(7, 4) == "metronomes"  # too few runs to fill a block
+    assert layouts.choose_layout(64, 100) == "metronomes"
 
 
 def test_far_wound_angles_fall_back_to_libm():
@@ -126,8 +126,8 @@ def test_far_wound_angles_fall_back_to_libm():
     far = [2.5 * REDUCTION_LIMIT, 0.1, -0.1]
     params = get_preset("default")
     ens = build_ensemble(3, 192.0, params=params, runs=2, seed=1, theta0=far, theta_dot0=[0.0] * 3)
-    ref = run(reference.advance_state, ens, 200)
-    for layout in ("runs", "oscillators"):
+    ref = run(twin.VERLET.advance_state, ens, 200)
+    for layout in ("runs", "metronomes"):
         got = run(verlet.advance_state, ens, 200, layout=layout)
         np.testing.assert_allclose(got.theta, ref.theta, rtol=1e-13, atol=1e-10)
 
@@ -146,13 +146,14 @@ def test_fast_sincos_is_within_two_ulp_of_libm(rng):
         assert np.max(np.abs(c - np.cos(x)) / np.spacing(np.abs(np.cos(x)))) <= 2
 
 
-def packed_double_ops(module, fastmath, ens):
-    """Recompile ``module.advance`` without the cache and count AVX packed-double ops."""
+def packed_double_ops(kernel, layout, fastmath, ens):
+    """Recompile ``kernel`` (in ``layout``) without the cache and count AVX packed-double
+    ops."""
     state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                             n_records=2, trajectories=False)  # fmt: skip
-    fresh = nb.njit(parallel=True, fastmath=fastmath)(module.advance.py_func)
+    fresh = nb.njit(parallel=True, fastmath=fastmath)(kernel.py_func)
     settings = settings_of(dt=0.01, step0=0, n_steps=10, record_every=10, overturn_angle=1.5)
-    constants = module.arrange(constants_of(ens.system, 0.01))
+    constants = layout.arrange(constants_of(ens.system))
     fresh(state.kernel_state(), constants, settings, state.kernel_recording())
     asm = "\n".join(fresh.inspect_asm().values())
     return len(re.findall(r"\tv\w+pd\t[^\n]*%[yz]mm", asm))
@@ -160,16 +161,20 @@ def packed_double_ops(module, fastmath, ens):
 
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    "module, fastmath",
-    [(kernel_runs, False), (kernel_oscillators, kernel_oscillators.FASTMATH)],
+    "kernel, layout, fastmath",
+    [
+        (verlet.advance_runs, layout_runs, False),
+        (verlet.advance_metronomes, layout_metronomes, layout_metronomes.FASTMATH),
+    ],
 )
-def test_hot_loops_are_vectorized(module, fastmath):
+def test_hot_loops_are_vectorized(kernel, layout, fastmath):
     ens = build_ensemble(5, 192.0, params=get_preset("default"), runs=3, seed=1)
-    count = packed_double_ops(module, fastmath, ens)
+    count = packed_double_ops(kernel, layout, fastmath, ens)
     assert count >= 100, (
-        f"{module.__name__}: only {count} AVX packed-double instructions in the generated "
-        f"code; the hot loop no longer vectorizes (a branch, a call or a float reduction in "
-        f"it?). Inspect with `inspect_asm()` on a fresh, uncached njit of the kernel."
+        f"{kernel.__name__} in {layout.__name__}: only {count} AVX packed-double instructions "
+        f"in the generated code; the hot loop no longer vectorizes (a branch, a call or a "
+        f"float reduction in it?). Inspect with `inspect_asm()` on a fresh, uncached njit of "
+        f"the kernel."
     )
 
 
@@ -190,7 +195,7 @@ def test_a_corrupt_compile_cache_is_rebuilt_not_used(tmp_path):
     assert again.returncode == 0, again.stderr
     assert again.stdout == first.stdout
     # A kernel source that changed (here: a stamp that no longer matches) purges the cache.
-    index = sorted(Path(tmp_path / "cache").rglob("kernel_*.advance-*.nbi"))
+    index = sorted(Path(tmp_path / "cache").rglob("verlet.advance_*-*.nbi"))
     assert index, "the kernel was not cached again"
     before = index[0].stat().st_mtime_ns
     (stamp,) = Path(tmp_path / "cache").rglob("metrosync-kernels.stamp")
@@ -210,7 +215,7 @@ def test_every_layout_gives_the_same_ensemble_statistics():
     steps = 30_000  # 300 s
     stats = {}
     backends = {layout: partial(verlet.advance_state, layout=layout) for layout in verlet.LAYOUTS}
-    backends["numpy"] = reference.advance_state
+    backends["numpy"] = twin.VERLET.advance_state
     for name, advance in backends.items():
         state = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
                                 n_records=steps // 10 + 1, trajectories=False)  # fmt: skip

@@ -8,7 +8,7 @@ import pytest
 from test_kernels import DEATH_OFFSET, ESCAPEMENT, FEATURES, FORCING, with_changes
 
 from metrosync import ParameterError, build_ensemble, get_preset, simulate
-from metrosync.integrators import REGISTRY, located, reference_located, verlet
+from metrosync.integrators import REGISTRY, located, twin, verlet
 from metrosync.integrators._state import StepState
 
 
@@ -38,7 +38,7 @@ LOCATED_FEATURES["all"] = lambda n: {
 def test_every_layout_matches_the_numpy_twin_over_1000_steps(layout, n, runs, feature):
     options = {"params": get_preset("default"), "sigma_bpm": 2.0, **LOCATED_FEATURES[feature](n)}
     ens = build_ensemble(n, 192.0, runs=runs, seed=7, **options)
-    ref = run(reference_located.advance_state, ens, 1000)
+    ref = run(twin.LOCATED.advance_state, ens, 1000)
     got = run(located.advance_state, ens, 1000, layout=layout)
     assert np.count_nonzero(np.diff(np.sign(ref.traj_theta), axis=1)) > 50 * runs  # kicks
     names = ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "acc_theta", "traj_theta", "r")

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from metrosync import equations
-from metrosync.integrators import _kernel_parts, _physics, kernel_runs
+from metrosync.integrators import _kernel_parts, _physics, layout_runs, located, verlet
 from metrosync.integrators._abi import Constants, constants_of
 from metrosync.integrators._physics import (
     applied_torque,
@@ -57,7 +57,7 @@ def scalar_accelerations(c, theta, theta_dot, phi_dot, kick, t, blocked):
     phdd, thdd, force = np.empty(b_runs), np.empty((b_runs, n)), np.empty(b_runs)
     for b in range(b_runs):
         if blocked:
-            blk, lane = divmod(b, kernel_runs.LANES)
+            blk, lane = divmod(b, layout_runs.LANES)
             m_of, r = [(blk, i, lane) for i in range(n)], (blk, lane)
         else:
             m_of, r = [(b, i) for i in range(n)], b
@@ -90,9 +90,9 @@ def test_scalar_physics_equals_the_vectorised_equations(rng, random_system, bloc
         theta_dot = rng.normal(0, 5, sys.shape)
         phi_dot = rng.normal(0, 1, sys.shape[0])
         kick = rng.choice([-1.0, 0.0, 1.0], sys.shape) * sys.drive / DT
-        c = constants_of(sys, DT)
+        c = constants_of(sys)
         if blocked:
-            c = kernel_runs.arrange(c)
+            c = layout_runs.arrange(c)
         phdd, thdd, force = scalar_accelerations(c, theta, theta_dot, phi_dot, kick, 1.5, blocked)
         want_phdd, want_thdd = equations.accelerations(sys, theta, theta_dot, phi_dot, kick, 1.5)
         scale = np.abs(kick).max() + 1.0
@@ -104,22 +104,37 @@ def test_scalar_physics_equals_the_vectorised_equations(rng, random_system, bloc
 
 def test_escapement_is_the_papers_discrete_kick(random_system):
     sys = random_system(b=1, n=1)
-    c = constants_of(sys, DT)
-    rate = sys.drive[0, 0] / DT
+    c = constants_of(sys)
     for before, after, want in [
-        (-0.1, 0.1, rate), (0.1, -0.1, -rate), (0.1, 0.2, 0.0), (-0.1, -0.2, 0.0),
+        (-0.1, 0.1, 1.0), (0.1, -0.1, -1.0), (0.1, 0.2, 0.0), (-0.1, -0.2, 0.0),
         (0.0, 0.1, 0.0), (-0.1, 0.0, 0.0),  # touching 0 is not crossing it
     ]:  # fmt: skip
         assert escapement.py_func(c, (0, 0), before, after) == want
         assert escapement(c, (0, 0), before, after) == want
 
 
+@pytest.mark.parametrize("scheme", [verlet, located])
+def test_a_scheme_makes_the_escapement_a_torque_or_an_impulse(random_system, scheme):
+    """The physics says where and which way; ``verlet`` makes it the paper's torque
+    ±M/dt over the step, ``located`` an impulse ±M at the crossing."""
+    sys = random_system(b=1, n=1)
+    c = constants_of(sys)
+    drive = sys.drive[0, 0]
+    for before, velocity, sign in [(-0.05, 10.0, 1.0), (0.05, -10.0, -1.0), (0.05, 1.0, 0.0)]:
+        after, _, fires, torque, impulse = scheme.begin(c, (0, 0), before, velocity, 0.0, DT, DT**2)
+        assert after == before + velocity * DT and fires == sign
+        if scheme is verlet:
+            assert torque == sign * drive * (1.0 / DT) and impulse == 0.0
+        else:
+            assert torque == 0.0 and impulse == sign * drive
+
+
 def test_scalar_escapement_kicks_at_its_offset_like_the_vectorised_one(rng, random_system):
     sys = with_features(random_system(b=3, n=50), rng)
-    c = constants_of(sys, DT)
+    c = constants_of(sys)
     theta = sys.escapement_offset + rng.uniform(-0.05, 0.05, sys.shape)
     theta_next = sys.escapement_offset + rng.uniform(-0.05, 0.05, sys.shape)
-    want = equations.escapement(sys, theta, theta_next, DT)
+    want = equations.escapement(sys, theta, theta_next)
     got = [[escapement(c, (b, i), theta[b, i], theta_next[b, i]) for i in range(50)]
            for b in range(3)]  # fmt: skip
     np.testing.assert_array_equal(got, want)
@@ -129,7 +144,7 @@ def test_scalar_escapement_kicks_at_its_offset_like_the_vectorised_one(rng, rand
 def test_applied_torque_is_off_unless_forced(random_system):
     sys = random_system(b=2, n=1)
     forced = replace(sys, forcing_amplitude=np.array([0.0, 0.01]), forcing_omega=np.full(2, 20.0))
-    c = constants_of(forced, DT)
+    c = constants_of(forced)
     assert applied_torque(c, 0, 0.3) == 0.0
     assert applied_torque(c, 1, 0.3) == pytest.approx(0.01 * math.sin(6.0), rel=1e-15)
 
@@ -140,11 +155,11 @@ def test_disk_velocity_inverts_the_disk_momentum(rng, random_system):
     theta_dot = rng.normal(0, 3, sys.shape)
     phi_dot = rng.normal(0, 1, 3)
     p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
-    c = constants_of(sys, DT)
+    c = constants_of(sys)
     for b in range(3):
         coupling = float(np.sum(sys.mh[b] * np.cos(theta[b]) * theta_dot[b]))
         assert disk_velocity(c, b, p_phi[b], coupling) == pytest.approx(phi_dot[b], rel=1e-12)
-    pinned = constants_of(equations.SystemArrays(**{**vars(sys), "total_inertia": np.full(3, np.inf)}), DT)  # fmt: skip  # noqa: E501
+    pinned = constants_of(equations.SystemArrays(**{**vars(sys), "total_inertia": np.full(3, np.inf)}))  # fmt: skip  # noqa: E501
     assert disk_velocity(pinned, 0, 1.0, 2.0) == 0.0
 
 

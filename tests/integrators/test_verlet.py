@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from metrosync import OverturnWarning, build_ensemble, get_preset, simulate
-from metrosync.integrators import REGISTRY, reference, verlet
+from metrosync.integrators import REGISTRY, twin, verlet
 from metrosync.integrators._state import StepState
 from metrosync.status import STATUS_DIVERGED, STATUS_OVERTURNED
 
@@ -28,7 +28,7 @@ def run_backend(backend, ensemble, steps, *, dt=0.01, record_every=10, chunks=1)
 
 def test_compiled_kernel_matches_plain_reference_over_1000_steps(small_ensemble):
     fast = run_backend(verlet, small_ensemble, 1000)
-    slow = run_backend(reference, small_ensemble, 1000)
+    slow = run_backend(twin.VERLET, small_ensemble, 1000)
     assert np.count_nonzero(np.diff(np.sign(fast.traj_theta), axis=1)) > 50  # kicks happened
     for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "acc_theta"):
         np.testing.assert_allclose(getattr(fast, name), getattr(slow, name), rtol=0, atol=1e-10)
