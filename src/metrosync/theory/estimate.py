@@ -30,7 +30,7 @@ from scipy.integrate import quad
 from scipy.special import ellipk
 
 from ..model import ModelParameters, get_preset
-from .coupling import Coupling, _tuned, disk_scale
+from ._coupling_base import Coupling, disk_scale, tuned_metronome
 from .tuning import relaxation_rate, with_tuning
 
 
@@ -54,7 +54,7 @@ def estimate(
 ) -> Coupling:
     """The first-order analytic K e^{−iα} (module docstring); its error is not known (0)."""
     params = with_tuning(get_preset(params, warn=False), tuning)
-    metronome, swing = _tuned(bpm, params)
+    metronome, swing = tuned_metronome(bpm, params)
     p = params.platform
     scale = disk_scale(n, params)
     mu_per_n = (metronome.mass * p.radius * metronome.h) ** 2 / metronome.inertia * scale
