@@ -50,6 +50,7 @@ import itertools
 from dataclasses import dataclass, replace
 
 from ..errors import ParameterError
+from ..model import TUNINGS
 from .studies import (
     FIG8_BOTTOM,
     FIG8_TOP,
@@ -66,7 +67,6 @@ from .studies import (
 from .studies import ZGrid as _ZGrid
 
 SIGMA_FACTORS = {"beat": 1.0, "period": 2.0}
-TUNINGS = ("small-amplitude", "steady-swing")
 #: (c_θ kg m²/s, M N m s) of each drive reading.
 DRIVES = {"published": (5e-5, 6e-4), "M/10": (5e-5, 6e-5), "c_theta*10": (5e-4, 6e-4)}
 #: The top of the published J range, kg m² (paper §5).

@@ -12,7 +12,8 @@ from dataclasses import dataclass, replace
 
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
-from .tuning import l2_for_bpm, steady_swing
+from ..model.steady_swing import steady_swing
+from ..model.tuning import l2_for_bpm
 
 
 @dataclass(frozen=True)

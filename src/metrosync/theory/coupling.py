@@ -20,7 +20,7 @@ only through indices ≡ ±1 mod N, negligible for N ≥ 16. The phases are the
 experiment's crossing-interpolated phases. One correction: the coupling acts partly
 through the swing amplitude (a metronome pushed ahead swings less and, the pendulum
 being anisochronous, faster), and the amplitude follows with the rate λ_A of
-`tuning.relaxation_rate`. For a mode growing at s this part is weakened by
+`metrosync.model.steady_swing.relaxation_rate`. For a mode growing at s this part is weakened by
 λ_A/(λ_A + s); solving 2s = K cos α · λ_A/(λ_A + s) − iK sin α for the steady values
 (what a slowly drifting oscillator near onset feels) removes it. Half the correction
 is counted as its uncertainty.
@@ -28,7 +28,7 @@ is counted as its uncertainty.
 Method "pair". Two metronomes, detuned by δω, lock at a phase difference Δ* and a
 common frequency Ω. With H(Δ) = Σ_n K_n sin(nΔ − α_n), the pair obeys
 δω = Σ_n K_n cos α_n sin nΔ* and Ω − ω̄ = −Σ_n (K_n/2) sin α_n (1 + cos nΔ*), ω̄ the
-mean free frequency (`tuning.steady_swing`). Locking at several detunings across the
+mean free frequency (`metrosync.model.steady_swing`). Locking at several detunings across the
 locking range and fitting these sums with harmonics {1,2}, {1,3} and {1,2,3} gives
 K₁ cos α₁ and K₁ sin α₁; the spread between the fits is their uncertainty. The
 locked state is stationary, so no amplitude correction is needed.
@@ -49,11 +49,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
+from ..model.steady_swing import relaxation_rate, steady_swing
+from ..model.tuning import l2_for_bpm, with_tuning
 from ..observables.order import crossing_phase
 from ..simulate import simulate
 from ._coupling_base import Coupling, disk_scale, tuned_metronome
 from .estimate import estimate
-from .tuning import l2_for_bpm, relaxation_rate, steady_swing, with_tuning
 
 METHODS = ("growth", "pair")
 #: Most metronomes in a growth run (its trajectories are kept in memory).

@@ -9,7 +9,7 @@ Averaged, that forcing does two things:
   K sin α = −N μ ω c₂ / 2, μ = (m R h)² / (I D₀), c₂ = ⟨cos²θ⟩ over the swing; for one
   metronome this is the exact first-order frequency shift on a free disk (a test);
 * it changes the amplitude, dA_i/dt ∝ μ ω A Σ_j sin(ψ_i − ψ_j), which the escapement
-  pulls back at the rate λ_A (`tuning.relaxation_rate`); the pendulum being
+  pulls back at the rate λ_A (`model.steady_swing.relaxation_rate`); the pendulum being
   anisochronous (dω/dA < 0, elliptic integral), the amplitude change becomes a
   frequency change: K cos α = N μ ω A |dω/dA| c₂ / (2 λ_A).
 
@@ -30,8 +30,9 @@ from scipy.integrate import quad
 from scipy.special import ellipk
 
 from ..model import ModelParameters, get_preset
+from ..model.steady_swing import relaxation_rate
+from ..model.tuning import with_tuning
 from ._coupling_base import Coupling, disk_scale, tuned_metronome
-from .tuning import relaxation_rate, with_tuning
 
 
 def _mean_cos_squared(amplitude: float) -> float:
