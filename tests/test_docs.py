@@ -42,8 +42,8 @@ def test_the_model_page_quotes_the_code_s_numbers():
     text = " ".join(MODEL.read_text().split())
     default, published = PRESETS["default"], PRESETS["boda2013"]
     design, platform = default.metronome, default.platform
-    assert f"{default.steady_amplitude:.2f} rad" in text
-    assert f"{published.steady_amplitude:.1f} rad" in text
+    assert f"{default.balance_amplitude:.2f} rad" in text
+    assert f"{published.balance_amplitude:.1f} rad" in text
     assert f"about {design.with_l2(0.019).natural_bpm:.0f} BPM (L₂ = 0.019 m)" in text
     assert f"down to {design.with_l2(0.049).natural_bpm:.0f} BPM (L₂ = 0.049 m)" in text
     low, high = design.bpm_range()

@@ -14,7 +14,7 @@ from metrosync.sweeps.critical import critical_frequency, plot_critical
 def drawn(monkeypatch):
     """The figures the paper's plotting functions make, instead of writing them."""
     made = []
-    monkeypatch.setattr(figures, "_save", lambda fig, stem: made.append(fig) or [])
+    monkeypatch.setattr(figures, "save_formats", lambda fig, stem: made.append(fig) or [])
     return made
 
 

@@ -197,7 +197,7 @@ def build_ensemble(
     else:
         if theta_dot0 is not None:
             raise ParameterError("`theta_dot0` was given without `theta0`: give both, or neither.")
-        amp = params.steady_amplitude if amplitude is None else amplitude
+        amp = params.balance_amplitude if amplitude is None else amplitude
         if amplitude is None and amp == 0:
             raise ParameterError(
                 "the default start amplitude is the energy-balance amplitude 2M/(pi c_theta), "

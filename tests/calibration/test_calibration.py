@@ -14,7 +14,7 @@ from metrosync.calibration import (
     disk_amplitude,
     fit_c_phi,
     fit_drive,
-    steady_amplitude,
+    simulated_steady_amplitude,
 )
 from metrosync.calibration.pendulum import (
     amplitude_from_ratio,
@@ -58,7 +58,7 @@ def test_c_theta_from_light_gate_log(decay, tmp_path):
 
 
 def test_drive_from_steady_amplitude():
-    amplitude = steady_amplitude(6e-5, c_theta=5e-5)
+    amplitude = simulated_steady_amplitude(6e-5, c_theta=5e-5)
     est = fit_drive(amplitude, c_theta=5e-5)
     assert est.value == pytest.approx(6e-5, rel=0.02)
     # and the model's own answer is near the energy balance 2M/(π c_θ)

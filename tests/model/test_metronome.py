@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from metrosync import Metronome, MetronomeDesign, ParameterError, bpm_to_omega, omega_to_bpm
-from metrosync.model import steady_amplitude
+from metrosync.model import balance_amplitude
 
 
 def test_bpm_means_two_beats_per_period():
@@ -74,6 +74,6 @@ def test_negative_or_non_finite_parameters_are_rejected(field, value):
 
 
 def test_energy_balance_amplitude():
-    assert steady_amplitude(6e-5, 5e-5) == pytest.approx(2 * 6e-5 / (math.pi * 5e-5))
-    assert steady_amplitude(6e-4, 5e-5) == pytest.approx(7.64, abs=0.01)
-    assert steady_amplitude(0.0, 0.0) == 0.0
+    assert balance_amplitude(6e-5, 5e-5) == pytest.approx(2 * 6e-5 / (math.pi * 5e-5))
+    assert balance_amplitude(6e-4, 5e-5) == pytest.approx(7.64, abs=0.01)
+    assert balance_amplitude(0.0, 0.0) == 0.0

@@ -44,7 +44,7 @@ def test_default_preset_is_quiet_and_swings_like_a_metronome():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         params = get_preset("default")
-    assert params.steady_amplitude == pytest.approx(0.764, abs=0.001)
+    assert params.balance_amplitude == pytest.approx(0.764, abs=0.001)
     assert not params.overturns
 
 

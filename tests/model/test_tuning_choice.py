@@ -11,8 +11,8 @@ import pytest
 from metrosync import ParameterError, simulate
 from metrosync.cli._options import parse_changes
 from metrosync.model import TUNINGS, MetronomeDesign, get_preset
+from metrosync.model.steady_swing import steady_swing_bpm_range
 from metrosync.sweeps import Grid
-from metrosync.theory import steady_swing_bpm_range
 
 #: Nominal BPMs across the steady-swing tunable range (81.4 to 227.9 BPM by default).
 ACROSS = (85.0, 120.0, 160.0, 192.0, 225.0)
@@ -96,7 +96,7 @@ def test_the_model_page_quotes_the_steady_swing_numbers():
     from dataclasses import replace
     from pathlib import Path
 
-    from metrosync.theory import steady_swing
+    from metrosync.model.steady_swing import steady_swing
 
     text = " ".join((Path(__file__).parents[2] / "docs" / "model.md").read_text().split())
     design = get_preset("default").metronome

@@ -6,14 +6,9 @@ from dataclasses import replace
 
 import pytest
 
+from metrosync.paper.claims_map import CLAIMS_MAP, ClaimsMapGrid
 from metrosync.paper.pipeline import reproduce
-from metrosync.paper.readings import (
-    CLAIMS_MAP,
-    TODAY,
-    ClaimsMapGrid,
-    ClaimStatistics,
-    Reading,
-)
+from metrosync.paper.readings import TODAY, ClaimStatistics, Reading
 from metrosync.paper.sigma_map import SIGMA_MAP, SigmaMapGrid
 from metrosync.paper.studies import (
     ESTIMATION,

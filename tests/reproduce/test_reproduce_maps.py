@@ -10,11 +10,10 @@ import xarray as xr
 
 from metrosync import ParameterError
 from metrosync.paper.claims import Verdict
-from metrosync.paper.claims_map import rank
+from metrosync.paper.claims_map import CLAIMS_MAP, rank
 from metrosync.paper.map_report import theory_half_note, which_reading
 from metrosync.paper.readings import (
     BEST,
-    CLAIMS_MAP,
     READINGS,
     SCREEN,
     TODAY,

@@ -6,17 +6,16 @@ import numpy as np
 import pytest
 
 from metrosync import ParameterError
+from metrosync.paper.catalogue import STUDIES, get_studies
 from metrosync.paper.studies import (
     FIG8_BOTTOM,
     FIG8_TOP,
     FIG10,
     FIG11,
-    STUDIES,
     TABLE1_SIGMA,
     TABLE2_SIGMA,
     Z_STUDY,
     Statistics,
-    get_studies,
     paper_sigma_to_bpm,
 )
 

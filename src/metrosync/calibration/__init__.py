@@ -8,7 +8,7 @@
 """
 
 from .damping import c_theta_from_log, c_theta_from_trajectory, fit_c_theta
-from .drive import fit_drive, steady_amplitude
+from .drive import fit_drive, simulated_steady_amplitude
 from .estimate import Estimate
 from .platform import disk_amplitude, fit_c_phi
 
@@ -20,5 +20,5 @@ __all__ = [
     "fit_c_phi",
     "fit_c_theta",
     "fit_drive",
-    "steady_amplitude",
+    "simulated_steady_amplitude",
 ]

@@ -17,22 +17,25 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import CalibrationError, OverturnWarning, ParameterError
+from ..model import balance_amplitude
 from ..simulate import simulate
 from .estimate import Estimate
 from .pendulum import swing_amplitudes
 
 
-def steady_amplitude(drive: float, *, c_theta: float, bpm: float = 192.0, preset="default",
-                     changes=None, duration: float = 40.0, dt: float = 0.01,
-                     integrator: str = "verlet") -> float:  # fmt: skip
-    """Mean swing amplitude (rad) over the last quarter of a driven single-metronome run."""
+def simulated_steady_amplitude(drive: float, *, c_theta: float, bpm: float = 192.0,
+                               preset="default", changes=None, duration: float = 40.0,
+                               dt: float = 0.01, integrator: str = "verlet") -> float:  # fmt: skip
+    """Mean swing amplitude (rad) over the last quarter of a driven single-metronome run:
+    the steady amplitude as `simulate` gives it (the closed-form estimate is
+    `metrosync.model.balance_amplitude`, the exact one `metrosync.model.steady_swing`)."""
     params = {
         **(changes or {}),
         "drive": float(drive),
         "c_theta": float(c_theta),
         "inertia": math.inf,
     }
-    start = min(max(2 * drive / (math.pi * c_theta), 0.05), 1.2) if c_theta > 0 else 0.5
+    start = min(max(balance_amplitude(drive, c_theta), 0.05), 1.2) if c_theta > 0 else 0.5
     with warnings.catch_warnings():
         # Trial values of M may overturn: the root finder only needs their amplitude.
         warnings.simplefilter("ignore", OverturnWarning)
@@ -59,7 +62,7 @@ def fit_drive(amplitude: float, *, c_theta: float, bpm: float = 192.0, preset="d
     trials: dict[float, float] = {}
 
     def excess(log_m: float) -> float:
-        value = steady_amplitude(math.exp(log_m), **kw)
+        value = simulated_steady_amplitude(math.exp(log_m), **kw)
         trials[math.exp(log_m)] = value
         return value - amplitude
 

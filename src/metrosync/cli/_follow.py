@@ -19,9 +19,9 @@ def follow(args, analyze_options: dict) -> int:
     from ..lightgate.analyze import analyze_logs
     from ..lightgate.follow import LogFollower
     from ..lightgate.plots import plot_analysis
+    from ..lightgate.summary import summary_text
     from ._io import write_outputs
     from ._live import LivePanel
-    from .analyze import summary
 
     if len(args.logs) != 1:
         raise ParameterError(
@@ -50,7 +50,7 @@ def follow(args, analyze_options: dict) -> int:
                              f"it was followed, so there is nothing to analyse.")  # fmt: skip
     ds = analyze_logs([follower.log()], counter_bits=reading["counter_bits"],
                       polarity=reading["polarity"], **analyze_options)  # fmt: skip
-    print(summary(ds))
+    print(summary_text(ds))
     write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
     # Ctrl-C is how a follow ends, but it is still Ctrl-C: exit status 130, as for every
     # command, with what it wrote.

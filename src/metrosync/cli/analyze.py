@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .._words import plural
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
 from ._audio import add_audio_options, audio_requested, run_audio
@@ -78,6 +77,7 @@ def run(args) -> int:
         return run_audio(args)
     from ..lightgate import analyze
     from ..lightgate.plots import plot_analysis
+    from ..lightgate.summary import summary_text
 
     check_output(args.out, "--out", suffixes=NETCDF)
     check_output(args.plot, "--plot", suffixes=FIGURE)
@@ -97,28 +97,6 @@ def run(args) -> int:
 
         return follow(args, options)
     ds = analyze(args.logs, **options)
-    print(summary(ds))
+    print(summary_text(ds))
     write_outputs(ds, out=args.out, plot=args.plot, plotter=plot_analysis)
     return 0
-
-
-def summary(ds) -> str:
-    """The printed summary: frequencies, jitter, σ, r_eq and the cleaning report."""
-    a = ds.attrs
-    lines = [
-        f"metrosync analyze: {ds.sizes['log']} log(s), "
-        f"{plural(ds.sizes['metronome'], 'metronome')}, "
-        f"common span {float(ds.time[0]):.1f} .. {float(ds.time[-1]):.1f} s",
-        "  metronome  frequency (BPM)  period jitter (ms, mean over logs)  passes bridged",
-    ]
-    jitter = ds.period_jitter.mean("log").values * 1e3
-    bridged = ds.passes_bridged.sum("log").values
-    rows = zip(ds.metronome.values, ds.frequency_bpm.values, jitter, bridged, strict=True)
-    for m, f, j, b in rows:
-        lines.append(f"  {int(m):9d}  {f:15.3f}  {j:34.3f}  {int(b):14d}")
-    lines += [
-        f"  sigma = {a['sigma_bpm']:.4f} BPM ({a['sigma_beats_per_tick']:.3g} beats per tick)",
-        f"  equilibrium r (last {a['equilibrium_window']:.1f} s): {a['r_eq']:.4f}",
-        a["report"],
-    ]
-    return "\n".join(lines)

@@ -30,7 +30,7 @@ def run(args) -> int:
             if key != "preset":
                 print(f"    {key:{width}s} {value} {units.get(key, '')}".rstrip())
         low, high = params.metronome.bpm_range()
-        print(f"    {'steady amp.':{width}s} {params.steady_amplitude:.3f} rad"
+        print(f"    {'steady amp.':{width}s} {params.balance_amplitude:.3f} rad"
               + ("  (OVERTURNS: > pi/2)" if params.overturns else ""))  # fmt: skip
         print(f"    {'tunable BPM':{width}s} {low:.1f} .. {high:.1f} ({params.metronome.tuning})")
         print(f"    {'tick at 192':{width}s} {_tick_at(params.metronome, 192.0)}")
@@ -46,7 +46,7 @@ def _tick_at(design, bpm: float) -> str:
     from dataclasses import replace
 
     from ..errors import ParameterError
-    from ..theory.tuning import steady_swing
+    from ..model.steady_swing import steady_swing
 
     rows = []
     for tuning in ("small-amplitude", "steady-swing"):

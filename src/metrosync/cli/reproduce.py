@@ -10,7 +10,8 @@ from ._options import add_aliases
 
 
 def register(subparsers) -> None:
-    from ..paper.studies import MEASURED_COST, STUDIES
+    from ..paper.catalogue import STUDIES
+    from ..paper.studies import MEASURED_COST
 
     parser = subparsers.add_parser(
         "reproduce",

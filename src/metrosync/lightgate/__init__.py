@@ -10,6 +10,7 @@
 ``live``      what the live panel shows: passes, BPM, silence, running r(t)
 ``recorder``  the logger's serial stream → a capture file, safely
 ``replay``    a capture written into a serial line at its own pace
+``summary``   the printed summary of an analysed dataset
 """
 
 from .analyze import analyze, analyze_logs

@@ -23,8 +23,10 @@ Tuning (docs/model.md §6.1–6.3): one beat is half a period, so
     form; a metronome tuned to "192 BPM" then ticks about 184.7 times a minute at its
     steady swing of 0.76 rad.
 ``"steady-swing"`` puts the *tick rate at the steady swing* on the nominal BPM, as a real
-    metronome's marking does (`metrosync.theory.tuning`, solved once per design and
+    metronome's marking does (`metrosync.model.steady_swing`, solved once per design and
     cached); it needs friction and a drive that does not overturn.
+
+`metrosync.model.tuning` knows the tunings by name (`TUNINGS`, `l2_for_bpm`).
 """
 
 from __future__ import annotations
@@ -35,10 +37,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import ParameterError, describe, require_finite, require_positive, shown_range
+from . import tuning as tunings
 
 STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
-#: How a nominal BPM becomes a slider position (see the module docstring).
-TUNINGS = ("small-amplitude", "steady-swing")
 
 
 def bpm_to_omega(bpm):
@@ -107,10 +108,7 @@ class MetronomeDesign:
     tuning: str = "small-amplitude"
 
     def __post_init__(self) -> None:
-        if self.tuning not in TUNINGS:
-            raise ParameterError(
-                f"unknown `tuning` {self.tuning!r}; choose one of {list(TUNINGS)}."
-            )
+        tunings.check_tuning(self.tuning)
         require_positive("w1", self.w1, unit="kg")
         require_positive("w2", self.w2, allow_zero=True, unit="kg")
         require_positive("l1", self.l1, unit="m")
@@ -146,11 +144,7 @@ class MetronomeDesign:
 
     def bpm_range(self) -> tuple[float, float]:
         """Lowest and highest nominal BPM the slider can tune to, under `tuning`."""
-        if self.tuning == "steady-swing":
-            from ..theory.tuning import steady_swing_bpm_range  # needs scipy; loaded on use
-
-            return steady_swing_bpm_range(self)
-        return self.small_amplitude_range()
+        return tunings.bpm_range(self)
 
     def small_amplitude_range(self) -> tuple[float, float]:
         """Lowest and highest small-amplitude frequency (BPM) the slider reaches."""
@@ -231,12 +225,7 @@ class MetronomeDesign:
 
         Accepts scalars or arrays; raises `ParameterError` for BPM outside `bpm_range`.
         """
-        self.check_tunable(bpm)
-        if self.tuning == "steady-swing":
-            from ..theory.tuning import steady_swing_l2
-
-            return steady_swing_l2(self, bpm)
-        return self.small_amplitude_l2(bpm)
+        return tunings.l2_for_bpm(self, bpm, tuning=self.tuning)
 
     def small_amplitude_l2(self, bpm):
         """``L2`` (m) whose small-amplitude frequency is ``bpm``, whatever `tuning` says.
@@ -321,13 +310,14 @@ class Metronome:
         return float(omega_to_bpm(self.natural_omega))
 
     @property
-    def steady_amplitude(self) -> float:
+    def balance_amplitude(self) -> float:
         """Energy-balance amplitude 2M/(π c_θ), rad (small-angle, rigid support)."""
-        return steady_amplitude(self.design.drive, self.design.c_theta)
+        return balance_amplitude(self.design.drive, self.design.c_theta)
 
 
-def steady_amplitude(drive: float, c_theta: float) -> float:
-    """Amplitude at which the escapement's energy input balances friction, rad.
+def balance_amplitude(drive: float, c_theta: float) -> float:
+    """Amplitude at which the escapement's energy input balances friction, rad: the
+    closed-form, small-angle estimate of the steady swing (rigid support).
 
     Per half period the kick adds ``M·θ̇(0) = M A ω`` and friction removes
     ``c_θ ∫θ̇² dt = π c_θ A² ω / 2``; equating gives ``A = 2M/(π c_θ)``.

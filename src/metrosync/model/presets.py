@@ -13,7 +13,7 @@ import warnings
 from dataclasses import dataclass, field, replace
 
 from ..errors import OverturnWarning, ParameterError
-from .metronome import MetronomeDesign, steady_amplitude
+from .metronome import MetronomeDesign, balance_amplitude
 from .platform import Platform
 
 
@@ -27,13 +27,14 @@ class ModelParameters:
     description: str = ""
 
     @property
-    def steady_amplitude(self) -> float:
-        return steady_amplitude(self.metronome.drive, self.metronome.c_theta)
+    def balance_amplitude(self) -> float:
+        """Energy-balance amplitude 2M/(π c_θ) of the design, rad (`balance_amplitude`)."""
+        return balance_amplitude(self.metronome.drive, self.metronome.c_theta)
 
     @property
     def overturns(self) -> bool:
         """True when the energy-balance amplitude passes the horizontal (π/2)."""
-        return self.steady_amplitude > math.pi / 2
+        return self.balance_amplitude > math.pi / 2
 
     def with_changes(self, **changes) -> ModelParameters:
         """Copy with fields of the metronome design or the platform replaced by name.
@@ -96,7 +97,7 @@ def get_preset(name: str | ModelParameters, *, warn: bool = True) -> ModelParame
     if warn and params.overturns:
         warnings.warn(
             f"preset {params.name!r}: the energy-balance amplitude 2M/(pi c_theta) = "
-            f"{params.steady_amplitude:.2f} rad exceeds pi/2, so the pendulums overturn "
+            f"{params.balance_amplitude:.2f} rad exceeds pi/2, so the pendulums overturn "
             f"(swing past the horizontal). Runs that do are flagged in `status`.",
             OverturnWarning,
             stacklevel=2,

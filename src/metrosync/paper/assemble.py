@@ -1,10 +1,11 @@
 """Assemble a study's dataset from its stored points.
 
 Contract: each point of a study is stored reduced (`metrosync.sweeps.keep`: run-mean
-r(t), per-run equilibrium r and status; or z per run); `assemble` joins a study's
-points into one dataset on the study's own coordinates (``case``; ``n`` × ``bpm``;
-``regime`` × ``theta2``) with the run statistics (mean r_eq and σ_r) and the
-attributes shared by every point.
+r(t), per-run equilibrium r and status; or z per run); each kind of study
+(`metrosync.paper.studies`) joins its points with its own function here into one
+dataset on its own coordinates (``case``: `assemble_time_series`; ``n`` × ``bpm``:
+`assemble_sweep`; ``regime`` × ``theta2``: `assemble_z`) with the run statistics (mean
+r_eq and σ_r) and the attributes shared by every point.
 """
 
 from __future__ import annotations
@@ -13,37 +14,10 @@ import numpy as np
 import xarray as xr
 
 from ..observables import ensemble_statistics
-from .studies import Study, SweepStudy, TimeSeriesStudy, ZStudy
 
-
-def assemble(study: Study, mode: str, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
-    first = parts[0]
-    if isinstance(study, TimeSeriesStudy):
-        ds = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="case")
-        ds = ds.assign_coords(
-            case=[c.label for c in study.cases],
-            n=("case", [c.n for c in study.cases]),
-            bpm=("case", [c.bpm for c in study.cases], {"units": "BPM"}),
-            sigma_bpm=("case", [c.sigma_bpm for c in study.cases], {"units": "BPM"}),
-        )
-        ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
-    elif isinstance(study, SweepStudy):
-        grid = study.grid(mode)
-        stacked = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="point")
-        shape = (len(grid.ns), len(grid.bpms))
-        ds = xr.Dataset(
-            coords={"n": list(grid.ns), "bpm": ("bpm", list(grid.bpms), {"units": "BPM"})}
-        )
-        for name in ("r_eq", "r_eq_analytic", "status", "sigma_realized"):
-            values = stacked[name].values.reshape(shape + (-1,))
-            ds[name] = (("n", "bpm", "run"), values, stacked[name].attrs)
-        ds["r_mean"] = (("n", "bpm", "time"), stacked.r_mean.values.reshape(shape + (-1,)))
-        ds = ds.assign_coords(time=stacked.time, run=stacked.run)
-        ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
-    else:
-        ds = _assemble_z(study, coords, parts)
-    # Attributes that vary between points live in coordinates and variables instead.
-    varying = {
+#: Attributes that vary between points: they live in coordinates and variables instead.
+VARYING = frozenset(
+    {
         "key",
         "error",
         "compute_seconds",
@@ -59,19 +33,55 @@ def assemble(study: Study, mode: str, coords: list[dict], parts: list[xr.Dataset
         "runs",
         "warnings",
     }
-    if isinstance(study, ZStudy):
-        varying |= {"preset", "c_theta", "c_phi", "drive", "theta0", "theta_dot0"}
-    common = {k: v for k, v in first.attrs.items() if k not in varying}
+)
+#: What varies, besides, between the points of a z-study (its regimes).
+VARYING_Z = frozenset({"preset", "c_theta", "c_phi", "drive", "theta0", "theta_dot0"})
+
+
+def assemble_time_series(study, parts: list[xr.Dataset]) -> xr.Dataset:
+    """A `TimeSeriesStudy`'s dataset: its cases' points along ``case``."""
+    ds = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="case")
+    ds = ds.assign_coords(
+        case=[c.label for c in study.cases],
+        n=("case", [c.n for c in study.cases]),
+        bpm=("case", [c.bpm for c in study.cases], {"units": "BPM"}),
+        sigma_bpm=("case", [c.sigma_bpm for c in study.cases], {"units": "BPM"}),
+    )
+    ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
+    return _shared_attrs(ds, parts, VARYING, legend_title=study.legend_title)
+
+
+def assemble_sweep(study, mode: str, parts: list[xr.Dataset]) -> xr.Dataset:
+    """A `SweepStudy`'s dataset: its points on the ``n`` × ``bpm`` grid of ``mode``."""
+    grid = study.grid(mode)
+    stacked = xr.concat([p.drop_attrs(deep=False) for p in parts], dim="point")
+    shape = (len(grid.ns), len(grid.bpms))
+    ds = xr.Dataset(coords={"n": list(grid.ns), "bpm": ("bpm", list(grid.bpms), {"units": "BPM"})})
+    for name in ("r_eq", "r_eq_analytic", "status", "sigma_realized"):
+        values = stacked[name].values.reshape(shape + (-1,))
+        ds[name] = (("n", "bpm", "run"), values, stacked[name].attrs)
+    ds["r_mean"] = (("n", "bpm", "time"), stacked.r_mean.values.reshape(shape + (-1,)))
+    ds = ds.assign_coords(time=stacked.time, run=stacked.run)
+    ds["r_eq_mean"], ds["sigma_r"] = _statistics(ds.r_eq)
+    return _shared_attrs(ds, parts, VARYING, sigma_bpm_study=study.sigma_bpm)
+
+
+def assemble_z(study, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
+    """A `ZStudy`'s dataset: ``regime`` × ``theta2`` from its batches of runs."""
+    return _shared_attrs(_z_grid(study, coords, parts), parts, VARYING | VARYING_Z)
+
+
+def _shared_attrs(ds: xr.Dataset, parts: list[xr.Dataset], varying, **own) -> xr.Dataset:
+    """``ds`` with the attributes every point shares, then its own (``own``), then the
+    points' warnings."""
+    common = {k: v for k, v in parts[0].attrs.items() if k not in varying}
     ds.attrs = {**common, **ds.attrs}
-    if isinstance(study, TimeSeriesStudy):
-        ds.attrs["legend_title"] = study.legend_title
-    elif isinstance(study, SweepStudy):
-        ds.attrs["sigma_bpm_study"] = study.sigma_bpm
+    ds.attrs.update(own)
     ds.attrs["warnings"] = " | ".join(sorted({p.attrs["warnings"] for p in parts}))
     return ds
 
 
-def _assemble_z(study: ZStudy, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
+def _z_grid(study, coords: list[dict], parts: list[xr.Dataset]) -> xr.Dataset:
     by_regime: dict[int, list[xr.Dataset]] = {}
     for where, part in zip(coords, parts, strict=True):
         by_regime.setdefault(where["regime"], []).append(part)

@@ -1,10 +1,12 @@
-"""Run the claims map: claims 1–5 under every reading, then the best readings again.
+"""The claims map: claims 1–5 under every reading, then the best readings again.
 
-Contract: `run_claims_map(study, mode, compute)` expands every reading of a
-`ClaimsMapStudy` (`metrosync.paper.readings`) into the points of its five studies at
-the mode's ``screen`` statistics, has ``compute(name, specs, label)`` simulate or
-reuse them (`metrosync.paper.runner.compute_points`: the one point store, so an
-interrupted map resumes), and judges each claim with the reproduction's own verdict
+Contract: `ClaimsMapStudy` declares the map (`CLAIMS_MAP`): every reading of
+`metrosync.paper.readings` at the ``screen`` level, and, in ``--full``, the ``best``
+readings again at the paper's statistics. `run_claims_map(study, mode, compute)` (its
+``run``) expands every reading into the points of its five studies at the mode's
+``screen`` statistics, has ``compute(name, specs, label)`` simulate or reuse them
+(`metrosync.paper.runner.compute_points`: the one point store, so an interrupted map
+resumes), and judges each claim with the reproduction's own verdict
 functions (`metrosync.paper.claims`). Readings are ranked by their score (1 per claim
 reproduced, ½ per claim partly reproduced); with a ``best`` level (``--full``), the
 ``top`` readings are simulated again at the paper's statistics and judged again.
@@ -24,14 +26,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from ..status import STATUS_OVERTURNED
-from .assemble import assemble
+from ..sweeps.points import PointSpec
 from .claims import CHECKS, OMEGA_C_PAPER, Verdict
-from .readings import SCORES, ClaimsMapStudy, ClaimStatistics, Reading, reading_studies
+from .readings import (
+    BEST,
+    READINGS,
+    SCORES,
+    SCREEN,
+    ClaimStatistics,
+    Reading,
+    axes_changed,
+    reading_studies,
+)
+from .runner import Compute
+from .studies import _check_mode
 
 LEVELS = ("screen", "best")
 CLAIMS = (1, 2, 3, 4, 5)
@@ -39,17 +54,58 @@ CLAIMS = (1, 2, 3, 4, 5)
 OVERTURNED_LIMIT = 0.5
 
 
+@dataclass(frozen=True)
+class ClaimsMapGrid:
+    """One mode of the claims map: the readings at ``screen``, and the ``top`` best
+    again at ``best`` (None: no second pass). ``one_axis`` keeps only today's reading
+    and those that change one axis from it (7 of the 25)."""
+
+    screen: ClaimStatistics
+    best: ClaimStatistics | None = None
+    top: int = 2
+    one_axis: bool = False
+
+
+@dataclass(frozen=True)
+class ClaimsMapStudy:
+    """Claims 1–5 under every reading of the paper's parameters."""
+
+    name: str
+    figure: str
+    title: str
+    readings: tuple[Reading, ...]
+    quick: ClaimsMapGrid
+    full: ClaimsMapGrid
+
+    def grid(self, mode: str) -> ClaimsMapGrid:
+        return getattr(self, _check_mode(mode))
+
+    def readings_of(self, mode: str) -> tuple[Reading, ...]:
+        """The readings run in ``mode`` (see `ClaimsMapGrid.one_axis`)."""
+        if not self.grid(mode).one_axis:
+            return self.readings
+        return tuple(r for r in self.readings if axes_changed(r) <= 1)
+
+    def points(self, mode: str) -> list[PointSpec]:
+        """The screen's points of ``mode`` (the best readings' are known after it)."""
+        return planned_specs(self, mode)
+
+    def point_label(self, spec: PointSpec) -> str:
+        return spec.key[:12]
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        return run_claims_map(self, mode, compute)
+
+
 def _plan(readings, level: ClaimStatistics):
     """(reading, claim, study, specs) for every claim of every reading at ``level``."""
-    from .runner import points_of
-
     out = []
     for reading in readings:
         for claim, study in reading_studies(reading, level).items():
             if (claim == 4 and reading.overturns) or (claim < 5 and not reading.tunable):
                 out.append((reading, claim, study, []))
             else:
-                out.append((reading, claim, study, points_of(study, "quick")))
+                out.append((reading, claim, study, study.points("quick")))
     return out
 
 
@@ -85,7 +141,7 @@ def _judge(reading, claim, study, specs, loaded) -> Verdict:
             study.name,
         )
     parts = [loaded[spec.key] for spec in specs]
-    ds = assemble(study, "quick", [spec.coords for spec in specs], parts)
+    ds = study.assemble("quick", specs, parts)
     ds.attrs["study"] = study.name
     verdict = CHECKS[study.name](ds)
     if claim == 5:
@@ -220,3 +276,13 @@ def _dataset(study: ClaimsMapStudy, mode: str, verdicts: dict, order) -> xr.Data
     grid = study.grid(mode)
     ds.attrs.update(top=grid.top if grid.best is not None else 0, runs_mode=mode)
     return ds
+
+
+CLAIMS_MAP = ClaimsMapStudy(
+    name="claims_map",
+    figure="claims map",
+    title="Which reading of the paper's parameters reproduces which claim",
+    readings=READINGS,
+    quick=ClaimsMapGrid(screen=SCREEN, one_axis=True),
+    full=ClaimsMapGrid(screen=SCREEN, best=BEST, top=2),
+)

@@ -44,7 +44,7 @@ def consistency_table(bpms: Sequence[float], *, check_bpm: float = 192.0) -> xr.
     predicted, over_pred, measured, over_meas, l2 = [], [], [], [], []
     for name in names:
         params = PRESETS[name]
-        predicted.append(params.steady_amplitude)
+        predicted.append(params.balance_amplitude)
         over_pred.append(params.overturns)
         with warnings.catch_warnings():
             # The overturn warning is the point of this table; it is recorded, not shown.

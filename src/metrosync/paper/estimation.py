@@ -1,6 +1,7 @@
 """The paper's §5 parameter estimation, run on simulated measurements of known truth.
 
-Contract: `run_estimation(study, mode, workdir)` "measures" with the public
+Contract: `run_estimation(study, mode, workdir)`, for an `EstimationStudy`
+(`metrosync.paper.studies`, whose ``run`` calls it), "measures" with the public
 `metrosync.simulate` and the study's true parameters (its preset), then runs the
 paper's procedure through `metrosync.calibration`, and returns one `xarray.Dataset`:
 
@@ -46,7 +47,6 @@ from ..errors import CalibrationError
 from ..lightgate import LightGate, write_logs
 from ..model import get_preset
 from ..simulate import simulate
-from .studies import EstimationStudy
 
 #: The parameters the procedure estimates, in report order: (coordinate, true value key).
 PARAMETERS = (
@@ -60,7 +60,7 @@ PARAMETERS = (
 UNITS = {"c_theta": "kg m2/s", "drive": "N m s", "c_phi": "kg m2/s", "c_phi_control": "kg m2/s"}
 
 
-def run_estimation(study: EstimationStudy, mode: str, workdir: Path) -> xr.Dataset:
+def run_estimation(study, mode: str, workdir: Path) -> xr.Dataset:
     """Simulate the measurements, run the §5 procedure, and collect what it found."""
     grid = study.grid(mode)
     params = get_preset(study.preset)
@@ -149,7 +149,7 @@ def run_estimation(study: EstimationStudy, mode: str, workdir: Path) -> xr.Datas
     )
 
 
-def _trajectory(study: EstimationStudy, duration: float, changes: dict, theta0: float):
+def _trajectory(study, duration: float, changes: dict, theta0: float):
     """One metronome of the study's preset, every step recorded."""
     return simulate(1, study.bpm, duration=duration, preset=study.preset, changes=changes,
                     theta0=[theta0], theta_dot0=[0.0], record_every=1, trajectories=True,

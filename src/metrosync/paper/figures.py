@@ -14,26 +14,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .._files import save_figure
-
-FORMATS = ("png", "pdf")
-DPI = 110
-
-
-def _figure(nrows: int = 1, ncols: int = 1, **options):
-    """A plain `Figure` (no pyplot, no backend switch) and its axes."""
-    from matplotlib.figure import Figure  # loaded when a figure is drawn, not on import
-
-    sharex = options.pop("sharex", False)
-    fig = Figure(**options)
-    return fig, fig.subplots(nrows, ncols, sharex=sharex)
-
-
-def _colors(name: str, values):
-    from matplotlib import colormaps
-
-    return colormaps[name](values)
-
+from ._canvas import new_figure, palette, save_formats
+from .map_figures import plot_claims_map, plot_sigma_map
 
 #: Line styles and markers cycled with the colours, so that curves that coincide
 #: (Fig. 11's N = 2 and 4 end at the same r) stay distinguishable.
@@ -52,10 +34,6 @@ def _math(text: str) -> str:
     return text
 
 
-def _save(fig, stem: Path) -> list[Path]:
-    return [save_figure(fig, Path(stem).with_suffix(f".{ext}"), dpi=DPI) for ext in FORMATS]
-
-
 def _subtitle(ds: xr.Dataset) -> str:
     a = ds.attrs
     runs = ds.sizes.get("run", a.get("runs", "?"))
@@ -68,10 +46,10 @@ def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : a time-series study, with ``r_mean`` (case, time) and ``case`` labels.
     """
-    fig, ax = _figure(figsize=(6.4, 4.2), constrained_layout=True)
+    fig, ax = new_figure(figsize=(6.4, 4.2), constrained_layout=True)
     cases = ds.case.values
     # A qualitative palette: neighbours in a sequential one (176 and 184 BPM) look alike.
-    colors = _colors("tab10", np.arange(cases.size) % 10)
+    colors = palette("tab10", np.arange(cases.size) % 10)
     every = max(1, ds.sizes["time"] // 10)
     for k, (color, case) in enumerate(zip(colors, cases, strict=True)):
         ax.plot(ds.time, ds.r_mean.sel(case=case), lw=1.2, color=color, label=str(case),
@@ -83,7 +61,7 @@ def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
     ax.set_xlim(0, float(ds.time[-1]))
     ax.legend(title=ds.attrs.get("legend_title") or None, fontsize=8, loc="best")
     ax.set_title(_math(f"{ds.attrs['figure']}: {ds.attrs['title']}\n{_subtitle(ds)}"), fontsize=9)
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def plot_sweep(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -91,8 +69,8 @@ def plot_sweep(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : a sweep study, with ``r_eq_mean`` and ``sigma_r`` (n, bpm).
     """
-    fig, (top, bottom) = _figure(2, 1, figsize=(6.4, 7.0), sharex=True, constrained_layout=True)
-    colors = _colors("plasma", np.linspace(0.0, 0.85, ds.sizes["n"]))
+    fig, (top, bottom) = new_figure(2, 1, figsize=(6.4, 7.0), sharex=True, constrained_layout=True)
+    colors = palette("plasma", np.linspace(0.0, 0.85, ds.sizes["n"]))
     for color, n in zip(colors, ds.n.values, strict=True):
         kw = {"color": color, "marker": "o", "ms": 3, "lw": 1.2, "label": f"N = {int(n)}"}
         top.plot(ds.bpm, ds.r_eq_mean.sel(n=n), **kw)
@@ -106,7 +84,7 @@ def plot_sweep(ds: xr.Dataset, stem: Path) -> list[Path]:
     top.legend(fontsize=8, loc="lower right")
     sigma = ds.attrs.get("sigma_bpm_study", float(ds.sigma_realized.mean()))
     top.set_title(f"{ds.attrs['figure']}: σ = {sigma:.3g} BPM\n{_subtitle(ds)}", fontsize=9)
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -114,7 +92,7 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : the z-study, with ``z`` and ``status`` (regime, theta2).
     """
-    fig, ax = _figure(figsize=(6.4, 5.6), layout="constrained")
+    fig, ax = new_figure(figsize=(6.4, 5.6), layout="constrained")
     markers = "osD^v"
     for i, regime in enumerate(ds.regime.values):
         z = ds.z.sel(regime=regime)
@@ -150,7 +128,7 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
         f"{a.get('mode', '')} mode: t = {a.get('duration', 0):g} s, dt = {a.get('dt')} s",
         fontsize=9,
     )
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -158,7 +136,7 @@ def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
 
     ds : ``r_sim``, ``sigma_r_sim``, ``r_exp`` (bpm).
     """
-    fig, ax = _figure(figsize=(4.8, 4.6), constrained_layout=True)
+    fig, ax = new_figure(figsize=(4.8, 4.6), constrained_layout=True)
     ax.plot([0, 1], [0, 1], "k--", lw=0.8, label=r"$r_\mathrm{sim} = r_\mathrm{exp}$")
     # Error bars: σ of r over the simulated runs, and over the logs where there are several.
     xerr = ds.r_exp_std if "r_exp_std" in ds else None
@@ -181,7 +159,7 @@ def plot_comparison(ds: xr.Dataset, stem: Path) -> list[Path]:
     ax.set_ylim(0, 1.02)
     ax.legend(fontsize=8, loc="upper left")
     ax.set_title("Fig. 9: simulated vs measured equilibrium r (N = 7)", fontsize=9)
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -190,7 +168,7 @@ def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
     ds : the estimation study (`metrosync.paper.estimation`): the fitted data of each
     step and ``disk_amplitude`` (c_phi), the sensitivity curve.
     """
-    fig, (decay, drive, disk) = _figure(1, 3, figsize=(14.0, 4.4), constrained_layout=True)
+    fig, (decay, drive, disk) = new_figure(1, 3, figsize=(14.0, 4.4), constrained_layout=True)
     est = ds.estimate
     steps = (("decay", "c_theta (trajectory)", "o"), ("gate", "c_theta (light gate)", "s"))
     for prefix, row, marker in steps:
@@ -237,18 +215,7 @@ def plot_estimation(ds: xr.Dataset, stem: Path) -> list[Path]:
     disk.legend(fontsize=7, loc="lower left")
     fig.suptitle(_math(f"{ds.attrs['figure']}: {ds.attrs['title']} "
                        f"({ds.attrs.get('mode', '')} mode)"), fontsize=10)  # fmt: skip
-    return _save(fig, stem)
-
-
-def _deferred(name: str):
-    """A plotter of `metrosync.paper.map_figures`, which imports this module."""
-
-    def plot(ds: xr.Dataset, stem: Path) -> list[Path]:
-        from . import map_figures
-
-        return getattr(map_figures, name)(ds, stem)
-
-    return plot
+    return save_formats(fig, stem)
 
 
 #: Which function draws each study kind (by the study's class name).
@@ -257,6 +224,6 @@ PLOTTERS = {
     "SweepStudy": plot_sweep,
     "ZStudy": plot_z,
     "EstimationStudy": plot_estimation,
-    "SigmaMapStudy": _deferred("plot_sigma_map"),
-    "ClaimsMapStudy": _deferred("plot_claims_map"),
+    "SigmaMapStudy": plot_sigma_map,
+    "ClaimsMapStudy": plot_claims_map,
 }

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .figures import _colors, _figure, _save
+from ._canvas import new_figure, palette, save_formats
 
 #: Colour of each verdict in the claims map (colour-blind safe: blue, light blue, grey,
 #: orange).
@@ -34,7 +34,7 @@ def plot_sigma_map(ds: xr.Dataset, stem: Path) -> list[Path]:
     two readings of Tables 1–2 are marked. (b) r̄(ω₀) at the largest N for every σ."""
     from .sigma_map import READINGS_OF_TABLES
 
-    fig, (left, right) = _figure(1, 2, figsize=(12.5, 4.8), constrained_layout=True)
+    fig, (left, right) = new_figure(1, 2, figsize=(12.5, 4.8), constrained_layout=True)
     sigma = ds.sigma.values
     for k, tuning in enumerate(ds.tuning.values):
         one = ds.sel(tuning=tuning)
@@ -63,7 +63,7 @@ def plot_sigma_map(ds: xr.Dataset, stem: Path) -> list[Path]:
              title="onset of synchronization against σ")  # fmt: skip
     left.legend(fontsize=6.5, loc="upper left")
     n = int(ds.n.values[-1])
-    colors = _colors("plasma", np.linspace(0.05, 0.85, ds.sizes["sigma"]))
+    colors = palette("plasma", np.linspace(0.05, 0.85, ds.sizes["sigma"]))
     for tuning in ds.tuning.values:
         for color, s in zip(colors, sigma, strict=True):
             r = ds.r_mean.sel(tuning=tuning, sigma=s, n=n)
@@ -81,7 +81,7 @@ def plot_sigma_map(ds: xr.Dataset, stem: Path) -> list[Path]:
         f"N = {', '.join(str(int(v)) for v in ds.n.values)}",
         fontsize=9,
     )
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def plot_claims_map(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -92,7 +92,7 @@ def plot_claims_map(ds: xr.Dataset, stem: Path) -> list[Path]:
     order = np.argsort(ds["rank"].values)
     levels = [lv for lv in ds.level.values if (ds.verdict.sel(level=lv) != "").any()]
     rows, cols = len(order), len(levels) * ds.sizes["claim"]
-    fig, ax = _figure(figsize=(3.0 + 0.55 * cols + 4.2, 1.2 + 0.32 * rows),
+    fig, ax = new_figure(figsize=(3.0 + 0.55 * cols + 4.2, 1.2 + 0.32 * rows),
                       constrained_layout=True)  # fmt: skip
     for y, i in enumerate(order):
         for k, level in enumerate(levels):
@@ -127,7 +127,7 @@ def plot_claims_map(ds: xr.Dataset, stem: Path) -> list[Path]:
         f"partly; {ds.attrs.get('mode', '')} mode)",
         fontsize=9,
     )
-    return _save(fig, stem)
+    return save_formats(fig, stem)
 
 
 def _cell(x: float, y: float, color: str):

@@ -2,7 +2,7 @@
 
 Contract: ``reproduce(out, mode=...)`` writes into ``out``
 
-    <study>.nc, figures/<study>.png|pdf   for every study (`studies.STUDIES`)
+    <study>.nc, figures/<study>.png|pdf   for every study (`catalogue.STUDIES`)
     points/estimation/free_decay000.log   the estimation study's virtual light-gate log
     consistency.nc                        the parameter-consistency table
     fig9.nc, figures/fig9.png|pdf         only with ``experiment``
@@ -31,11 +31,12 @@ from ..integrators._cache import compile_seconds
 from ..sweeps import PointStore
 from ..sweeps.executors import check_scheduler
 from ..sweeps.points import PointSpec
+from .catalogue import get_studies
 from .claims import Verdict, all_verdicts
+from .claims_map import ClaimsMapStudy, best_work
 from .consistency import consistency_table
 from .experiment import compare_experiment, find_experiment, lightgate_analyze
 from .figures import PLOTTERS, plot_comparison
-from .readings import ClaimsMapStudy
 from .report import write_report
 from .runner import StudyResult, points_of, run_study
 from .studies import (
@@ -46,7 +47,6 @@ from .studies import (
     SweepStudy,
     TimeSeriesStudy,
     ZStudy,
-    get_studies,
 )
 
 NO_EXPERIMENT = (
@@ -199,8 +199,6 @@ def _full_work(study: Study) -> float:
     """Oscillator-steps of ``study`` in ``--full`` (the claims map's second pass included)."""
     work = float(sum(p.work for p in points_of(study, "full")))
     if isinstance(study, ClaimsMapStudy):
-        from .claims_map import best_work
-
         work += best_work(study, "full")
     return work
 

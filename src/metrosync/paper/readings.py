@@ -6,9 +6,8 @@ rule, the drive and friction, the disk's inertia J(N), and whether the escapemen
 reaction acts on the disk. `READINGS` is the Cartesian product of the first four, and
 today's reading without the reaction. `reading_studies(reading, level)` turns the
 paper's studies into that reading's versions (`metrosync.paper.studies`), with the statistics of a
-`ClaimStatistics` level; `ClaimsMapStudy` declares the map: every reading at the
-``screen`` level, and, in ``--full``, the ``best`` readings again at the paper's
-statistics. Running it is `metrosync.paper.claims_map`.
+`ClaimStatistics` level (`SCREEN` for every reading, `BEST` for the best readings
+again in ``--full``). The claims map that runs them is `metrosync.paper.claims_map`.
 
 The axes (each value is an overridable model parameter, never a hidden constant):
 
@@ -50,6 +49,7 @@ import itertools
 from dataclasses import dataclass, replace
 
 from ..errors import ParameterError
+from ..model import TUNINGS
 from .studies import (
     FIG8_BOTTOM,
     FIG8_TOP,
@@ -61,12 +61,10 @@ from .studies import (
     Regime,
     Statistics,
     SweepGrid,
-    _check_mode,
 )
 from .studies import ZGrid as _ZGrid
 
 SIGMA_FACTORS = {"beat": 1.0, "period": 2.0}
-TUNINGS = ("small-amplitude", "steady-swing")
 #: (c_θ kg m²/s, M N m s) of each drive reading.
 DRIVES = {"published": (5e-5, 6e-4), "M/10": (5e-5, 6e-5), "c_theta*10": (5e-4, 6e-4)}
 #: The top of the published J range, kg m² (paper §5).
@@ -189,39 +187,6 @@ class ClaimStatistics:
     z: _ZGrid
 
 
-@dataclass(frozen=True)
-class ClaimsMapGrid:
-    """One mode of the claims map: the readings at ``screen``, and the ``top`` best
-    again at ``best`` (None: no second pass). ``one_axis`` keeps only today's reading
-    and those that change one axis from it (7 of the 25)."""
-
-    screen: ClaimStatistics
-    best: ClaimStatistics | None = None
-    top: int = 2
-    one_axis: bool = False
-
-
-@dataclass(frozen=True)
-class ClaimsMapStudy:
-    """Claims 1–5 under every reading of the paper's parameters."""
-
-    name: str
-    figure: str
-    title: str
-    readings: tuple[Reading, ...]
-    quick: ClaimsMapGrid
-    full: ClaimsMapGrid
-
-    def grid(self, mode: str) -> ClaimsMapGrid:
-        return getattr(self, _check_mode(mode))
-
-    def readings_of(self, mode: str) -> tuple[Reading, ...]:
-        """The readings run in ``mode`` (see `ClaimsMapGrid.one_axis`)."""
-        if not self.grid(mode).one_axis:
-            return self.readings
-        return tuple(r for r in self.readings if axes_changed(r) <= 1)
-
-
 def axes_changed(reading: Reading, base: Reading | None = None) -> int:
     """How many axes of ``reading`` differ from ``base`` (today's reading)."""
     base = TODAY if base is None else base
@@ -314,13 +279,4 @@ BEST = ClaimStatistics(
     fig8=FIG8_TOP.full,
     fig10=SweepGrid(ns=(7, 64, 128), bpms=_bpms(150.0, 220.0, 5.0), stats=FIG10.full.stats),
     z=Z_STUDY.full,
-)
-
-CLAIMS_MAP = ClaimsMapStudy(
-    name="claims_map",
-    figure="claims map",
-    title="Which reading of the paper's parameters reproduces which claim",
-    readings=READINGS,
-    quick=ClaimsMapGrid(screen=SCREEN, one_axis=True),
-    full=ClaimsMapGrid(screen=SCREEN, best=BEST, top=2),
 )

@@ -143,7 +143,7 @@ def _discrepancies(rep) -> list[str]:
         f"(`paper_sigma_to_bpm`). Table 1 (ω₀: value → BPM): {t1}. Table 2: {t2}. "
         f"Fig. 10 uses {FIG10_SIGMA} → {paper_sigma_to_bpm(FIG10_SIGMA):.3f} BPM.",
         f"- **Drive M.** With the published M = {m.metronome.drive:g} N m s and c_θ = "
-        f"{m.metronome.c_theta:g}, the energy-balance amplitude is {m.steady_amplitude:.2f} rad: "
+        f"{m.metronome.c_theta:g}, the energy-balance amplitude is {m.balance_amplitude:.2f} rad: "
         "the pendulums go over the top (see the consistency table, measured). Every ensemble "
         "study uses the `default` preset, M = 6×10⁻⁵ N m s (the value of the paper's own "
         "z-study); the z-study runs both values, as the paper did.",

@@ -1,8 +1,8 @@
-"""Run a declared study on the sweep machinery and assemble its data.
+"""Run a declared study on the sweep machinery and assemble its data: the engine.
 
-Contract: `run_study(study, mode, out)` expands a study (`metrosync.paper.studies`)
-into *points*, one public `metrosync.simulate` call each, with the exact keyword
-arguments a user would pass (`points_of`), and runs them with the sweep machinery
+Contract: `run_study(study, mode, out)` has a study expand itself into *points*, one
+public `metrosync.simulate` call each, with the exact keyword arguments a user would
+pass (`points_of`: the study's ``points``), and runs them with the sweep machinery
 (`metrosync.sweeps`): the points are keyed by `metrosync.sweeps.points` (the fully
 resolved model parameters, the package version and the simulation's sources, never a
 preset's name), computed by `metrosync.sweeps.executors.execute` in process or on
@@ -10,15 +10,21 @@ Dask, and each written atomically to the one point store of the output folder,
 ``out/points/<key>.nc`` (`metrosync.sweeps.PointStore` rooted at ``out``). An
 interrupted run (``--full`` takes a quarter of an hour or more) resumes where it
 stopped; a point whose parameters or simulation code changed is recomputed, never
-reused. The points are then assembled into one `xarray.Dataset` per study, written to
+reused. The study then assembles its points into one `xarray.Dataset`, written to
 ``out/<study>.nc``.
+
+The engine knows no kind of study: a study is anything with the few members of
+`Study` (its points, a label for each, and how it runs and assembles them), declared in
+`metrosync.paper.studies`, `metrosync.paper.sigma_map` and `metrosync.paper.claims_map`;
+`metrosync.paper.catalogue` lists the paper's. Most run the usual way, `run_points`.
 
 Each stored point holds what it cost (compute seconds and oscillator-steps), so a
 study's throughput, and from it the estimate of a ``--full`` run, comes from every
 point, reused or not (`StudyResult.throughput`).
 
-The estimation study (`EstimationStudy`) has no points: its `simulate` calls are made
-inside `metrosync.calibration` and take seconds, so it is recomputed on every run.
+A study without points (the estimation study: its `simulate` calls are made inside
+`metrosync.calibration` and take seconds) is recomputed on every run; its compute time
+is its wall time.
 
 Seeds are a fixed function of the study and point names, so results never depend on
 the order or the number of points computed in one go, nor on the executor.
@@ -32,6 +38,7 @@ import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 import xarray as xr
@@ -42,16 +49,37 @@ from ..errors import MetrosyncError
 from ..sweeps import PointStore
 from ..sweeps.executors import execute
 from ..sweeps.points import PointSpec, make_point
-from . import sigma_map
-from .assemble import assemble
-from .estimation import run_estimation
-from .readings import ClaimsMapStudy
-from .sigma_map import SigmaMapStudy
-from .studies import EstimationStudy, Study, SweepStudy, TimeSeriesStudy, ZStudy
 
-#: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
-Z_BATCH = 12
+#: Time step of the ensemble studies' points, s (the paper's).
 DT = 0.01
+
+#: ``compute(name, specs, label)``: the points of ``specs`` computed or reused
+#: (`compute_points` with the run's output folder, executor and log).
+Compute = Callable[[str, list[PointSpec], Callable[[PointSpec], str]], "Computed"]
+
+
+class Study(Protocol):
+    """What the engine asks of a study (every kind in `metrosync.paper` has these).
+
+    name, figure, title : its file name, the paper's figure and a one-line title.
+    points(mode) : its `simulate` calls in ``mode`` ("quick" or "full"); [] for none.
+    point_label(spec) : a short human name of one of its points (for reports).
+    run(mode, out, compute) : (dataset, specs, computed): its points computed or reused
+        with ``compute`` and assembled (most do `run_points`); ``computed`` is None for
+        a study without points, which computes in process.
+    """
+
+    name: str
+    figure: str
+    title: str
+
+    def points(self, mode: str) -> list[PointSpec]: ...
+
+    def point_label(self, spec: PointSpec) -> str: ...
+
+    def run(
+        self, mode: str, out: Path, compute: Compute
+    ) -> tuple[xr.Dataset, list[PointSpec], Computed | None]: ...
 
 
 class StudyIncomplete(MetrosyncError):
@@ -90,70 +118,12 @@ class StudyResult:
 
 def points_of(study: Study, mode: str) -> list[PointSpec]:
     """Expand ``study`` into its `simulate` calls for ``mode`` ("quick" or "full")."""
-    if isinstance(study, TimeSeriesStudy | SweepStudy):
-        if isinstance(study, TimeSeriesStudy):
-            stats = study.statistics(mode)
-            cells = [(f"case{i:02d}", c.n, c.bpm, c.sigma_bpm, {"case": i})
-                     for i, c in enumerate(study.cases)]  # fmt: skip
-        else:
-            grid = study.grid(mode)
-            stats = grid.stats
-            cells = [(f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, study.sigma_bpm, {"n": n, "bpm": bpm})
-                     for n in grid.ns for bpm in grid.bpms]  # fmt: skip
-        return [
-            _ensemble_point(study.name, i, key, n, bpm, sigma, stats, study.preset, coords,
-                            dict(study.changes))
-            for i, (key, n, bpm, sigma, coords) in enumerate(cells)
-        ]  # fmt: skip
-    if isinstance(study, ZStudy):
-        grid = study.grid(mode)
-        theta2 = np.asarray(grid.theta2, dtype=float)
-        out = []
-        for r, regime in enumerate(study.regimes):
-            for start in range(0, theta2.size, Z_BATCH):
-                chunk = theta2[start : start + Z_BATCH]
-                theta0 = np.column_stack([np.full(chunk.size, study.theta1), chunk])
-                kwargs = {
-                    "n": 2,
-                    "bpm": study.bpm,
-                    "runs": int(chunk.size),
-                    "duration": grid.duration,
-                    "dt": study.dt,
-                    "preset": regime.preset,
-                    "changes": dict(regime.changes) or None,
-                    "theta0": theta0.tolist(),
-                    "theta_dot0": np.zeros_like(theta0).tolist(),
-                    "trajectories": True,
-                    "record_every": grid.record_every,
-                    "seed": 0,
-                }
-                where = {"regime": r, "start": start}
-                out.append(make_point(kwargs, keep="z", index=(len(out),), coords=where))
-        return out
-    if isinstance(study, SigmaMapStudy):
-        return sigma_map.points(study, mode)
-    if isinstance(study, ClaimsMapStudy):
-        from .claims_map import planned_specs
-
-        return planned_specs(study, mode)
-    if isinstance(study, EstimationStudy):
-        return []
-    raise TypeError(f"unknown study type {type(study).__name__}")
+    return study.points(mode)
 
 
 def point_label(study: Study, spec: PointSpec) -> str:
     """A short human name of one point of ``study`` (for reports)."""
-    c = spec.coords
-    if isinstance(study, TimeSeriesStudy):
-        return study.cases[c["case"]].label
-    if isinstance(study, SweepStudy):
-        return f"N = {c['n']}, ω₀ = {c['bpm']:g} BPM"
-    if isinstance(study, SigmaMapStudy):
-        return sigma_map.label(spec)
-    if isinstance(study, ZStudy):
-        runs = spec.kwargs["runs"]
-        return f"regime {c['regime']}, θ₂(0) #{c['start']}–{c['start'] + runs - 1}"
-    return spec.key[:12]
+    return study.point_label(spec)
 
 
 def run_study(
@@ -174,35 +144,27 @@ def run_study(
     """
     out = Path(out)
     started = time.perf_counter()
-    if isinstance(study, EstimationStudy):
-        dataset = run_estimation(study, mode, out / "points" / study.name)
+
+    def compute(name, specs, label):
+        return compute_points(
+            name, specs, out, label=label, progress=progress, log=log,
+            scheduler=scheduler, n_workers=n_workers, started=started,
+        )  # fmt: skip
+
+    dataset, specs, computed = study.run(mode, out, compute)
+    if computed is None:
         wall = time.perf_counter() - started
         return _finish(study, mode, out, dataset, started, 0.0, 0.0, [], 0, wall)
-    if isinstance(study, ClaimsMapStudy):
-        from .claims_map import run_claims_map
-
-        def compute(name, specs, label):
-            return compute_points(
-                name, specs, out, label=label, progress=progress, log=log,
-                scheduler=scheduler, n_workers=n_workers, started=started,
-            )  # fmt: skip
-
-        dataset, specs, computed = run_claims_map(study, mode, compute)
-        return _summarise(study, mode, out, dataset, started, specs, computed, computed.loaded)
-    if isinstance(study, SigmaMapStudy):
-        sigma_map.check(study, mode)
-    specs = points_of(study, mode)
-    computed = compute_points(
-        study.name, specs, out, label=lambda spec: point_label(study, spec), progress=progress,
-        log=log, scheduler=scheduler, n_workers=n_workers, started=started,
-    )  # fmt: skip
-    reduced = [computed.loaded[spec.key] for spec in specs]
-    if isinstance(study, SigmaMapStudy):
-        dataset = sigma_map.assemble(study, mode, specs, reduced)
-        dataset = sigma_map.analyse(study, mode, dataset, out / "points" / "theory")
-    else:
-        dataset = assemble(study, mode, [spec.coords for spec in specs], reduced)
     return _summarise(study, mode, out, dataset, started, specs, computed, computed.loaded)
+
+
+def run_points(study, mode: str, out: Path, compute: Compute):
+    """The usual `Study.run`: compute or reuse every point of ``study`` in ``mode``, then
+    join them with its ``assemble(mode, specs, parts)``."""
+    specs = study.points(mode)
+    computed = compute(study.name, specs, study.point_label)
+    parts = [computed.loaded[spec.key] for spec in specs]
+    return study.assemble(mode, specs, parts), specs, computed
 
 
 @dataclass
@@ -331,7 +293,16 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def _ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes=None):
+def ensemble_points(study: str, cells, stats, preset: str, changes) -> list[PointSpec]:
+    """The points of an ensemble study: one per cell ``(key, n, bpm, sigma, coords)``, with
+    the statistics ``stats`` (runs, duration) and the model ``changes`` of the study."""
+    return [
+        ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, dict(changes))
+        for i, (key, n, bpm, sigma, coords) in enumerate(cells)
+    ]
+
+
+def ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes=None):
     """One ensemble point; its seed depends on the study's and the cell's names only, so
     every reading of the claims map draws the same frequencies and starts."""
     kwargs = {

@@ -2,7 +2,7 @@
 
 Contract: a `SigmaMapStudy` runs the Fig. 10 sweep (equilibrium r against ω₀ for
 several N) for every spread σ (BPM) and every tuning, on a BPM window around each
-onset; `points` expands it into `metrosync.simulate` calls, `assemble` joins the
+onset; its `points` are `metrosync.simulate` calls, its `assemble` joins the
 stored points into one dataset
 
     r_eq, status        (tuning, sigma, n, bpm, run)  NaN / -1 outside the window
@@ -42,6 +42,7 @@ from ..errors import ParameterError
 from ..status import STATUS_ABSENT
 from ..sweeps.critical import METHODS, critical_frequency
 from ..sweeps.points import PointSpec, make_point
+from .runner import DT, Compute, point_seed, run_points
 from .studies import Statistics, _check_mode
 
 #: The paper's critical frequency, BPM.
@@ -114,6 +115,85 @@ class SigmaMapStudy:
         every = {b for t in self.tunings for s in self.sigmas for b in self.window(t, s, mode)}
         return tuple(sorted(every))
 
+    def points(self, mode: str) -> list[PointSpec]:
+        """One `simulate` call per tuning, σ, N and ω₀ of the windows."""
+        g = self.grid(mode)
+        out = []
+        for tuning in self.tunings:
+            for sigma in self.sigmas:
+                for n in g.ns:
+                    for bpm in self.window(tuning, sigma, mode):
+                        kwargs = {
+                            "n": int(n),
+                            "bpm": bpm,
+                            "sigma_bpm": float(sigma),
+                            "runs": g.stats.runs,
+                            "duration": g.stats.duration,
+                            "dt": DT,
+                            "preset": self.preset,
+                            # The same draws for every σ and tuning (see the module docstring).
+                            "seed": point_seed(self.name, f"n{n:04d}_bpm{bpm:07.2f}"),
+                        }
+                        if changes := model_changes(tuning):
+                            kwargs["changes"] = changes
+                        where = {"tuning": tuning, "sigma": float(sigma), "n": int(n), "bpm": bpm}
+                        out.append(make_point(kwargs, keep="r_eq", index=(len(out),), coords=where))
+        return out
+
+    def point_label(self, spec: PointSpec) -> str:
+        c = spec.coords
+        return f"{c['tuning']}, σ = {c['sigma']:g}, N = {c['n']}, ω₀ = {c['bpm']:g} BPM"
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        """Refuse unreachable windows first; then the points, assembled and analysed (the
+        theory's measurements cached under ``out/points/theory``)."""
+        check(self, mode)
+        dataset, specs, computed = run_points(self, mode, out, compute)
+        return analyse(self, mode, dataset, Path(out) / "points" / "theory"), specs, computed
+
+    def assemble(self, mode: str, specs: list[PointSpec], parts: list[xr.Dataset]) -> xr.Dataset:
+        """One dataset of every point's per-run r_eq (NaN outside its window)."""
+        g = self.grid(mode)
+        bpms = self.bpms(mode)
+        shape = (len(self.tunings), len(self.sigmas), len(g.ns), len(bpms), g.stats.runs)
+        r_eq = np.full(shape, np.nan)
+        status = np.full(shape, STATUS_ABSENT, dtype=np.int8)
+        for spec, part in zip(specs, parts, strict=True):
+            c = spec.coords
+            i = (
+                self.tunings.index(c["tuning"]),
+                self.sigmas.index(c["sigma"]),
+                g.ns.index(c["n"]),
+                bpms.index(c["bpm"]),
+            )
+            r_eq[i] = part.r_eq.values
+            status[i] = part.status.values
+        dims = ("tuning", "sigma", "n", "bpm", "run")
+        ds = xr.Dataset(
+            {
+                "r_eq": (dims, r_eq, {"long_name": "equilibrium r per run (crossing phases)"}),
+                "status": (dims, status, {"long_name": "run status bits (-1: not swept)"}),
+            },
+            coords={
+                "tuning": list(self.tunings),
+                "sigma": ("sigma", list(self.sigmas), {"units": "BPM"}),
+                "n": list(g.ns),
+                "bpm": ("bpm", list(bpms), {"units": "BPM", "long_name": "nominal ω₀"}),
+                "run": np.arange(g.stats.runs),
+            },
+        )
+        ds["in_window"] = ds.status.isel(n=0, run=0) != STATUS_ABSENT
+        first = parts[0].attrs
+        ds.attrs.update(
+            runs=g.stats.runs,
+            duration=g.stats.duration,
+            dt=first.get("dt", 0.01),
+            preset=self.preset,
+            target_bpm=self.target,
+            warnings=" | ".join(sorted({p.attrs.get("warnings", "none") for p in parts})),
+        )
+        return ds
+
 
 def check(study: SigmaMapStudy, mode: str) -> None:
     """Refuse, before any work, a window or theory BPM a tuning cannot reach."""
@@ -129,83 +209,6 @@ def check(study: SigmaMapStudy, mode: str) -> None:
 def model_changes(tuning: str) -> dict:
     """The model changes of a tuning (none for the default, small-amplitude)."""
     return {} if tuning == "small-amplitude" else {"tuning": tuning}
-
-
-def points(study: SigmaMapStudy, mode: str) -> list[PointSpec]:
-    """One `simulate` call per tuning, σ, N and ω₀ of the windows."""
-    from .runner import DT, point_seed
-
-    g = study.grid(mode)
-    out = []
-    for tuning in study.tunings:
-        for sigma in study.sigmas:
-            for n in g.ns:
-                for bpm in study.window(tuning, sigma, mode):
-                    kwargs = {
-                        "n": int(n),
-                        "bpm": bpm,
-                        "sigma_bpm": float(sigma),
-                        "runs": g.stats.runs,
-                        "duration": g.stats.duration,
-                        "dt": DT,
-                        "preset": study.preset,
-                        # The same draws for every σ and tuning (see the module docstring).
-                        "seed": point_seed(study.name, f"n{n:04d}_bpm{bpm:07.2f}"),
-                    }
-                    if changes := model_changes(tuning):
-                        kwargs["changes"] = changes
-                    where = {"tuning": tuning, "sigma": float(sigma), "n": int(n), "bpm": bpm}
-                    out.append(make_point(kwargs, keep="r_eq", index=(len(out),), coords=where))
-    return out
-
-
-def label(spec: PointSpec) -> str:
-    c = spec.coords
-    return f"{c['tuning']}, σ = {c['sigma']:g}, N = {c['n']}, ω₀ = {c['bpm']:g} BPM"
-
-
-def assemble(study: SigmaMapStudy, mode: str, specs, parts) -> xr.Dataset:
-    """One dataset of every point's per-run r_eq (NaN outside its window)."""
-    g = study.grid(mode)
-    bpms = study.bpms(mode)
-    shape = (len(study.tunings), len(study.sigmas), len(g.ns), len(bpms), g.stats.runs)
-    r_eq = np.full(shape, np.nan)
-    status = np.full(shape, STATUS_ABSENT, dtype=np.int8)
-    for spec, part in zip(specs, parts, strict=True):
-        c = spec.coords
-        i = (
-            study.tunings.index(c["tuning"]),
-            study.sigmas.index(c["sigma"]),
-            g.ns.index(c["n"]),
-            bpms.index(c["bpm"]),
-        )
-        r_eq[i] = part.r_eq.values
-        status[i] = part.status.values
-    dims = ("tuning", "sigma", "n", "bpm", "run")
-    ds = xr.Dataset(
-        {
-            "r_eq": (dims, r_eq, {"long_name": "equilibrium r per run (crossing phases)"}),
-            "status": (dims, status, {"long_name": "run status bits (-1: not swept)"}),
-        },
-        coords={
-            "tuning": list(study.tunings),
-            "sigma": ("sigma", list(study.sigmas), {"units": "BPM"}),
-            "n": list(g.ns),
-            "bpm": ("bpm", list(bpms), {"units": "BPM", "long_name": "nominal ω₀"}),
-            "run": np.arange(g.stats.runs),
-        },
-    )
-    ds["in_window"] = ds.status.isel(n=0, run=0) != STATUS_ABSENT
-    first = parts[0].attrs
-    ds.attrs.update(
-        runs=g.stats.runs,
-        duration=g.stats.duration,
-        dt=first.get("dt", 0.01),
-        preset=study.preset,
-        target_bpm=study.target,
-        warnings=" | ".join(sorted({p.attrs.get("warnings", "none") for p in parts})),
-    )
-    return ds
 
 
 def analyse(study: SigmaMapStudy, mode: str, ds: xr.Dataset, theory_cache: Path) -> xr.Dataset:

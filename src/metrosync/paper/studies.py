@@ -1,14 +1,17 @@
 """The paper's simulation studies, declared as data.
 
 Contract: every study is a frozen dataclass that says *what* to simulate (model
-parameters, the grid of cases, the statistics of each mode) and nothing about *how*;
-`metrosync.paper.runner` turns each into calls of the public `metrosync.simulate`.
+parameters, the grid of cases, the statistics of each mode); each kind of study knows
+its points (calls of the public `metrosync.simulate`), a label for each and how its
+points are assembled (`points`, `point_label`, `run`, `assemble`), which is all the
+engine, `metrosync.paper.runner`, asks of it (`runner.Study`).
 A study's ``quick`` and ``full`` fields hold the statistics of the two modes:
 ``full`` follows the paper (100 runs a point), ``quick`` is reduced so that each
 verdict of the report still rests on a measurable effect.
 
-Adding a study is a declarative change: append an instance to `STUDIES` (and, for a
-new kind of study, teach the runner and `figures` about its type).
+Adding a study is a declarative change: append an instance to
+`metrosync.paper.catalogue.STUDIES` (and, for a new kind of study, give it those
+methods and a plotter in `figures`).
 
 Units: BPM (ω = π·BPM/60), seconds, radians. The σ columns of the paper's Tables 1
 and 2 are converted by `paper_sigma_to_bpm` (docs/model.md §6.4).
@@ -16,12 +19,19 @@ and 2 are converted by `paper_sigma_to_bpm` (docs/model.md §6.4).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
 from ..errors import ParameterError
+from ..sweeps.points import PointSpec, make_point
+from .assemble import assemble_sweep, assemble_time_series, assemble_z
+from .runner import Compute, Study, ensemble_points, run_points
+
+#: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
+Z_BATCH = 12
 
 #: The logger's clock tick, s (paper §2): the unit in which Tables 1–2 read sensibly.
 LOGGER_TICK = 64e-6
@@ -116,6 +126,22 @@ class TimeSeriesStudy:
     def statistics(self, mode: str) -> Statistics:
         return getattr(self, _check_mode(mode))
 
+    def points(self, mode: str) -> list[PointSpec]:
+        """One ensemble point per case."""
+        cells = [
+            (f"case{i:02d}", c.n, c.bpm, c.sigma_bpm, {"case": i}) for i, c in enumerate(self.cases)
+        ]
+        return ensemble_points(self.name, cells, self.statistics(mode), self.preset, self.changes)
+
+    def point_label(self, spec: PointSpec) -> str:
+        return self.cases[spec.coords["case"]].label
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        return run_points(self, mode, out, compute)
+
+    def assemble(self, mode: str, specs: list[PointSpec], parts: list[xr.Dataset]):
+        return assemble_time_series(self, parts)
+
 
 @dataclass(frozen=True)
 class SweepGrid:
@@ -142,6 +168,25 @@ class SweepStudy:
 
     def grid(self, mode: str) -> SweepGrid:
         return getattr(self, _check_mode(mode))
+
+    def points(self, mode: str) -> list[PointSpec]:
+        """One ensemble point per (N, ω₀) of the mode's grid."""
+        grid = self.grid(mode)
+        cells = [
+            (f"n{n:04d}_bpm{bpm:07.2f}", n, bpm, self.sigma_bpm, {"n": n, "bpm": bpm})
+            for n in grid.ns
+            for bpm in grid.bpms
+        ]
+        return ensemble_points(self.name, cells, grid.stats, self.preset, self.changes)
+
+    def point_label(self, spec: PointSpec) -> str:
+        return f"N = {spec.coords['n']}, ω₀ = {spec.coords['bpm']:g} BPM"
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        return run_points(self, mode, out, compute)
+
+    def assemble(self, mode: str, specs: list[PointSpec], parts: list[xr.Dataset]):
+        return assemble_sweep(self, mode, parts)
 
 
 @dataclass(frozen=True)
@@ -179,6 +224,43 @@ class ZStudy:
 
     def grid(self, mode: str) -> ZGrid:
         return getattr(self, _check_mode(mode))
+
+    def points(self, mode: str) -> list[PointSpec]:
+        """Per regime, the θ₂(0) grid in batches of `Z_BATCH` runs, trajectories kept."""
+        grid = self.grid(mode)
+        theta2 = np.asarray(grid.theta2, dtype=float)
+        out = []
+        for r, regime in enumerate(self.regimes):
+            for start in range(0, theta2.size, Z_BATCH):
+                chunk = theta2[start : start + Z_BATCH]
+                theta0 = np.column_stack([np.full(chunk.size, self.theta1), chunk])
+                kwargs = {
+                    "n": 2,
+                    "bpm": self.bpm,
+                    "runs": int(chunk.size),
+                    "duration": grid.duration,
+                    "dt": self.dt,
+                    "preset": regime.preset,
+                    "changes": dict(regime.changes) or None,
+                    "theta0": theta0.tolist(),
+                    "theta_dot0": np.zeros_like(theta0).tolist(),
+                    "trajectories": True,
+                    "record_every": grid.record_every,
+                    "seed": 0,
+                }
+                where = {"regime": r, "start": start}
+                out.append(make_point(kwargs, keep="z", index=(len(out),), coords=where))
+        return out
+
+    def point_label(self, spec: PointSpec) -> str:
+        c = spec.coords
+        return f"regime {c['regime']}, θ₂(0) #{c['start']}–{c['start'] + spec.kwargs['runs'] - 1}"
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        return run_points(self, mode, out, compute)
+
+    def assemble(self, mode: str, specs: list[PointSpec], parts: list[xr.Dataset]):
+        return assemble_z(self, [spec.coords for spec in specs], parts)
 
 
 @dataclass(frozen=True)
@@ -223,8 +305,19 @@ class EstimationStudy:
     def grid(self, mode: str) -> EstimationGrid:
         return getattr(self, _check_mode(mode))
 
+    def points(self, mode: str) -> list[PointSpec]:
+        """None: its `simulate` calls are made inside `metrosync.calibration`."""
+        return []
 
-Study = TimeSeriesStudy | SweepStudy | ZStudy | EstimationStudy  # and SigmaMapStudy, ClaimsMapStudy
+    def point_label(self, spec: PointSpec) -> str:
+        return spec.key[:12]
+
+    def run(self, mode: str, out: Path, compute: Compute):
+        """The procedure, recomputed on every run (seconds); its light-gate log is written
+        under ``out/points/<name>``."""
+        from .estimation import run_estimation  # calibration and the light gate, on use
+
+        return run_estimation(self, mode, Path(out) / "points" / self.name), [], None
 
 
 def _check_mode(mode: str) -> str:
@@ -322,27 +415,6 @@ ESTIMATION = EstimationStudy(
     full=EstimationGrid(c_phi_scan=tuple(np.geomspace(1e-6, 10.0, 43))),
 )
 
-# The σ map and the claims map are declared in their own modules, which build on the
-# types and studies above (hence the import here, after them).
-from .readings import CLAIMS_MAP  # noqa: E402
-from .sigma_map import SIGMA_MAP  # noqa: E402
-
-#: Every study `metrosync reproduce` runs, in report order.
-STUDIES: tuple[Study, ...] = (
-    FIG8_TOP, FIG8_BOTTOM, FIG10, FIG11, Z_STUDY, ESTIMATION, SIGMA_MAP, CLAIMS_MAP,
-)  # fmt: skip
-
-
-def get_studies(names: Sequence[str] | None = None) -> tuple[Study, ...]:
-    """The studies called ``names`` (all of `STUDIES` when None), in report order."""
-    if names is None:
-        return STUDIES
-    known = {s.name: s for s in STUDIES}
-    unknown = [n for n in names if n not in known]
-    if unknown:
-        raise ParameterError(f"unknown study {unknown}; choose from {list(known)}.")
-    return tuple(s for s in STUDIES if s.name in set(names))
-
 
 def reduced(study: Study, **statistics) -> Study:
     """Copy of ``study`` with its ``quick`` statistics or grid replaced (for tests).
@@ -354,14 +426,11 @@ def reduced(study: Study, **statistics) -> Study:
 
 
 __all__ = [
-    "CLAIMS_MAP",
     "ESTIMATION",
     "FIG8_BOTTOM",
     "FIG8_TOP",
     "FIG10",
     "FIG11",
-    "SIGMA_MAP",
-    "STUDIES",
     "TABLE1_SIGMA",
     "TABLE2_SIGMA",
     "Z_STUDY",
@@ -376,7 +445,6 @@ __all__ = [
     "TimeSeriesStudy",
     "ZGrid",
     "ZStudy",
-    "get_studies",
     "paper_sigma_to_bpm",
     "reduced",
 ]

@@ -298,7 +298,7 @@ class Grid:
         for values in itertools.product(*(self.axes[name] for name in swept_model)):
             where = dict(zip(swept_model, values, strict=True))
             params = self.model_parameters(where)
-            swing = params.steady_amplitude
+            swing = params.balance_amplitude
             if not started and not (math.isfinite(swing) and swing > 0):
                 at = f" at {where}" if where else ""
                 raise ParameterError(

@@ -232,7 +232,7 @@ def _warn_overturn(grid: Grid) -> None:
             where = dict(zip(swept, values, strict=True))
             warnings.warn(
                 f"with {params.name!r} parameters {where} the energy-balance "
-                f"amplitude is {params.steady_amplitude:.2f} rad > pi/2: pendulums overturn; such "
+                f"amplitude is {params.balance_amplitude:.2f} rad > pi/2: pendulums overturn; such "
                 f"runs are flagged in `status`.",
                 OverturnWarning,
                 stacklevel=3,

@@ -1,6 +1,5 @@
 """Why the transition sits where it does: a reduced theory of the disk model.
 
-* `tuning`: the steady-swing tuning (L2 at which a metronome ticks at its marking).
 * `sakaguchi`: the exact onset K_c(α, σ) of the Kuramoto–Sakaguchi model.
 * `coupling`: K(ω₀, N) e^{−iα(ω₀)} measured on the full model two ways, and estimated.
 * `reduced`, `fitted`: the phase model, alone or on the ensembles `simulate` builds.
@@ -10,6 +9,17 @@ Nothing here is imported by ``import metrosync``; `reduced_theory` and
 `simulate_reduced` are served lazily from the top-level package.
 """
 
+# The steady-swing tuning is single-pendulum mechanics and lives in `metrosync.model`;
+# its names stay importable from here, where the theory uses them.
+from ..model.steady_swing import (
+    SteadySwing,
+    relaxation_rate,
+    steady_swing,
+    steady_swing_bpm_range,
+    steady_swing_l2,
+    tick_rate_bpm,
+)
+from ..model.tuning import TUNINGS, l2_for_bpm
 from .coupling import Coupling, disk_scale, measure_by_growth, measure_by_pair
 from .estimate import estimate
 from .figure import plot_theory
@@ -17,16 +27,6 @@ from .fitted import simulate_fitted
 from .predict import coupling_curve, default_cache_dir, predict_onset, reduced_theory
 from .reduced import simulate_reduced
 from .sakaguchi import Onset, critical_coupling, growth_rate, onset
-from .tuning import (
-    TUNINGS,
-    SteadySwing,
-    l2_for_bpm,
-    relaxation_rate,
-    steady_swing,
-    steady_swing_bpm_range,
-    steady_swing_l2,
-    tick_rate_bpm,
-)
 
 __all__ = [
     "TUNINGS",

@@ -20,7 +20,7 @@ only through indices ≡ ±1 mod N, negligible for N ≥ 16. The phases are the
 experiment's crossing-interpolated phases. One correction: the coupling acts partly
 through the swing amplitude (a metronome pushed ahead swings less and, the pendulum
 being anisochronous, faster), and the amplitude follows with the rate λ_A of
-`tuning.relaxation_rate`. For a mode growing at s this part is weakened by
+`metrosync.model.steady_swing.relaxation_rate`. For a mode growing at s this part is weakened by
 λ_A/(λ_A + s); solving 2s = K cos α · λ_A/(λ_A + s) − iK sin α for the steady values
 (what a slowly drifting oscillator near onset feels) removes it. Half the correction
 is counted as its uncertainty.
@@ -28,7 +28,7 @@ is counted as its uncertainty.
 Method "pair". Two metronomes, detuned by δω, lock at a phase difference Δ* and a
 common frequency Ω. With H(Δ) = Σ_n K_n sin(nΔ − α_n), the pair obeys
 δω = Σ_n K_n cos α_n sin nΔ* and Ω − ω̄ = −Σ_n (K_n/2) sin α_n (1 + cos nΔ*), ω̄ the
-mean free frequency (`tuning.steady_swing`). Locking at several detunings across the
+mean free frequency (`metrosync.model.steady_swing`). Locking at several detunings across the
 locking range and fitting these sums with harmonics {1,2}, {1,3} and {1,2,3} gives
 K₁ cos α₁ and K₁ sin α₁; the spread between the fits is their uncertainty. The
 locked state is stationary, so no amplitude correction is needed.
@@ -44,98 +44,23 @@ The analytic estimate beside the measurements is in `estimate`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
+from ..model.steady_swing import relaxation_rate, steady_swing
+from ..model.tuning import l2_for_bpm, with_tuning
 from ..observables.order import crossing_phase
 from ..simulate import simulate
-from .tuning import l2_for_bpm, relaxation_rate, steady_swing, with_tuning
+from ._coupling_base import Coupling, disk_scale, tuned_metronome
+from .estimate import estimate
 
 METHODS = ("growth", "pair")
 #: Most metronomes in a growth run (its trajectories are kept in memory).
 MAX_GROWTH_N = 256
 #: Integration step of the measurements, s (continuous-time model; see the docstring).
 MEASURE_DT = 1e-4
-
-
-@dataclass(frozen=True)
-class Coupling:
-    """K e^{−iα} of the reduced model for ``n`` metronomes at nominal ``bpm``.
-
-    k_cos, k_sin : K cos α and K sin α, rad/s, with their uncertainties (1 σ).
-    scale : N/D₀(N) of the disk it was measured on, 1/(kg m²).
-    free_bpm : tick rate of a free metronome at the steady swing, BPM.
-    """
-
-    bpm: float
-    n: int
-    k_cos: float
-    k_sin: float
-    k_cos_err: float
-    k_sin_err: float
-    method: str
-    scale: float
-    free_bpm: float
-
-    @property
-    def k(self) -> float:
-        return math.hypot(self.k_cos, self.k_sin)
-
-    @property
-    def alpha(self) -> float:
-        """Phase lag α, rad (negative: the locked frequency lies above the free one)."""
-        return math.atan2(self.k_sin, self.k_cos)
-
-    @property
-    def k_err(self) -> float:
-        return math.hypot(self.k_cos * self.k_cos_err, self.k_sin * self.k_sin_err) / self.k
-
-    @property
-    def alpha_err(self) -> float:
-        return math.hypot(self.k_sin * self.k_cos_err, self.k_cos * self.k_sin_err) / self.k**2
-
-    @property
-    def kappa(self) -> float:
-        """K/(N/D₀), the disk-independent strength, rad/s · kg m²."""
-        return self.k / self.scale
-
-    def for_n(self, n: int | float, params: ModelParameters | str = "default") -> Coupling:
-        """The same coupling for ``n`` metronomes (``math.inf`` for the N → ∞ limit)."""
-        factor = disk_scale(n, params) / self.scale
-        return replace(
-            self,
-            n=n,
-            k_cos=self.k_cos * factor,
-            k_sin=self.k_sin * factor,
-            k_cos_err=self.k_cos_err * factor,
-            k_sin_err=self.k_sin_err * factor,
-            scale=self.scale * factor,
-        )
-
-
-def disk_scale(n: int | float, params: ModelParameters | str = "default") -> float:
-    """N/D₀(N) with D₀ = J(N) + N m R²; its N → ∞ limit for ``n = math.inf``."""
-    params = get_preset(params, warn=False)
-    p, mass = params.platform, params.metronome.mass
-    if n == math.inf:
-        if p.inertia is not None:
-            raise ParameterError(
-                "`n` = inf needs the J(N) law, but this platform has a fixed `inertia`; with a "
-                "fixed J the coupling per metronome vanishes as N grows. Give a finite `n`."
-            )
-        return 1.0 / (p.j_per_metronome + mass * p.radius**2)
-    if isinstance(n, bool) or int(n) != n or n < 1:
-        raise ParameterError(f"`n` must be a whole number >= 1 of metronomes, got {n!r}.")
-    return n / (p.disk_inertia(int(n)) + n * mass * p.radius**2)
-
-
-def _tuned(bpm: float, params: ModelParameters):
-    design = params.metronome
-    metronome = design.with_l2(float(l2_for_bpm(design, bpm, tuning=design.tuning)))
-    return metronome, steady_swing(metronome)
 
 
 def _start(phases, swing):
@@ -207,9 +132,7 @@ def measure_by_growth(
     """
     params = with_tuning(get_preset(params, warn=False), tuning)
     check_growth_n(n)
-    metronome, swing = _tuned(bpm, params)
-    from .estimate import estimate  # it builds on this module
-
+    metronome, swing = tuned_metronome(bpm, params)
     guess = estimate(bpm, n, params)
     rate = max(guess.k_cos / 2, 1e-3)
     t_min = 5.0
@@ -316,7 +239,7 @@ def measure_by_pair(
     params = with_tuning(get_preset(params, warn=False), tuning)
     if isinstance(points, bool) or not isinstance(points, int) or points < 4:
         raise ParameterError(f"`points` must be an integer >= 4 detunings, got {points!r}.")
-    _, swing = _tuned(bpm, params)
+    _, swing = tuned_metronome(bpm, params)
     # A first small detuning gives the slope δω/Δ*, hence the locking range to span.
     dw, lag, _, _ = _locked_pair(bpm, 0.05, params, dt, 0.05)
     edge_bpm = 0.05 / math.sin(lag) if lag > 0 else 0.0

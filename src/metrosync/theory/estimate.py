@@ -9,7 +9,7 @@ Averaged, that forcing does two things:
   K sin α = −N μ ω c₂ / 2, μ = (m R h)² / (I D₀), c₂ = ⟨cos²θ⟩ over the swing; for one
   metronome this is the exact first-order frequency shift on a free disk (a test);
 * it changes the amplitude, dA_i/dt ∝ μ ω A Σ_j sin(ψ_i − ψ_j), which the escapement
-  pulls back at the rate λ_A (`tuning.relaxation_rate`); the pendulum being
+  pulls back at the rate λ_A (`model.steady_swing.relaxation_rate`); the pendulum being
   anisochronous (dω/dA < 0, elliptic integral), the amplitude change becomes a
   frequency change: K cos α = N μ ω A |dω/dA| c₂ / (2 λ_A).
 
@@ -30,8 +30,9 @@ from scipy.integrate import quad
 from scipy.special import ellipk
 
 from ..model import ModelParameters, get_preset
-from .coupling import Coupling, _tuned, disk_scale
-from .tuning import relaxation_rate, with_tuning
+from ..model.steady_swing import relaxation_rate
+from ..model.tuning import with_tuning
+from ._coupling_base import Coupling, disk_scale, tuned_metronome
 
 
 def _mean_cos_squared(amplitude: float) -> float:
@@ -54,7 +55,7 @@ def estimate(
 ) -> Coupling:
     """The first-order analytic K e^{−iα} (module docstring); its error is not known (0)."""
     params = with_tuning(get_preset(params, warn=False), tuning)
-    metronome, swing = _tuned(bpm, params)
+    metronome, swing = tuned_metronome(bpm, params)
     p = params.platform
     scale = disk_scale(n, params)
     mu_per_n = (metronome.mass * p.radius * metronome.h) ** 2 / metronome.inertia * scale

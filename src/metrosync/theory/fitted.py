@@ -6,7 +6,7 @@ natural frequencies and the same random initial phases), and runs the reduced mo
 (`reduced.simulate_reduced`) on it instead of the mechanics:
 
 * each metronome's natural frequency is its tick rate at the steady swing
-  (`tuning.tick_rate_bpm`), which is what the phase model's ω_i means;
+  (`model.steady_swing.tick_rate_bpm`), which is what the phase model's ω_i means;
 * its initial phase is the analytic phase atan2(−θ̇/ω, θ) of its initial state;
 * K and α are the measured coupling at the nominal ``bpm``, rescaled to ``n``
   (`coupling.measure_by_growth`, cached like `predict.coupling_curve`), unless given.
@@ -25,10 +25,11 @@ import xarray as xr
 
 from ..ensemble import build_ensemble
 from ..model import ModelParameters, get_preset
+from ..model.steady_swing import tick_rate_bpm
+from ..model.tuning import with_tuning
 from .coupling import Coupling
 from .predict import _measure_cached
 from .reduced import simulate_reduced
-from .tuning import tick_rate_bpm, with_tuning
 
 
 def simulate_fitted(

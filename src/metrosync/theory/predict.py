@@ -37,12 +37,13 @@ from .._version import __version__
 from ..budget import Budget
 from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
+from ..model.steady_swing import steady_swing
+from ..model.tuning import l2_for_bpm, with_tuning
 from ..progress import progress_bar
 from . import coupling as cp
 from .estimate import estimate
 from .reduced import simulate_reduced
 from .sakaguchi import critical_coupling
-from .tuning import l2_for_bpm, steady_swing, with_tuning
 
 #: Bumped when a measurement method changes, so that old cache files are not reused.
 CACHE_VERSION = 1
@@ -323,7 +324,7 @@ def reduced_theory(
     if params.overturns:
         raise ParameterError(
             f"preset {params.name!r} overturns (energy-balance amplitude "
-            f"{params.steady_amplitude:.2f} rad): there is no steady swing to reduce to a phase "
+            f"{params.balance_amplitude:.2f} rad): there is no steady swing to reduce to a phase "
             f"model. Use a preset whose swing stays below pi/2, e.g. 'default'."
         )
     sigmas = np.asarray(sigmas, dtype=float)

@@ -1,7 +1,10 @@
-"""Steady-swing tuning: the slider position at which a metronome *ticks* at its marking.
+"""The steady swing of one metronome on a rigid support, and the slider position at which
+it *ticks* at its marking (the ``"steady-swing"`` tuning of `metrosync.model.tuning`).
+
+Single-pendulum mechanics: nothing here runs the ensemble simulator.
 
 A metronome's marking is its actual tick rate, two ticks per period. The model's
-default tuning (`MetronomeDesign.l2_for_bpm`) inverts the *small-amplitude*
+default tuning (``"small-amplitude"``) inverts the *small-amplitude*
 frequency ω₀² = m g h / (m h² + J_i); at the steady swing of ≈ 0.77 rad the pendulum
 is slower, so a metronome tuned to "192 BPM" that way ticks about 184.7 times a
 minute. This module finds instead the ``L2`` whose tick rate *at the steady swing*
@@ -38,8 +41,9 @@ against simulations at a small step.
 Contract: `steady_swing_l2(design, bpm)` is the tuning, vectorised like
 `MetronomeDesign.l2_for_bpm`; it is computed once per design (a spline of the
 ratio of tick rate to small-amplitude rate against ``L2``, inverted by iteration)
-and cached in memory.
-`l2_for_bpm(design, bpm, tuning=...)` picks a tuning by name from `TUNINGS`.
+and cached in memory. `metrosync.model.tuning` picks a tuning by name.
+Throughout, ``design`` is a `MetronomeDesign` and ``metronome`` a `Metronome` (this
+module does not import theirs, which loads this one on use).
 """
 
 from __future__ import annotations
@@ -55,7 +59,6 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
 from ..errors import ParameterError, shown_range
-from ..model import Metronome, MetronomeDesign, ModelParameters
 
 #: Slider positions in the per-design table of the tick-rate ratio (interpolation
 #: error below 1e-4 BPM, checked in the tests).
@@ -83,7 +86,7 @@ class SteadySwing:
     small_amplitude_bpm: float
 
 
-def _check_swing(design: MetronomeDesign) -> None:
+def _check_swing(design) -> None:
     if design.drive <= 0 or design.c_theta <= 0:
         raise ParameterError(
             f"steady-swing tuning needs both friction and drive (`c_theta` = {design.c_theta!r}, "
@@ -130,17 +133,17 @@ def _half_swing(u_plus: float, gamma: float) -> tuple[float, float, float]:
     return float(sol.t_events[0][0]), float(-sol.y_events[0][0][1]), float(sol.y_events[2][0][0])
 
 
-def _overturns(design: MetronomeDesign, metronome: Metronome) -> ParameterError:
+def _overturns(design, metronome) -> ParameterError:
     return ParameterError(
         f"the steady swing does not exist: with `drive` = {design.drive!r} N m s and "
         f"`c_theta` = {design.c_theta!r} kg m²/s the escapement drives the pendulum "
         f"(L2 = {metronome.l2:.4g} m) over the top (energy-balance amplitude "
-        f"{metronome.steady_amplitude:.2f} rad). Lower `drive` or raise `c_theta`, or use "
+        f"{metronome.balance_amplitude:.2f} rad). Lower `drive` or raise `c_theta`, or use "
         f"tuning='small-amplitude'."
     )
 
 
-def steady_swing(metronome: Metronome) -> SteadySwing:
+def steady_swing(metronome) -> SteadySwing:
     """The exact steady swing of ``metronome`` on a rigid support (see module docstring)."""
     design = metronome.design
     _check_swing(design)
@@ -173,7 +176,7 @@ def steady_swing(metronome: Metronome) -> SteadySwing:
     )
 
 
-def relaxation_rate(metronome: Metronome) -> float:
+def relaxation_rate(metronome) -> float:
     """Rate (1/s) at which the swing amplitude returns to the steady swing.
 
     The Floquet exponent of the half-swing map at its fixed point: a change δu₊ of the
@@ -190,7 +193,7 @@ def relaxation_rate(metronome: Metronome) -> float:
     return -math.log(multiplier) * swing.tick_bpm / 60.0
 
 
-def energy_balance_swing(metronome: Metronome) -> SteadySwing:
+def energy_balance_swing(metronome) -> SteadySwing:
     """First-order steady swing: elliptic-integral energy balance and period.
 
     Solves M k = 4 c_θ [E(k) − (1 − k²) K(k)] for k = sin(A/2) (independent of L2)
@@ -220,7 +223,7 @@ def energy_balance_swing(metronome: Metronome) -> SteadySwing:
     )
 
 
-def tick_rate_bpm(design: MetronomeDesign, l2, *, exact: bool = True):
+def tick_rate_bpm(design, l2, *, exact: bool = True):
     """Tick rate (BPM) at the steady swing of ``design`` with slider at ``l2`` (m).
 
     Scalars give a float, arrays an array of the same shape. ``exact`` solves each
@@ -238,7 +241,7 @@ def tick_rate_bpm(design: MetronomeDesign, l2, *, exact: bool = True):
     return out if out.ndim else float(out)
 
 
-def _natural_omega_sq(design: MetronomeDesign, l2):
+def _natural_omega_sq(design, l2):
     m = design.mass
     h = (design.w1 * design.l1 - design.w2 * l2) / m
     return m * design.g * h / (m * h * h + design.w1 * design.l1**2 + design.w2 * l2 * l2)
@@ -253,13 +256,13 @@ class _Table:
     ratio: CubicSpline
 
 
-def _table(design: MetronomeDesign) -> _Table:
+def _table(design) -> _Table:
     # One table per physical design: the `tuning` field does not change the swing.
     return _design_table(replace(design, tuning="small-amplitude"))
 
 
 @functools.lru_cache(maxsize=32)
-def _design_table(design: MetronomeDesign) -> _Table:
+def _design_table(design) -> _Table:
     lo, hi = design.l2_bounds
     # Chebyshev–Lobatto nodes: the ends (the tunable range) are exact, and the spline
     # of the slowly varying ratio stays accurate near them.
@@ -269,14 +272,14 @@ def _design_table(design: MetronomeDesign) -> _Table:
     return _Table(l2=l2, tick_bpm=ticks, ratio=CubicSpline(l2, ticks / natural))
 
 
-def steady_swing_bpm_range(design: MetronomeDesign) -> tuple[float, float]:
+def steady_swing_bpm_range(design) -> tuple[float, float]:
     """Lowest and highest tick rate (BPM) the slider reaches at the steady swing."""
     _check_swing(design)
     ticks = _table(design).tick_bpm
     return float(ticks[-1]), float(ticks[0])
 
 
-def steady_swing_l2(design: MetronomeDesign, bpm):
+def steady_swing_l2(design, bpm):
     """Slider position ``L2`` (m) at which ``design`` ticks at ``bpm`` at its steady swing.
 
     The steady-swing counterpart of `MetronomeDesign.small_amplitude_l2` (what
@@ -312,37 +315,3 @@ def steady_swing_l2(design: MetronomeDesign, bpm):
         if done:
             break
     return x if x.ndim else float(x)
-
-
-#: Tuning names: how a nominal BPM becomes a slider position.
-TUNINGS = {
-    "small-amplitude": lambda design, bpm: design.small_amplitude_l2(bpm),
-    "steady-swing": steady_swing_l2,
-}
-
-
-def l2_for_bpm(design: MetronomeDesign, bpm, *, tuning: str = "small-amplitude"):
-    """Slider position for ``bpm`` under the named ``tuning`` (a key of `TUNINGS`)."""
-    try:
-        solve = TUNINGS[tuning]
-    except (KeyError, TypeError):
-        raise ParameterError(
-            f"unknown `tuning` {tuning!r}; choose one of {sorted(TUNINGS)}."
-        ) from None
-    # The design's one range check and message (it names the range and a fix) first.
-    replace(design, tuning=tuning).check_tunable(bpm)
-    return solve(design, bpm)
-
-
-def with_tuning(params: ModelParameters, tuning: str | None) -> ModelParameters:
-    """``params`` whose design uses ``tuning``; None keeps the design's own.
-
-    The theory's functions take ``tuning=`` beside ``params``; this is the one place
-    where the two meet, so that what is computed, labelled, stored and cached is the
-    design's ``tuning`` and nothing else.
-    """
-    if tuning is None or tuning == params.metronome.tuning:
-        return params
-    if not isinstance(tuning, str) or tuning not in TUNINGS:
-        raise ParameterError(f"unknown `tuning` {tuning!r}; choose one of {sorted(TUNINGS)}.")
-    return params.with_changes(tuning=tuning)
