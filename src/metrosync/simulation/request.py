@@ -25,6 +25,7 @@ from ..errors import ParameterError
 from ..groups import Group
 from ..integrators import BACKENDS, Integrator, get_integrator
 from ..model import Metronome, ModelParameters, get_preset
+from ..model.quantity import quantity
 
 #: Time between records of r(t) when `record_every` is not given, s.
 RECORD_SECONDS = 0.1
@@ -42,8 +43,9 @@ _CALLER_LEVEL = 6
 
 @dataclass(frozen=True, eq=False)
 class SimulationRequest:
-    """Every option of one `metrosync.simulate` call (see it for their meaning),
-    checked when the request is made, and what follows from them alone.
+    """Every option of one `metrosync.simulate` call (see it for their meaning; the
+    units are declared on the fields), checked when the request is made, and what
+    follows from them alone.
 
     Resolved on construction: ``params`` (the preset with its ``changes``),
     ``scheme`` (the integrator), ``n_steps``, ``stride`` (the record stride used, in
@@ -52,12 +54,12 @@ class SimulationRequest:
     """
 
     n: int | None = 7
-    bpm: float | None = 192.0
-    sigma_bpm: float = 0.0
+    bpm: float | None = quantity(192.0, unit="BPM")
+    sigma_bpm: float = quantity(0.0, unit="BPM")
     groups: Sequence[Group | tuple] | None = None
     runs: int = 1
-    duration: float = 600.0
-    dt: float = 0.01
+    duration: float = quantity(600.0, unit="s")
+    dt: float = quantity(0.01, unit="s")
     seed: int | None = 0
     preset: str | ModelParameters = "default"
     changes: Mapping[str, float] | None = None
@@ -65,13 +67,13 @@ class SimulationRequest:
     backend: str = "numba"
     frequencies_bpm: Sequence[float] | np.ndarray | None = None
     metronomes: Sequence[Metronome] | None = None
-    amplitude: float | None = None
+    amplitude: float | None = quantity(None, unit="rad")
     theta0: Sequence[float] | np.ndarray | None = None
     theta_dot0: Sequence[float] | np.ndarray | None = None
     record_every: int | None = None
     trajectories: bool = False
-    equilibrium_window: float | None = None
-    overturn_angle: float = math.pi / 2
+    equilibrium_window: float | None = quantity(None, unit="s")
+    overturn_angle: float = quantity(math.pi / 2, unit="rad")
     progress: bool | None = None
 
     params: ModelParameters = field(init=False)
