@@ -47,7 +47,8 @@ from .._version import __version__
 from ..ensemble import Ensemble
 from ..groups import describe_groups
 from ..integrators._state import Records
-from ..model import ModelParameters
+from ..model import Metronome, MetronomeDesign, ModelParameters
+from ..model.quantity import units
 from ..observables.death import stopped_metronomes
 from ..observables.order import ensemble_statistics, equilibrium_order
 from ..status import STATUS_MEANINGS, STATUS_STOPPED
@@ -57,45 +58,14 @@ from .run import RunRecords
 
 def to_dataset(request: SimulationRequest, ensemble: Ensemble, run: RunRecords) -> xr.Dataset:
     """The dataset of ``run``, the run of ``ensemble`` that ``request`` asked for."""
-    scheme = request.scheme
-    settings = {
-        "n": ensemble.n,
-        "bpm": "groups"
-        if request.groups is not None
-        else "explicit"
-        if request.bpm is None
-        or request.frequencies_bpm is not None
-        or request.metronomes is not None
-        else request.bpm,
-        "sigma_bpm": request.sigma_bpm,
-        "runs": ensemble.runs,
-        "duration": request.simulated_time,
-        "dt": request.dt,
-        "seed": "none" if request.seed is None else request.seed,
-        "integrator": request.integrator,
-        "backend": request.backend if scheme.fixed_step else scheme.backends[0],
-        "record_every": request.stride,
-        "record_interval": request.record_interval,
-        "record_every_reason": request.stride_reason,
-        "equilibrium_window": run.window,
-        "overturn_angle": request.overturn_angle,
-        "tick_rate_span": run.tail_steps * request.dt,
-    }
-    return _assemble(
-        ensemble, run.records, run.rates, request.record_interval, run.window, settings
-    )
-
-
-def _assemble(
-    ensemble: Ensemble, rec: Records, rates: np.ndarray, grid_dt: float, window: float, settings
-) -> xr.Dataset:
-    n_rec = rec.r.shape[1]
-    time = np.arange(n_rec) * grid_dt
+    rec, window = run.records, run.window
+    time = np.arange(rec.r.shape[1]) * request.record_interval
     r = rec.r.T
     r_cross = rec.r_crossing.T
     r_eq = equilibrium_order(r_cross, time, window)
     r_eq_analytic = equilibrium_order(r, time, window)
     mean, spread = ensemble_statistics(r_eq)
+    span = run.tail_steps * request.dt
     data = {
         "r": (("time", "run"), r, {"long_name": "Kuramoto order parameter (analytic phase)"}),
         "r_crossing": (
@@ -126,21 +96,67 @@ def _assemble(
         "l2": (
             ("run", "metronome"),
             ensemble.l2,
-            {"units": "m", "long_name": "slider position L2"},
+            {"units": units(Metronome)["l2"], "long_name": "slider position L2"},
         ),
         "tick_rate_bpm": (
             ("run", "metronome"),
-            rates,
+            run.rates,
             {
                 "units": "BPM",
                 "long_name": f"ticks per minute measured over the final "
-                f"{settings['tick_rate_span']:g} s (NaN for a flagged run)",
+                f"{span:g} s (NaN for a flagged run)",
             },
         ),
     }
+    _add_when_present(data, ensemble, rec, window, request.simulated_time)
+    attrs = {**_settings(request, ensemble, run), **_flat_params(ensemble.params)}
+    attrs.update(
+        r_eq_mean=mean,
+        r_eq_std=spread,
+        disk_inertia=float(ensemble.disk_inertia[0]),
+        metrosync_version=__version__,
+    )
+    coords = {
+        "time": ("time", time, {"units": "s"}),
+        "run": np.arange(ensemble.runs),
+        "metronome": np.arange(ensemble.n),
+    }
+    if ensemble.groups:
+        _add_groups(data, coords, attrs, ensemble, rec, time, window)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _settings(request: SimulationRequest, ensemble: Ensemble, run: RunRecords) -> dict:
+    """What was asked and what was used, for ``attrs``."""
+    scheme = request.scheme
+    explicit = (
+        request.bpm is None or request.frequencies_bpm is not None or request.metronomes is not None
+    )
+    return {
+        "n": ensemble.n,
+        "bpm": "groups" if request.groups is not None else "explicit" if explicit else request.bpm,
+        "sigma_bpm": request.sigma_bpm,
+        "runs": ensemble.runs,
+        "duration": request.simulated_time,
+        "dt": request.dt,
+        "seed": "none" if request.seed is None else request.seed,
+        "integrator": request.integrator,
+        "backend": request.backend if scheme.fixed_step else scheme.backends[0],
+        "record_every": request.stride,
+        "record_interval": request.record_interval,
+        "record_every_reason": request.stride_reason,
+        "equilibrium_window": run.window,
+        "overturn_angle": request.overturn_angle,
+        "tick_rate_span": run.tail_steps * request.dt,
+    }
+
+
+def _add_when_present(data, ensemble: Ensemble, rec: Records, window: float, duration) -> None:
+    """The variables a run has only with some feature on: stopped escapements, a disk
+    held by dry friction, escapements out of beat, trajectories (module docstring)."""
     system = ensemble.system
     if np.any(rec.status & STATUS_STOPPED):  # say which metronomes died
-        stopped = stopped_metronomes(rec.last_kick, settings["duration"], system.omega)
+        stopped = stopped_metronomes(rec.last_kick, duration, system.omega)
         data["escapement_stopped"] = (
             ("run", "metronome"),
             stopped & ((rec.status & STATUS_STOPPED) != 0)[:, None],
@@ -164,7 +180,10 @@ def _assemble(
         data["escapement_offset"] = (
             ("run", "metronome"),
             np.array(offset, dtype=float),
-            {"units": "rad", "long_name": "angle at which the escapement acts"},
+            {
+                "units": units(MetronomeDesign)["escapement_offset"],
+                "long_name": "angle at which the escapement acts",
+            },
         )
     if rec.theta is not None:
         data["theta"] = (
@@ -179,21 +198,6 @@ def _assemble(
         )
         data["phi"] = (("time", "run"), rec.phi.T, {"units": "rad"})
         data["phi_dot"] = (("time", "run"), rec.phi_dot.T, {"units": "rad/s"})
-    attrs = {**settings, **_flat_params(ensemble.params)}
-    attrs.update(
-        r_eq_mean=mean,
-        r_eq_std=spread,
-        disk_inertia=float(ensemble.disk_inertia[0]),
-        metrosync_version=__version__,
-    )
-    coords = {
-        "time": ("time", time, {"units": "s"}),
-        "run": np.arange(ensemble.runs),
-        "metronome": np.arange(ensemble.n),
-    }
-    if ensemble.groups:
-        _add_groups(data, coords, attrs, ensemble, rec, time, window)
-    return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def _add_groups(data, coords, attrs, ensemble: Ensemble, rec: Records, time, window) -> None:
