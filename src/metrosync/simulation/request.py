@@ -84,8 +84,16 @@ class SimulationRequest:
     n_records: int = field(init=False)
 
     def __post_init__(self) -> None:
-        # The model, the integrator and the backend: from here on the request knows
-        # what will run, and on what.
+        self._resolve_model_and_scheme()
+        n_steps = self._check_time()
+        stride, reason = record_stride(self.record_every, n_steps, self.dt)
+        self._set(n_steps=n_steps, stride=stride, stride_reason=reason)
+        self._set(n_records=n_steps // stride + 1)
+        self._check_budget()
+
+    def _resolve_model_and_scheme(self) -> None:
+        """The model (preset and changes), the integrator and the backend: the one
+        place where all three are known together, before anything is sized."""
         params = get_preset(self.preset, warn=not self.changes)
         if self.changes:
             params = get_preset(params.with_changes(**self.changes))
@@ -94,11 +102,6 @@ class SimulationRequest:
             raise ParameterError(
                 f"unknown `backend` {self.backend!r}; choose one of {sorted(BACKENDS)}."
             )
-        n_steps = self._check_time()
-        stride, reason = record_stride(self.record_every, n_steps, self.dt)
-        self._set(n_steps=n_steps, stride=stride, stride_reason=reason)
-        self._set(n_records=n_steps // stride + 1)
-        self._check_budget()
 
     def _set(self, **resolved) -> None:
         for name, value in resolved.items():
