@@ -6,7 +6,8 @@ and recording stride, and the memory and time the run will take (`metrosync.budg
 refused when it cannot fit, a warning when it will take minutes), all before the
 ensemble's first array is allocated. What needs the ensemble (the step against its
 fastest period, `metrosync.ensemble.check_time_step`) is checked where the ensemble
-exists, in the run (`metrosync.simulation.run`).
+exists, in the run (`metrosync.simulation.run`), and so is the averaging window
+(`SimulationRequest.window`), after the ensemble's own checks as it always was.
 """
 
 from __future__ import annotations
