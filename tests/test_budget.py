@@ -16,7 +16,7 @@ from metrosync import budget, simulate
 from metrosync.budget import Budget, LongRunWarning, ResourceError, simulation_budget
 from metrosync.pacing import Pacer
 
-SIMULATE = importlib.import_module("metrosync.simulate")
+REQUEST = importlib.import_module("metrosync.simulation.request")
 GiB = 1024.0**3
 
 
@@ -108,7 +108,7 @@ def test_estimate_covers_what_a_run_allocates_and_not_far_more():
 
 
 def test_a_long_run_records_at_a_stride_that_caps_the_records(monkeypatch):
-    monkeypatch.setattr(SIMULATE, "MAX_RECORDS", 100)
+    monkeypatch.setattr(REQUEST, "MAX_RECORDS", 100)
     ds = simulate(3, 192.0, duration=60.0)  # 6000 steps: 601 records at 0.1 s
     assert ds.sizes["time"] <= 100
     assert ds.attrs["record_every"] == 61 and ds.attrs["record_interval"] == pytest.approx(0.61)
@@ -132,7 +132,7 @@ def test_memory_of_r_does_not_grow_with_the_duration(monkeypatch):
         with pytest.raises(KeyboardInterrupt):
             simulate(7, 192.0, runs=20, duration=duration)
     sizes = [b.arrays["r(t) records"] for b in seen]
-    cap = 20 * budget.RECORD_BYTES * SIMULATE.MAX_RECORDS
+    cap = 20 * budget.RECORD_BYTES * REQUEST.MAX_RECORDS
     assert sizes[0] < 0.2 * cap and 0.99 * cap <= sizes[1] <= cap and 0.99 * cap <= sizes[2] <= cap
 
 

@@ -94,10 +94,12 @@ class Budget:
             f"{self.fixes or 'ask for less'}."
         )
 
-    def check(self, *, available: float | None = None) -> Budget:
+    def check(self, *, available: float | None = None, stacklevel: int = 3) -> Budget:
         """Refuse what does not fit (`ResourceError`), warn about long work; returns self.
 
         available : bytes of memory available (default: measured now).
+        stacklevel : of the warning, as for `warnings.warn`: by default the line that
+            called the caller of ``check``.
         """
         message = self.refusal(available_memory() if available is None else available)
         if message:
@@ -110,7 +112,7 @@ class Budget:
                 + (f", or {self.fixes}" if self.fixes else "")
                 + ".",
                 LongRunWarning,
-                stacklevel=3,
+                stacklevel=stacklevel,
             )
         return self
 

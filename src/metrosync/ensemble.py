@@ -22,7 +22,14 @@ import numpy as np
 
 from .errors import ParameterError, describe
 from .groups import Group, as_groups, group_bounds
-from .model import Metronome, ModelParameters, SystemArrays, omega_to_bpm, system_arrays
+from .model import (
+    Metronome,
+    MetronomeDesign,
+    ModelParameters,
+    SystemArrays,
+    omega_to_bpm,
+    system_arrays,
+)
 from .model.system import PER_METRONOME
 
 #: The coarsest step accepted: a period must span at least this many steps.
@@ -113,8 +120,6 @@ def build_ensemble(
             f"`seed` must be a non-negative integer or None, got {describe(seed)}."
         )
     freq_rng, phase_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
-    design = params.metronome
-
     if (
         isinstance(sigma_bpm, bool)
         or not isinstance(sigma_bpm, int | float | np.integer | np.floating)
@@ -124,105 +129,27 @@ def build_ensemble(
             f"`sigma_bpm` must be >= 0 BPM, got {describe(sigma_bpm)}; give a number "
             f"(0 tunes every metronome to the nominal `bpm`)."
         )
+    design = params.metronome
     per_metronome = None
     if groups is not None:
-        if metronomes is not None or frequencies_bpm is not None:
-            given = "`metronomes`" if metronomes is not None else "`frequencies_bpm`"
-            raise ParameterError(
-                f"give `groups` or {given}, not both: each sets the metronomes' frequencies."
-            )
-        if not (math.isfinite(sigma_bpm) and sigma_bpm >= 0):
-            raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {sigma_bpm!r}.")
-        groups = as_groups(groups, sigma_bpm)
-        for k, g in enumerate(groups):
-            design.check_tunable(
-                g.bpm,
-                what=f"`groups` entry {k} ({g.label()}) has BPM {{value}}, which",
-                fix="Move that group's BPM into the range.",
-            )
-        n = sum(g.n for g in groups)
-        loc = np.repeat([g.bpm for g in groups], [g.n for g in groups])
-        scale = np.repeat([g.sigma_bpm for g in groups], [g.n for g in groups])
-        # One draw over all N, as for a single group, so equal groups are one group.
-        freq = freq_rng.normal(loc, scale, size=(runs, n))
-        for k, (g, lo) in enumerate(zip(groups, group_bounds(groups), strict=False)):
-            design.check_tunable(
-                freq[:, lo : lo + g.n],
-                what=f"with `groups` entry {k} ({g.label()}), a drawn natural frequency "
-                "({value} BPM)",
-                fix="Lower that group's sigma or move its BPM inward.",
-            )
-        l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
-    elif metronomes is not None:
-        metronomes = list(metronomes)
-        if not metronomes:
-            raise ParameterError("`metronomes` is empty: give at least one Metronome.")
-        _require_explicit("metronomes", len(metronomes), n, sigma_bpm)
-        n = len(metronomes)
-        l2 = np.broadcast_to([m.l2 for m in metronomes], (runs, n)).copy()
-        per_metronome = {
-            name: np.broadcast_to([getattr(m.design, name) for m in metronomes], (runs, n))
-            for name in PER_METRONOME
-        }
-    else:
-        if frequencies_bpm is not None:
-            freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
-            _require_explicit("frequencies_bpm", freq.shape[1], n, sigma_bpm)
-            n = freq.shape[1]
-            written = np.asarray(frequencies_bpm, dtype=float)  # so an entry is named as written
-            design.check_tunable(written, name="frequencies_bpm", index=True)
-        else:
-            n = _require_count("n", n)
-            if bpm is None or not math.isfinite(float(bpm)):
-                raise ParameterError(f"`bpm` must be a finite number, got {bpm!r}.")
-            design.check_tunable(bpm)
-            freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
-            design.check_tunable(
-                freq,
-                what=f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency ({{value}} BPM)",
-                fix="Lower `sigma_bpm` or move `bpm` inward.",
-            )
-        l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
-    system, disk = system_arrays(params, l2, per_metronome)
-    omega = system.omega
-
-    phases = phase_rng.uniform(0.0, 2 * np.pi, size=(runs, n))
-    if theta0 is not None:
-        th0 = _per_metronome("theta0", theta0, runs, n)
-        thd0 = (
-            _per_metronome("theta_dot0", theta_dot0, runs, n)
-            if theta_dot0 is not None
-            else np.zeros((runs, n))
+        groups, l2 = _grouped(
+            design, groups, sigma_bpm, freq_rng, runs, metronomes, frequencies_bpm
         )
+    elif metronomes is not None:
+        l2, per_metronome = _explicit(metronomes, n, sigma_bpm, runs)
     else:
-        if theta_dot0 is not None:
-            raise ParameterError("`theta_dot0` was given without `theta0`: give both, or neither.")
-        amp = params.balance_amplitude if amplitude is None else amplitude
-        if amplitude is None and amp == 0:
-            raise ParameterError(
-                "the default start amplitude is the energy-balance amplitude 2M/(pi c_theta), "
-                "which is 0 without drive (`drive` = 0): every pendulum would start at rest. "
-                "Give `amplitude` (--amplitude) or `theta0` (--theta0)."
-            )
-        if not (math.isfinite(amp) and amp >= 0):
-            raise ParameterError(
-                f"`amplitude` must be a finite angle >= 0 rad, got {amp!r}"
-                + (
-                    " (no friction: give `amplitude` or `theta0` explicitly)"
-                    if amplitude is None
-                    else ""
-                )
-                + "."
-            )
-        th0 = amp * np.cos(phases)
-        thd0 = -amp * omega * np.sin(phases)
+        freq = _frequencies(design, n, bpm, sigma_bpm, freq_rng, runs, frequencies_bpm)
+        l2 = np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(freq.shape)
+    system, disk = system_arrays(params, l2, per_metronome)
+    phases = phase_rng.uniform(0.0, 2 * np.pi, size=l2.shape)
+    th0, thd0 = _start(params, system.omega, phases, amplitude, theta0, theta_dot0)
     if not math.isfinite(phi_dot0):
         raise ParameterError(f"`phi_dot0` must be finite, got {phi_dot0!r}.")
     return Ensemble(
         params=params,
         system=system,
         l2=l2,
-        frequency_bpm=omega_to_bpm(omega),
+        frequency_bpm=omega_to_bpm(system.omega),
         disk_inertia=disk,
         theta0=th0,
         theta_dot0=thd0,
@@ -230,6 +157,117 @@ def build_ensemble(
         phi_dot0=np.full(runs, float(phi_dot0)),
         groups=tuple(groups) if groups is not None else (),
     )
+
+
+def _grouped(
+    design: MetronomeDesign, groups, sigma_bpm, freq_rng, runs: int, metronomes, frequencies_bpm
+) -> tuple[tuple[Group, ...], np.ndarray]:
+    """The groups, their spreads resolved, and the (B, N) slider positions of their
+    drawn frequencies."""
+    if metronomes is not None or frequencies_bpm is not None:
+        given = "`metronomes`" if metronomes is not None else "`frequencies_bpm`"
+        raise ParameterError(
+            f"give `groups` or {given}, not both: each sets the metronomes' frequencies."
+        )
+    if not (math.isfinite(sigma_bpm) and sigma_bpm >= 0):
+        raise ParameterError(f"`sigma_bpm` must be >= 0 BPM, got {sigma_bpm!r}.")
+    groups = as_groups(groups, sigma_bpm)
+    for k, g in enumerate(groups):
+        design.check_tunable(
+            g.bpm,
+            what=f"`groups` entry {k} ({g.label()}) has BPM {{value}}, which",
+            fix="Move that group's BPM into the range.",
+        )
+    n = sum(g.n for g in groups)
+    loc = np.repeat([g.bpm for g in groups], [g.n for g in groups])
+    scale = np.repeat([g.sigma_bpm for g in groups], [g.n for g in groups])
+    # One draw over all N, as for a single group, so equal groups are one group.
+    freq = freq_rng.normal(loc, scale, size=(runs, n))
+    for k, (g, lo) in enumerate(zip(groups, group_bounds(groups), strict=False)):
+        design.check_tunable(
+            freq[:, lo : lo + g.n],
+            what=f"with `groups` entry {k} ({g.label()}), a drawn natural frequency "
+            "({value} BPM)",
+            fix="Lower that group's sigma or move its BPM inward.",
+        )
+    return groups, np.asarray(design.l2_for_bpm(freq), dtype=float).reshape(runs, n)
+
+
+def _explicit(metronomes, n, sigma_bpm, runs: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The (B, N) slider positions of explicit metronomes, and each one's own design
+    parameters (`model.system.PER_METRONOME`), the same in every run."""
+    metronomes = list(metronomes)
+    if not metronomes:
+        raise ParameterError("`metronomes` is empty: give at least one Metronome.")
+    _require_explicit("metronomes", len(metronomes), n, sigma_bpm)
+    n = len(metronomes)
+    l2 = np.broadcast_to([m.l2 for m in metronomes], (runs, n)).copy()
+    per_metronome = {
+        name: np.broadcast_to([getattr(m.design, name) for m in metronomes], (runs, n))
+        for name in PER_METRONOME
+    }
+    return l2, per_metronome
+
+
+def _frequencies(
+    design: MetronomeDesign, n, bpm, sigma_bpm, freq_rng, runs: int, frequencies_bpm
+) -> np.ndarray:
+    """The (B, N) natural frequencies: ``frequencies_bpm`` as given, or drawn from
+    Normal(bpm, sigma_bpm)."""
+    if frequencies_bpm is not None:
+        freq = _per_metronome("frequencies_bpm", frequencies_bpm, runs, None)
+        _require_explicit("frequencies_bpm", freq.shape[1], n, sigma_bpm)
+        written = np.asarray(frequencies_bpm, dtype=float)  # so an entry is named as written
+        design.check_tunable(written, name="frequencies_bpm", index=True)
+        return freq
+    n = _require_count("n", n)
+    if bpm is None or not math.isfinite(float(bpm)):
+        raise ParameterError(f"`bpm` must be a finite number, got {bpm!r}.")
+    design.check_tunable(bpm)
+    freq = freq_rng.normal(float(bpm), float(sigma_bpm), size=(runs, n))
+    design.check_tunable(
+        freq,
+        what=f"with `sigma_bpm` = {sigma_bpm!r}, a drawn natural frequency ({{value}} BPM)",
+        fix="Lower `sigma_bpm` or move `bpm` inward.",
+    )
+    return freq
+
+
+def _start(
+    params: ModelParameters, omega: np.ndarray, phases: np.ndarray, amplitude, theta0, theta_dot0
+) -> tuple[np.ndarray, np.ndarray]:
+    """The (B, N) initial angles and angular velocities: ``theta0`` and ``theta_dot0``
+    as given, or a swing of ``amplitude`` (default the energy-balance amplitude) at
+    the random ``phases``."""
+    runs, n = phases.shape
+    if theta0 is not None:
+        th0 = _per_metronome("theta0", theta0, runs, n)
+        thd0 = (
+            _per_metronome("theta_dot0", theta_dot0, runs, n)
+            if theta_dot0 is not None
+            else np.zeros((runs, n))
+        )
+        return th0, thd0
+    if theta_dot0 is not None:
+        raise ParameterError("`theta_dot0` was given without `theta0`: give both, or neither.")
+    amp = params.balance_amplitude if amplitude is None else amplitude
+    if amplitude is None and amp == 0:
+        raise ParameterError(
+            "the default start amplitude is the energy-balance amplitude 2M/(pi c_theta), "
+            "which is 0 without drive (`drive` = 0): every pendulum would start at rest. "
+            "Give `amplitude` (--amplitude) or `theta0` (--theta0)."
+        )
+    if not (math.isfinite(amp) and amp >= 0):
+        raise ParameterError(
+            f"`amplitude` must be a finite angle >= 0 rad, got {amp!r}"
+            + (
+                " (no friction: give `amplitude` or `theta0` explicitly)"
+                if amplitude is None
+                else ""
+            )
+            + "."
+        )
+    return amp * np.cos(phases), -amp * omega * np.sin(phases)
 
 
 def check_time_step(dt: float, ensemble: Ensemble) -> None:

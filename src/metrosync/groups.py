@@ -24,16 +24,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError, describe
+from .model.quantity import NON_NEGATIVE, declared, quantity
 
 
 @dataclass(frozen=True)
 class Group:
-    """One group: ``n`` metronomes at nominal ``bpm`` (BPM), natural frequencies spread
-    with standard deviation ``sigma_bpm`` (BPM; None: the ensemble's ``sigma_bpm``)."""
+    """One group: ``n`` metronomes at nominal ``bpm``, natural frequencies spread with
+    standard deviation ``sigma_bpm`` (None: the ensemble's ``sigma_bpm``); the units
+    and bounds are declared on the fields."""
 
     n: int
-    bpm: float
-    sigma_bpm: float | None = None
+    bpm: float = quantity(unit="BPM")
+    sigma_bpm: float | None = quantity(None, unit="BPM", bounds=NON_NEGATIVE)
 
     def label(self) -> str:
         """The group as the command line writes it, ``N@BPM:SIGMA``."""
@@ -137,6 +139,7 @@ def _number(where: str, name: str, value) -> float:
 
 def _spread(where: str, value) -> float:
     number = _number(where, "sigma_bpm", value)
-    if number < 0:
-        raise ParameterError(f"{where}: `sigma_bpm` must be >= 0 BPM, got {value!r}.")
+    bounds, unit = declared(Group, "sigma_bpm", "bounds"), declared(Group, "sigma_bpm")
+    if not bounds.admits(number):
+        raise ParameterError(f"{where}: `sigma_bpm` must {bounds} {unit}, got {value!r}.")
     return number

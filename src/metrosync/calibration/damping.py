@@ -21,7 +21,8 @@ import numpy as np
 from ..errors import CalibrationError
 from ..lightgate.cleaning import clean_log
 from ..lightgate.reader import DEFAULT_TICK, read_log
-from ..model import Metronome
+from ..model import Metronome, MetronomeDesign
+from ..model.quantity import declared
 from .estimate import Estimate
 from .pendulum import amplitude_from_ratio, envelope_coordinate, swing_amplitudes
 
@@ -54,7 +55,7 @@ def fit_c_theta(time, amplitude, *, metronome: Metronome, min_amplitude: float =
     value = -2.0 * inertia * slope
     fit_t = np.linspace(t.min(), t.max(), 100)
     return Estimate(
-        name="c_theta", value=float(value), unit="kg m²/s",
+        name="c_theta", value=float(value), unit=declared(MetronomeDesign, "c_theta"),
         x=t, y=u, fit_x=fit_t, fit_y=intercept + slope * fit_t,
         xlabel="t (s)", ylabel="log swing amplitude: u(A) ≈ ln(A / rad)",
         title=r"$c_\theta$ from the free decay (drive off, rigid support)",

@@ -17,7 +17,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import CalibrationError, OverturnWarning, ParameterError
-from ..model import balance_amplitude
+from ..model import MetronomeDesign, balance_amplitude
+from ..model.quantity import declared
 from ..simulate import simulate
 from .estimate import Estimate
 from .pendulum import swing_amplitudes
@@ -82,7 +83,7 @@ def fit_drive(amplitude: float, *, c_theta: float, bpm: float = 192.0, preset="d
     value = math.exp(log_m)
     ms = np.array(sorted(trials))
     return Estimate(
-        name="M", value=value, unit="N m s",
+        name="M", value=value, unit=declared(MetronomeDesign, "drive"),
         x=ms, y=np.array([trials[m] for m in ms]),
         fit_x=np.array([ms.min(), ms.max()]), fit_y=np.array([amplitude, amplitude]),
         xlabel="M (N m s)", ylabel="steady amplitude (rad)",

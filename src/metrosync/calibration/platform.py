@@ -26,6 +26,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import CalibrationError, ParameterError
+from ..model import Platform
+from ..model.quantity import declared
 from ..simulate import simulate
 from .estimate import Estimate
 
@@ -87,7 +89,7 @@ def fit_c_phi(amplitude: float, *, n: int = 7, bpm: float = 192.0, c_theta: floa
             f"by {1 / max(abs(sensitivity), 1e-12):.3g} %); it cannot be estimated this way."
         )
     return Estimate(
-        name="c_phi", value=value, unit="kg m²/s",
+        name="c_phi", value=value, unit=declared(Platform, "c_phi"),
         x=grid, y=values, fit_x=np.array([grid[0], grid[-1]]), fit_y=np.array([amplitude] * 2),
         xlabel=r"$c_\varphi$ (kg m²/s)", ylabel="disk amplitude (rad)",
         title=rf"$c_\varphi$ from the synchronized disk's amplitude (N = {n}, {bpm} BPM)",

@@ -19,19 +19,19 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     del args
-    from ..model import PRESETS
-    from ..sweeps.grid import UNITS
+    from ..model import PRESETS, MetronomeDesign, Platform
+    from ..model.quantity import units
 
-    units = {**UNITS, "l2_bounds": "m"}
+    unit = units(MetronomeDesign, Platform)
     width = max(16, *(len(key) for params in PRESETS.values() for key in params.as_dict()))
     for name, params in PRESETS.items():
         print(f"{name}: {params.description}")
         for key, value in params.as_dict().items():
             if key != "preset":
-                print(f"    {key:{width}s} {value} {units.get(key, '')}".rstrip())
+                print(f"    {key:{width}s} {value} {unit.get(key, '')}".rstrip())
         low, high = params.metronome.bpm_range()
-        print(f"    {'steady amp.':{width}s} {params.balance_amplitude:.3f} rad"
-              + ("  (OVERTURNS: > pi/2)" if params.overturns else ""))  # fmt: skip
+        overturns = "  (OVERTURNS: > pi/2)" if params.overturns else ""
+        print(f"    {'steady amp.':{width}s} {params.balance_amplitude:.3f} rad{overturns}")
         print(f"    {'tunable BPM':{width}s} {low:.1f} .. {high:.1f} ({params.metronome.tuning})")
         print(f"    {'tick at 192':{width}s} {_tick_at(params.metronome, 192.0)}")
     print(

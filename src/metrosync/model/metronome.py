@@ -36,8 +36,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import ParameterError, describe, require_finite, require_positive, shown_range
+from ..errors import ParameterError, describe, require_finite, shown_range
 from . import tuning as tunings
+from .quantity import (
+    LOWER_HALF,
+    NON_NEGATIVE,
+    POSITIVE,
+    check_quantities,
+    declared,
+    documented,
+    quantity,
+)
+from .tuning import TUNINGS
 
 STANDARD_GRAVITY = 9.81  # m/s², the value used throughout the paper's era of models
 
@@ -78,50 +88,48 @@ def natural_omega(w1, w2, l1, l2, g):
     return np.sqrt((w1 + w2) * g * h / pendulum_inertia(w1, w2, l1, l2))
 
 
+@documented
 @dataclass(frozen=True)
 class MetronomeDesign:
     """Everything about a metronome except where its sliding weight sits.
 
-    Parameters (SI units)
-    ---------------------
-    w1, w2 : fixed and sliding weight, kg.
-    l1 : distance of ``w1`` below the pivot, m.
-    c_theta : viscous friction of the pivot, kg m²/s.
-    drive : angular momentum ``M`` given at each zero crossing by the escapement, N m s.
-    l2_bounds : the slider's reach on the rod, m; it bounds the tunable BPM range.
-    g : gravitational acceleration, m/s².
-    escapement_offset : the angle δ at which the escapement gives its impulse, rad
+    Parameters (SI units, each declared on its field and listed below)
+    ------------------------------------------------------------------
+    w1, w2 : fixed and sliding weight.
+    l1 : distance of ``w1`` below the pivot.
+    c_theta : viscous friction of the pivot.
+    drive : angular momentum ``M`` given at each zero crossing by the escapement.
+    l2_bounds : the slider's reach on the rod (low, high), 0 <= low < high; it bounds
+        the tunable BPM range.
+    g : gravitational acceleration.
+    escapement_offset : the angle δ at which the escapement gives its impulse
         (paper: 0, the vertical). A metronome "out of beat" has δ ≠ 0: it is kicked
-        where θ crosses δ, so tick and tock alternate short and long. Must lie in
-        (−π/2, π/2); real metronomes are often a few per cent of the swing out.
+        where θ crosses δ, so tick and tock alternate short and long; real metronomes
+        are often a few per cent of the swing out.
     tuning : how a nominal BPM becomes ``L2``, one of `TUNINGS` (module docstring).
     """
 
-    w1: float = 0.025
-    w2: float = 0.0069
-    l1: float = 0.0358
-    c_theta: float = 5e-5
-    drive: float = 6e-5
-    l2_bounds: tuple[float, float] = (0.0, 0.1)
-    g: float = STANDARD_GRAVITY
-    escapement_offset: float = 0.0
-    tuning: str = "small-amplitude"
+    w1: float = quantity(0.025, unit="kg", bounds=POSITIVE)
+    w2: float = quantity(0.0069, unit="kg", bounds=NON_NEGATIVE)
+    l1: float = quantity(0.0358, unit="m", bounds=POSITIVE)
+    c_theta: float = quantity(5e-5, unit="kg m²/s", bounds=NON_NEGATIVE)
+    drive: float = quantity(6e-5, unit="N m s", bounds=NON_NEGATIVE)
+    #: Checked as a pair in `__post_init__`: 0 <= low < high, short of inverting.
+    l2_bounds: tuple[float, float] = quantity((0.0, 0.1), unit="m")
+    g: float = quantity(STANDARD_GRAVITY, unit="m/s²", bounds=POSITIVE)
+    escapement_offset: float = quantity(
+        0.0,
+        unit="rad",
+        bounds=LOWER_HALF,
+        why="the escapement acts on the lower half of the swing. A metronome a few per cent "
+        "out of beat has an offset of a few hundredths of a radian",
+    )
+    tuning: str = quantity("small-amplitude", choices=TUNINGS)
 
     def __post_init__(self) -> None:
         tunings.check_tuning(self.tuning)
-        require_positive("w1", self.w1, unit="kg")
-        require_positive("w2", self.w2, allow_zero=True, unit="kg")
-        require_positive("l1", self.l1, unit="m")
-        require_positive("c_theta", self.c_theta, allow_zero=True, unit="kg m²/s")
-        require_positive("drive", self.drive, allow_zero=True, unit="N m s")
-        require_positive("g", self.g, unit="m/s²")
-        offset = require_finite("escapement_offset", self.escapement_offset)
-        if not abs(offset) < math.pi / 2:
-            raise ParameterError(
-                f"`escapement_offset` must lie in (-pi/2, pi/2) rad, got {offset!r}: the "
-                f"escapement acts on the lower half of the swing. A metronome a few per cent "
-                f"out of beat has an offset of a few hundredths of a radian."
-            )
+        check_quantities(self)  # w1 to escapement_offset, as declared above
+        unit = declared(self, "l2_bounds")
         lo, hi = (require_finite("l2_bounds", b) for b in self.l2_bounds)
         if not 0 <= lo < hi:
             raise ParameterError(
@@ -130,9 +138,9 @@ class MetronomeDesign:
         if self.w2 > 0 and hi >= self.w1 * self.l1 / self.w2:
             limit = self.w1 * self.l1 / self.w2
             raise ParameterError(
-                f"`l2_bounds` upper end {hi!r} m reaches the point where h <= 0 "
-                f"(L2 >= w1*L1/w2 = {limit:.5f} m): the pendulum would be inverted. "
-                f"Use an upper bound below {limit:.5f} m."
+                f"`l2_bounds` upper end {hi!r} {unit} reaches the point where h <= 0 "
+                f"(L2 >= w1*L1/w2 = {limit:.5f} {unit}): the pendulum would be inverted. "
+                f"Use an upper bound below {limit:.5f} {unit}."
             )
 
     @property
@@ -261,20 +269,22 @@ class MetronomeDesign:
         return x if x.ndim else float(x)
 
 
+@documented
 @dataclass(frozen=True)
 class Metronome:
-    """A tuned metronome: a design plus the slider position ``l2`` (m)."""
+    """A tuned metronome: a design plus the slider position ``l2``."""
 
     design: MetronomeDesign = field(default_factory=MetronomeDesign)
-    l2: float = 0.03
+    l2: float = quantity(0.03, unit="m", bounds=NON_NEGATIVE)
 
     def __post_init__(self) -> None:
-        require_positive("l2", self.l2, allow_zero=True, unit="m")
+        check_quantities(self)
         if self.h <= 0:
+            unit = declared(self, "l2")
             raise ParameterError(
-                f"`l2` = {self.l2!r} m gives h = {self.h:.3g} m <= 0: the centre of mass is "
-                f"above the pivot and the pendulum is inverted. Use l2 < "
-                f"{self.design.w1 * self.design.l1 / max(self.design.w2, 1e-300):.5f} m."
+                f"`l2` = {self.l2!r} {unit} gives h = {self.h:.3g} {unit} <= 0: the centre of "
+                f"mass is above the pivot and the pendulum is inverted. Use l2 < "
+                f"{self.design.w1 * self.design.l1 / max(self.design.w2, 1e-300):.5f} {unit}."
             )
 
     @property

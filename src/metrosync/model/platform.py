@@ -28,22 +28,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, require_positive
+from ..errors import ParameterError
+from .quantity import NON_NEGATIVE, POSITIVE, check_quantities, declared, documented, quantity
 
 PAPER_J_MIN = 0.0729
 PAPER_J_MAX = 0.25515
 PAPER_N_MAX = 7
 
 
+@documented
 @dataclass(frozen=True)
 class Platform:
-    """Disk parameters, SI units.
+    """Disk parameters, SI units (each declared on its field and listed below).
 
-    radius : R, distance of the pivots from the axis, m.
-    c_phi : viscous friction of the disk's bearing, kg m²/s.
-    j0, j_per_metronome : the law J(N) = j0 + N·j_per_metronome, kg m².
+    radius : R, distance of the pivots from the axis.
+    c_phi : viscous friction of the disk's bearing.
+    j0, j_per_metronome : the law J(N) = j0 + N·j_per_metronome.
     inertia : if set, a fixed J that ignores the law; ``math.inf`` pins the disk.
-    forcing_amplitude : A of the external torque τ(t) = A sin(Ω t) on the disk, N m;
+    forcing_amplitude : A of the external torque τ(t) = A sin(Ω t) on the disk;
         0 (the default) switches it off.
     forcing_bpm : the forcing's frequency in the metronomes' BPM, Ω = π·BPM/60 rad/s;
         needed (> 0) when ``forcing_amplitude`` is not 0.
@@ -51,37 +53,38 @@ class Platform:
         −Σ𝕄_i term of eq. (metron2a) (True, as the paper writes it). False keeps the
         kicks on the pendulums but takes their reaction off the disk, as if the
         escapement were driven from outside the platform. Accepts 0 or 1.
-    disk_dry_friction : the disk's Coulomb friction torque, N m: the largest torque
-        that holds the disk at rest, and the torque against a slipping disk; 0 for none.
+    disk_dry_friction : the disk's Coulomb friction torque: the largest torque that
+        holds the disk at rest, and the torque against a slipping disk; 0 for none.
     """
 
-    radius: float = 0.27
-    c_phi: float = 1e-5
-    j0: float = PAPER_J_MIN
-    j_per_metronome: float = (PAPER_J_MAX - PAPER_J_MIN) / PAPER_N_MAX
-    inertia: float | None = None
-    forcing_amplitude: float = 0.0
-    forcing_bpm: float = 0.0
+    radius: float = quantity(0.27, unit="m", bounds=POSITIVE)
+    c_phi: float = quantity(1e-5, unit="kg m²/s", bounds=NON_NEGATIVE)
+    j0: float = quantity(PAPER_J_MIN, unit="kg m²", bounds=NON_NEGATIVE)
+    j_per_metronome: float = quantity(
+        (PAPER_J_MAX - PAPER_J_MIN) / PAPER_N_MAX, unit="kg m²", bounds=NON_NEGATIVE
+    )
+    #: None (the law) or, checked in `__post_init__`, within its bounds or ``math.inf``.
+    inertia: float | None = quantity(None, unit="kg m²", bounds=POSITIVE)
+    forcing_amplitude: float = quantity(0.0, unit="N m", bounds=NON_NEGATIVE)
+    forcing_bpm: float = quantity(0.0, unit="BPM", bounds=NON_NEGATIVE)
     escapement_reaction: bool = True
-    disk_dry_friction: float = 0.0
+    disk_dry_friction: float = quantity(0.0, unit="N m", bounds=NON_NEGATIVE)
 
     def __post_init__(self) -> None:
-        require_positive("radius", self.radius, unit="m")
-        require_positive("c_phi", self.c_phi, allow_zero=True, unit="kg m²/s")
-        require_positive("j0", self.j0, allow_zero=True, unit="kg m²")
-        require_positive("j_per_metronome", self.j_per_metronome, allow_zero=True, unit="kg m²")
-        require_positive("disk_dry_friction", self.disk_dry_friction, allow_zero=True, unit="N m")
-        if self.inertia is not None and not (self.inertia == math.inf or self.inertia > 0):
+        # In the order they have always been checked: the first wrong value is named.
+        check_quantities(self, "radius", "c_phi", "j0", "j_per_metronome", "disk_dry_friction")
+        inertia, bounds = self.inertia, declared(self, "inertia", "bounds")
+        if inertia is not None and not (inertia == math.inf or bounds.admits(inertia)):
             raise ParameterError(
-                f"`inertia` must be > 0 kg m² (or math.inf for a rigid support), "
-                f"got {self.inertia!r}."
+                f"`inertia` must {bounds} {declared(self, 'inertia')} (or math.inf for a rigid "
+                f"support), got {inertia!r}."
             )
-        require_positive("forcing_amplitude", self.forcing_amplitude, allow_zero=True, unit="N m")
-        require_positive("forcing_bpm", self.forcing_bpm, allow_zero=True, unit="BPM")
+        check_quantities(self, "forcing_amplitude", "forcing_bpm")
         if self.forcing_amplitude > 0 and self.forcing_bpm == 0:
             raise ParameterError(
-                f"`forcing_amplitude` = {self.forcing_amplitude!r} N m needs a frequency: set "
-                f"`forcing_bpm` > 0 (Ω = π·BPM/60, e.g. the metronomes' BPM for resonance)."
+                f"`forcing_amplitude` = {self.forcing_amplitude!r} "
+                f"{declared(self, 'forcing_amplitude')} needs a frequency: set `forcing_bpm` > 0 "
+                f"(Ω = π·BPM/60, e.g. the metronomes' BPM for resonance)."
             )
         reaction = self.escapement_reaction
         if not (isinstance(reaction, bool | np.bool_) or reaction in (0, 1)):

@@ -32,6 +32,8 @@ from .._version import __version__
 from ..errors import ParameterError, describe
 from ..groups import as_groups, describe_groups, shifted
 from ..model import TUNINGS, MetronomeDesign, Platform, get_preset
+from ..model.quantity import units
+from ..simulation.request import SimulationRequest
 from .points import PointSpec, canonical_json, make_point
 
 #: Ensemble settings of `simulate`, with their type and default in a sweep.
@@ -67,28 +69,16 @@ ALIASES = {
     "J": "inertia",
     "seeds": "seed",
 }
+#: Units of the settings and parameters a sweep can vary, as file attributes write them:
+#: each declared once, on the field that defines it (`metrosync.model.quantity`).
 UNITS = {
-    "amplitude": "rad",
-    "bpm": "BPM",
-    "group_offset_bpm": "BPM",
-    "sigma_bpm": "BPM",
-    "duration": "s",
-    "dt": "s",
-    "drive": "N m s",
-    "c_theta": "kg m2/s",
-    "c_phi": "kg m2/s",
-    "inertia": "kg m2",
-    "j0": "kg m2",
-    "j_per_metronome": "kg m2",
-    "w1": "kg",
-    "w2": "kg",
-    "l1": "m",
-    "radius": "m",
-    "g": "m/s2",
-    "forcing_amplitude": "N m",
-    "forcing_bpm": "BPM",
-    "escapement_offset": "rad",
-    "disk_dry_friction": "N m",
+    name: unit
+    for name, unit in {
+        **units(SimulationRequest),
+        "group_offset_bpm": "BPM",
+        **units(MetronomeDesign, Platform),
+    }.items()
+    if name in ENSEMBLE_SETTINGS or name in GROUP_SETTINGS or name in MODEL_PARAMETERS
 }
 #: Model switches: true/false in TOML, 0 or 1 on the command line.
 SWITCHES = ("escapement_reaction",)

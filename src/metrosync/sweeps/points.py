@@ -10,9 +10,9 @@ SHA-256 over everything that decides the stored result:
 - what is kept of the result (``keep``, see `metrosync.sweeps.keep`);
 - the package version;
 - a digest of the sources that compute the result (`source_digest`): every module of
-  the ``integrators``, ``model`` and ``observables`` packages, found by walking the
-  folders (a renamed or added module is covered), plus ``equations.py``,
-  ``ensemble.py``, ``simulate.py`` and the reductions in ``sweeps/keep.py``.
+  the ``integrators``, ``model``, ``observables`` and ``simulation`` packages, found by
+  walking the folders (a renamed or added module is covered), plus ``equations.py``,
+  ``ensemble.py``, ``groups.py``, ``simulate.py`` and the reductions in ``sweeps/keep.py``.
 
 A stored point is therefore reused only when recomputing it would give the same file.
 Every entry point that stores points (`metrosync.sweep`, `metrosync.reproduce`) builds
@@ -40,8 +40,8 @@ from ..model import get_preset
 KEEPS = ("r_eq", "r_eq+r", "run_mean_r", "z")
 #: Packages (folders) and modules, relative to the metrosync package, whose source
 #: decides a point's result.
-SOURCE_PACKAGES = ("integrators", "model", "observables")
-SOURCE_MODULES = ("equations.py", "ensemble.py", "simulate.py", "sweeps/keep.py")
+SOURCE_PACKAGES = ("integrators", "model", "observables", "simulation")
+SOURCE_MODULES = ("equations.py", "ensemble.py", "groups.py", "simulate.py", "sweeps/keep.py")
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ import xarray as xr
 from .._words import plural
 from ..budget import Budget, simulation_budget
 from ..errors import Interrupted, OverturnWarning, ParameterError
-from ..simulate import record_stride
+from ..simulation.request import record_stride
 from .executors import Execution, check_scheduler, execute
 from .grid import MODEL_PARAMETERS, Grid
 from .store import PointStore, merge, write_dataset
