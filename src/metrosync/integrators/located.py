@@ -33,11 +33,13 @@ two more terms per metronome in the second pass. The layouts are
 `kernel_located_runs` and `kernel_located_oscillators`, picked as for ``verlet``;
 `reference_located` is the NumPy twin. The scheme takes the forcing torque and the
 escapement's offset and reaction from `_physics` like ``verlet``; it refuses dry
-friction on the disk (`refuse_dry_friction`).
+friction on the disk (`metrosync.capabilities` says so): its stick/slip events would
+need locating inside the step like the kicks.
 """
 
 from __future__ import annotations
 
+from ..capabilities import require
 from . import kernel_located_oscillators, kernel_located_runs
 from ._state import StepState
 from .verlet import advance_in_layout
@@ -51,16 +53,8 @@ def advance_state(
 ):
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from the problem's size, as for ``verlet``)."""
-    refuse_dry_friction(sys)
+    require("located/numba", sys)
     advance_in_layout(
         LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
         overturn_angle=overturn_angle, layout=layout,
     )  # fmt: skip
-
-
-def refuse_dry_friction(sys) -> None:
-    """`ParameterError` for dry friction on the disk, which this scheme does not have:
-    its stick/slip events would need locating inside the step like the kicks."""
-    sys.refuse_dry_friction(
-        "integrator 'located' has no dry friction on the disk", "integrator='verlet' (or 'exact')"
-    )

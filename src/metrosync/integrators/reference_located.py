@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..capabilities import require
 from ..equations import SystemArrays, accelerations, disk_torque, escapement
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._abi import constants_of
 from ._located_parts import kick
 from ._physics import disk_acceleration
 from ._state import StepState
-from .located import refuse_dry_friction
 from .reference import _add_crossing_phase, _record
 
 
@@ -35,7 +35,7 @@ def advance_state(
     overturn_angle: float,
 ) -> None:
     """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
-    refuse_dry_friction(sys)
+    require("located/numpy", sys)
     c = constants_of(sys, dt)
     if step0 == 0:
         _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
