@@ -26,6 +26,7 @@ from importlib import resources
 from pathlib import Path
 
 from .._files import write_text
+from ..capabilities import require
 from .._version import __version__
 from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
@@ -103,6 +104,8 @@ def playground_config(
             f"`tuning` = {params.metronome.tuning!r} is not available there. Leave out "
             f"`tuning` (CLI: --set tuning=...)."
         )
+    # The page runs the model terms the capability table says it has, and no other.
+    require("playground", params)
     _check_ranges(params)
     get_preset(params)  # warns if its pendulums overturn, once the values are known to fit
     presets = {name: preset_data(get_preset(name, warn=False)) for name in PRESETS}
