@@ -242,9 +242,13 @@ class Consumer:
 
 
 _ALL = frozenset(FEATURES)
-#: The playground's JavaScript (`metrosync.show.playground`): the paper's model;
-#: ``run(params, steps)`` returns trajectories; no groups' orders, no kick records.
-PLAYGROUND_RUNS = frozenset({"trajectories"})
+#: The playground's JavaScript (`metrosync.show.playground`): the paper's model with
+#: the forcing torque, the escapement's offset and reaction switch, and dry friction on
+#: the disk; ``run(params, steps)`` returns trajectories; no groups' orders, no kick
+#: records.
+PLAYGROUND_RUNS = frozenset(
+    {"forcing", "escapement-offset", "no-escapement-reaction", "dry-friction", "trajectories"}
+)
 
 CONSUMERS: dict[str, Consumer] = {
     c.name: c
