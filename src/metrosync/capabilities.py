@@ -242,12 +242,19 @@ class Consumer:
 
 
 _ALL = frozenset(FEATURES)
-#: The playground's JavaScript (`metrosync.show.playground`): the paper's model with
-#: the forcing torque, the escapement's offset and reaction switch, and dry friction on
-#: the disk; ``run(params, steps)`` returns trajectories; no groups' orders, no kick
-#: records.
+#: The playground's JavaScript (`metrosync.show.playground`): every term of the model
+#: (the forcing torque, the escapement's offset and reaction switch, dry friction on
+#: the disk) and the steady-swing tuning; ``run(params, steps)`` returns trajectories;
+#: no groups' orders, no kick records.
 PLAYGROUND_RUNS = frozenset(
-    {"forcing", "escapement-offset", "no-escapement-reaction", "dry-friction", "trajectories"}
+    {
+        "forcing",
+        "escapement-offset",
+        "no-escapement-reaction",
+        "dry-friction",
+        "steady-swing",
+        "trajectories",
+    }
 )
 
 CONSUMERS: dict[str, Consumer] = {

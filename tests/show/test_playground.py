@@ -252,6 +252,25 @@ def test_browser_physics_is_the_numpy_reference(browser, tmp_path, case):
                                    err_msg=name)  # fmt: skip
 
 
+def test_the_page_tunes_by_the_steady_swing_as_the_package_does(browser, tmp_path):
+    """L2 from a BPM under ``tuning="steady-swing"``: the page's inversion of the
+    package's spline against `l2_for_bpm`, over the tunable range."""
+    from metrosync.theory.tuning import l2_for_bpm
+
+    config = playground_config(changes={"tuning": "steady-swing"}, bpm=180.0)
+    design = PRESETS["default"].metronome
+    low, high = config["presets"]["default+changes"]["bpm_range"]
+    bpms = np.linspace(low, high, 41)
+    page = write_playground(tmp_path / "play.html", changes={"tuning": "steady-swing"}, bpm=180.0)
+    open_offline(browser, page)
+    got = browser.evaluate(
+        "(() => { const c = window.metrosync.config.presets['default+changes'].constants;"
+        f" return {json.dumps(bpms.tolist())}.map((b) => Physics.l2ForBpm(c, b)); }})()"
+    )
+    expected = l2_for_bpm(design, bpms, tuning="steady-swing")
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
+
+
 #: Every model feature of the capability table, and all of them together; the dry
 #: friction also strong enough to hold the disk between kicks.
 FEATURE_CASES = {name: dict(f.example) for name, f in FEATURES.items() if f.kind == "model"}

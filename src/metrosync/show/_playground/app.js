@@ -54,6 +54,10 @@
     $("hold").checked = s.hold;
     $("jlaw").checked = s.jLaw;
     drive.set(s.drive); cphi.set(s.cPhi); inertia.set(s.j);
+    // The steady-swing tuning's spline is the preset's drive's: M stays as tuned.
+    const steady = session.constants.tuning === "steady-swing";
+    $("drive").disabled = steady;
+    $("drive").title = steady ? "the steady-swing tuning holds M at the preset's value" : "";
     showValues();
   }
 

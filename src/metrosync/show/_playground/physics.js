@@ -60,7 +60,10 @@ const Physics = (function () {
   function l2ForBpm(d, bpm) {
     if (d.tuning !== "steady-swing") return smallAmplitudeL2(d, bpm);
     const table = d.steady_swing;
-    if (!table) throw new Error("the steady-swing tuning needs its table from the package");
+    if (!table) throw new Error("the steady-swing tuning needs its spline from the package");
+    if (d.drive !== table.drive || d.c_theta !== table.c_theta) {
+      throw new Error("the steady-swing spline was made for another drive or friction");
+    }
     const [lo, hi] = d.l2_bounds, [natLo, natHi] = table.natural_range;
     let x = (lo + hi) / 2;
     for (let round = 0; round < table.max_rounds; round++) {
