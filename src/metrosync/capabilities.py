@@ -59,8 +59,9 @@ class Feature:
     summary : one line for help texts and messages.
     lacks : how a message says that a consumer does not have it ("no dry friction on
         the disk"); "has {lacks}" must read as a sentence.
-    example : model parameter changes (``with_changes``) that switch it on, or for a
-        run option, `simulate` keyword arguments; tests use it.
+    example : for a model feature, the parameter changes (``with_changes``) that
+        switch it on; for a run option, `simulate`'s keyword arguments that ask for it
+        (for two metronomes); tests ask every consumer with it.
     kind : ``"model"`` (a term of the equations, or the tuning), ``"run"`` (a run
         option or record of `simulate`).
     from_params : (ModelParameters) → `Found` when it is on, else None.
@@ -206,10 +207,12 @@ FEATURES: dict[str, Feature] = {
             parameters=("escapement_stopped",),
             summary="each escapement's last kick, which flags a metronome that stopped",
             lacks="no record of each escapement's last kick",
-            example={"escapement_offset": 0.45},
+            example={"changes": {"escapement_offset": 0.45}, "theta0": [0.3, 0.6]},
             kind="run",
-            # Every `simulate` records it: every request asks for it.
-            from_request=lambda r: ("escapement_stopped", True, ""),
+            # `simulate` records it always, and says so in its request.
+            from_request=lambda r: (
+                ("escapement_stopped", True, "") if r.get("escapement_stopped") else None
+            ),
         ),
     )
 }

@@ -159,7 +159,8 @@ def simulate(
     if backend not in BACKENDS:
         raise ParameterError(f"unknown `backend` {backend!r}; choose one of {sorted(BACKENDS)}.")
     # What runs where is one table (`metrosync.capabilities`): refuse before any work.
-    scheme.require(backend, params, {"trajectories": trajectories, "groups": groups})
+    request = {"trajectories": trajectories, "groups": groups, "escapement_stopped": True}
+    scheme.require(backend, params, request)
     if not (math.isfinite(duration) and duration > 0):
         raise ParameterError(f"`duration` must be a finite time > 0 s, got {duration!r}.")
     if not (math.isfinite(overturn_angle) and overturn_angle > 0):
