@@ -150,3 +150,21 @@ def test_reading_the_table_loads_nothing_heavy():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_budget_times_each_consumer_as_its_cost_in_the_table_says():
+    from metrosync import budget
+
+    size = {"n": 7, "runs": 10, "steps": 1000, "records": 101, "trajectories": False}
+    per_run_step = 10 * 1000 * (budget.NUMBA_RUN_STEP + budget.NUMBA_OSC_STEP * 7)
+    expected = {
+        "compiled": per_run_step,
+        "numpy": 1000 * (budget.NUMPY_STEP + budget.NUMPY_OSC_STEP * 70),
+        "whole-run": 10 * 1000 * 0.01 * (budget.EXACT_RUN_SECOND + budget.EXACT_OSC_SECOND * 7),
+    }
+    for c in CONSUMERS.values():
+        if c.integrator is None:
+            continue
+        estimate = budget.simulation_budget(**size, integrator=c.integrator, backend=c.backend)
+        assert estimate.seconds == pytest.approx(expected[c.cost]), c.name
+        assert ("one run's samples" in estimate.arrays) == (c.cost == "whole-run")
