@@ -296,6 +296,8 @@ def test_the_page_runs_each_model_feature_or_refuses_it_by_name(request, tmp_pat
     base = CASES["free"]["changes"]
     page = write_playground(tmp_path / "play.html", changes={**base, **changes})
     open_offline(browser, page)
+    # The page says which terms beyond the paper it runs.
+    wait_for(browser, "document.getElementById('status').textContent.includes('Beyond the paper')")
     out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
     ds = metrosync.simulate(
         None, None, **params, duration=100.0, dt=0.01, record_every=1, trajectories=True,
