@@ -244,6 +244,9 @@ class Consumer:
         return self.name.split("/")[1] if "/" in self.name else None
 
 
+#: The integrators share one set of force functions (`equations`, `integrators._physics`),
+#: so each runs every feature but those it names; a feature added to the table is then
+#: compared between every layout and its NumPy twin (tests/integrators/test_kernels.py).
 _ALL = frozenset(FEATURES)
 #: The playground's JavaScript (`metrosync.show.playground`): every term of the model
 #: (the forcing torque, the escapement's offset and reaction switch, dry friction on
