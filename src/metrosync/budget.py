@@ -25,7 +25,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import MetrosyncError
+from .capabilities import consumer_of
+from .errors import MetrosyncError, ParameterError
 
 #: Estimated work above this many seconds draws a `LongRunWarning`.
 WARN_SECONDS = 180.0
@@ -156,11 +157,17 @@ def simulation_budget(
         # θ and θ̇ (runs, records, N), φ and φ̇ (runs, records), and one transposed
         # copy of the largest while a NetCDF file is written.
         arrays["trajectories"] = 8.0 * records * runs * (3 * n + 2)
-    if integrator == "exact":
+    # How a consumer's time grows is the capability table's (`Consumer.cost`); a
+    # request for none (refused later, by name) is sized as a compiled kernel.
+    try:
+        cost = consumer_of(integrator, backend).cost
+    except ParameterError:
+        cost = "compiled"
+    if cost == "whole-run":
         # one run at a time: its dense samples (records, 2N + 2) and the phases.
         arrays["one run's samples"] = 8.0 * records * (5 * n + 2)
         seconds = runs * steps * dt * (EXACT_RUN_SECOND + EXACT_OSC_SECOND * n)
-    elif backend == "numpy":
+    elif cost == "numpy":
         seconds = steps * (NUMPY_STEP + NUMPY_OSC_STEP * oscillators)
     else:
         seconds = runs * float(steps) * (NUMBA_RUN_STEP + NUMBA_OSC_STEP * n)

@@ -1,6 +1,9 @@
 """The tuning has one source in every command that takes `--tuning` or `--set tuning=`:
 what is computed, printed, stored and cached is the same tuning, however it is spelled."""
 
+import json
+import re
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -74,11 +77,13 @@ def test_sweep_set_tuning_reaches_the_model(tmp_path, capsys, spec):
     assert xr.load_dataset(out, engine="h5netcdf").attrs["model_tuning"] == spec
 
 
-def test_playground_refuses_a_tuning_its_page_cannot_compute(tmp_path, capsys):
-    # The page sets L2 by the small-amplitude formula: a steady-swing label would lie.
+def test_playground_takes_the_steady_swing_tuning(tmp_path, capsys):
+    # The page inverts the steady-swing tuning with the package's own spline (the
+    # browser test compares its L2 with `l2_for_bpm`), so the label is what it computes.
     out = tmp_path / "p.html"
-    assert main(["playground", "--set", "tuning=steady-swing", "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "tunes a metronome by its small-amplitude frequency only" in err
-    assert "--set tuning=" in err and not out.exists()
+    assert main(["playground", "--set", "tuning=steady-swing", "--out", str(out)]) == 0
+    constants = json.loads(
+        re.search(r'id="config">(.*?)</script>', out.read_text(encoding="utf-8"), re.S)[1]
+    )["presets"]["default+changes"]["constants"]
+    assert constants["tuning"] == "steady-swing" and constants["steady_swing"]["knots"]
     assert main(["playground", "--set", "tuning=small-amplitude", "--out", str(out)]) == 0

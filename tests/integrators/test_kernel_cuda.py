@@ -14,6 +14,7 @@ SIMULATED_CHECK = """
 import math
 import numpy as np
 from metrosync import build_ensemble, get_preset
+from metrosync.capabilities import FEATURES as TABLE, UnsupportedFeature, runs
 from metrosync.integrators import kernel_cuda, twin
 from metrosync.integrators._state import StepState
 
@@ -26,11 +27,11 @@ def run(advance, **kw):
     return st
 
 # 4 threads for 5 metronomes: each thread strides over two of them; then two groups,
-# then the features beyond the paper (the GPU kernel compiles the same _physics
-# functions, so it has them too).
+# then the features beyond the paper that the capability table says the GPU runs (its
+# kernel compiles the same _physics functions), all at once.
 # Last, escapements beyond the start swing of two metronomes: they never fire.
-FEATURES = {"forcing_amplitude": 0.02, "forcing_bpm": 189.0, "escapement_offset": 0.07,
-            "escapement_reaction": False}
+FEATURES = {k: v for name, f in TABLE.items() if f.kind == "model" and runs("verlet/gpu", name)
+            for k, v in f.example.items()}
 DEATH = ({"escapement_offset": 0.45}, {"theta0": [0.2, 0.3, 0.5, 0.6, 0.7],
                                         "theta_dot0": [0.0] * 5})
 for groups, changes, start in ((None, {}, {}), ([(2, 186.0), (3, 198.0)], {}, {}),
@@ -60,6 +61,18 @@ ref = run(twin.VERLET.advance_state)
 assert ref.status[1] & 2 and np.isnan(ref.r[1]).all()
 np.testing.assert_array_equal(gpu.status, ref.status)
 np.testing.assert_allclose(gpu.r, ref.r, rtol=0, atol=1e-9)  # NaN in the same places
+
+# The model features the table says it lacks, it refuses by name.
+for name, f in TABLE.items():
+    if f.kind == "model" and not runs("verlet/gpu", name):
+        params = get_preset("default").with_changes(**f.example)
+        ens = build_ensemble(3, 192.0, params=params, runs=2, seed=3)
+        try:
+            run(kernel_cuda.advance_state, threads=4)
+        except UnsupportedFeature as refused:
+            assert refused.feature == name and f.parameters[0] in str(refused), refused
+        else:
+            raise AssertionError(f"the GPU kernel ran {name}")
 print("ok")
 """
 

@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 
 from metrosync import build_ensemble, get_preset
+from metrosync.capabilities import FEATURES as TABLE
+from metrosync.capabilities import runs
 from metrosync.integrators import layout_metronomes, layout_runs, layouts, twin, verlet
 from metrosync.integrators._abi import constants_of, settings_of
 from metrosync.integrators._state import StepState
@@ -32,11 +34,10 @@ def run(advance, ens, steps, **kwargs):
 
 #: Model features every layout must reproduce, switched on one at a time and all at once:
 #: name -> keyword arguments of `build_ensemble` for n metronomes (``params`` included).
-FORCING = {"forcing_amplitude": 0.02, "forcing_bpm": 189.0}
-ESCAPEMENT = {"escapement_offset": 0.07, "escapement_reaction": False}
-#: Dry friction on the disk below the pendulums' reaction: stick-slip, with stops and
-#: reversals within steps.
-DRY = {"disk_dry_friction": 5e-3}
+#: The model's terms are the capability table's (`metrosync.capabilities`), each with
+#: its example values, so a term added there is tested here (and for every scheme that
+#: runs it, `features_for`) without a line written here. The table's dry friction is
+#: below the pendulums' reaction: stick-slip, with stops and reversals within steps.
 
 
 DEATH_OFFSET = 0.45
@@ -51,25 +52,39 @@ def with_changes(**changes):
     return {"params": get_preset("default").with_changes(**changes)}
 
 
-FEATURES = {
-    "plain": lambda n: {},
+#: The table's run options, as ensembles: a new one must be given its builder here.
+RUN_OPTIONS = {
     # Three groups at their own frequencies, the first of a single metronome.
     "groups": lambda n: {
         "groups": [(1, 184.0), ((n - 1) // 2, 192.0), (n - 1 - (n - 1) // 2, 200.0, 1.0)]
     },
-    "forcing": lambda n: with_changes(**FORCING),
-    "escapement": lambda n: with_changes(**ESCAPEMENT),
-    "dry-friction": lambda n: with_changes(**DRY),
-    # ... and near the kick's torque: held, jolted at kicks, held again.
-    "dry-friction-held": lambda n: with_changes(disk_dry_friction=2e-2),
     # Escapements beyond the start swing of the first metronomes: those never fire and
     # decay ("metronome death"), the others keep going.
     "death": lambda n: {**with_changes(escapement_offset=DEATH_OFFSET), **death_start(n)},
+    "trajectories": None,  # every run here records them
 }
-FEATURES["all"] = lambda n: {
-    **FEATURES["groups"](n),
-    **with_changes(**FORCING, **ESCAPEMENT, **DRY),
-}
+
+
+def features_for(consumer: str) -> dict:
+    """The features of the capability table that ``consumer`` runs, one at a time and
+    all at once (``"all"``), with the baseline (``"plain"``)."""
+    out = {"plain": lambda n: {}}
+    together = {}
+    for name, f in TABLE.items():
+        if not runs(consumer, name):
+            continue
+        if f.kind == "model":
+            out[name] = partial(lambda example, n: with_changes(**example), dict(f.example))
+            together.update(f.example)
+        elif RUN_OPTIONS[name] is not None:
+            out[name] = RUN_OPTIONS[name]
+    if "dry-friction" in out:  # ... and near the kick's torque: held, jolted, held again.
+        out["dry-friction-held"] = lambda n: with_changes(disk_dry_friction=2e-2)
+    out["all"] = lambda n: {**out["groups"](n), **with_changes(**together)}
+    return out
+
+
+FEATURES = features_for("verlet/numba")
 
 
 @pytest.mark.parametrize("feature", sorted(FEATURES))

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from test_kernels import DEATH_OFFSET, ESCAPEMENT, FEATURES, FORCING, with_changes
+from test_kernels import DEATH_OFFSET, features_for
 
 from metrosync import ParameterError, build_ensemble, get_preset, simulate
 from metrosync.integrators import REGISTRY, located, twin, verlet
@@ -24,12 +24,8 @@ def run(advance, ens, steps, *, dt=0.01, chunks=1, **kwargs):
     return state
 
 
-#: The model features of test_kernels but dry friction, which ``located`` refuses.
-LOCATED_FEATURES = {k: v for k, v in FEATURES.items() if not k.startswith("dry-friction")}
-LOCATED_FEATURES["all"] = lambda n: {
-    **FEATURES["groups"](n),
-    **with_changes(**FORCING, **ESCAPEMENT),
-}
+#: The features of the capability table that ``located`` runs (test_kernels).
+LOCATED_FEATURES = features_for("located/numba")
 
 
 @pytest.mark.parametrize("feature", sorted(LOCATED_FEATURES))

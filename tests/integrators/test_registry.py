@@ -1,8 +1,6 @@
 """The integrator registry: what each integrator declares is what `simulate` and the
 CLI offer and do."""
 
-import importlib
-
 import pytest
 
 from metrosync import ParameterError, simulate
@@ -12,6 +10,7 @@ from metrosync.integrators import (
     REGISTRY,
     get_integrator,
     integrator_names,
+    load_backend,
 )
 
 
@@ -23,7 +22,7 @@ def test_every_backend_of_every_integrator_is_implemented(name):
     assert set(scheme.trajectories) <= set(scheme.backends)
     for backend, module in scheme.modules.items():
         entry = "advance_state" if scheme.fixed_step else "integrate"
-        assert callable(getattr(importlib.import_module(module), entry)), (backend, module)
+        assert callable(getattr(load_backend(module), entry)), (backend, module)
         if scheme.fixed_step:
             assert backend in BACKENDS
 

@@ -17,11 +17,13 @@ import numpy as np
 import pytest
 
 import metrosync
+from metrosync.capabilities import FEATURES, UnsupportedFeature, runs
 from metrosync.cli import main
 from metrosync.errors import ParameterError
 from metrosync.model import PRESETS
 from metrosync.show.playground import SCRIPTS, playground_config, write_playground
 
+MODEL_FEATURES = [name for name, f in FEATURES.items() if f.kind == "model"]
 ASSETS = Path(metrosync.show.playground.__file__).parent / "_playground"
 
 
@@ -245,6 +247,66 @@ def test_browser_physics_is_the_numpy_reference(browser, tmp_path, case):
         trajectories=True, backend="numpy", changes=changes or None,
     ).isel(run=0)  # fmt: skip
     assert len(out["theta"]) == ds.sizes["time"] == 10001
+    for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
+        np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
+                                   err_msg=name)  # fmt: skip
+
+
+def test_the_page_tunes_by_the_steady_swing_as_the_package_does(browser, tmp_path):
+    """L2 from a BPM under ``tuning="steady-swing"``: the page's inversion of the
+    package's spline against `l2_for_bpm`, over the tunable range."""
+    from metrosync.model.tuning import l2_for_bpm
+
+    config = playground_config(changes={"tuning": "steady-swing"}, bpm=180.0)
+    design = PRESETS["default"].metronome
+    low, high = config["presets"]["default+changes"]["bpm_range"]
+    bpms = np.linspace(low, high, 41)
+    page = write_playground(tmp_path / "play.html", changes={"tuning": "steady-swing"}, bpm=180.0)
+    open_offline(browser, page)
+    got = browser.evaluate(
+        "(() => { const c = window.metrosync.config.presets['default+changes'].constants;"
+        f" return {json.dumps(bpms.tolist())}.map((b) => Physics.l2ForBpm(c, b)); }})()"
+    )
+    expected = l2_for_bpm(design, bpms, tuning="steady-swing")
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-15)
+
+
+#: Every model feature of the capability table, and all of them together; the dry
+#: friction also strong enough to hold the disk between kicks.
+FEATURE_CASES = {name: dict(f.example) for name, f in FEATURES.items() if f.kind == "model"}
+FEATURE_CASES["dry-friction-held"] = {"disk_dry_friction": 2e-2}
+FEATURE_CASES["all"] = {k: v for name in MODEL_FEATURES for k, v in FEATURES[name].example.items()}
+
+
+@pytest.mark.parametrize("case", sorted(FEATURE_CASES))
+def test_the_page_runs_each_model_feature_or_refuses_it_by_name(request, tmp_path, case):
+    """Each feature of the capability table: refused by name, or the page's physics is
+    `simulate(..., backend="numpy")`'s to 1e-9 over 10 000 steps with it on."""
+    changes = FEATURE_CASES[case]
+    named = [FEATURES[n] for n in FEATURES if set(FEATURES[n].parameters) & set(changes)]
+    if not all(runs("playground", f.name) for f in named):
+        with pytest.raises(UnsupportedFeature) as refused:
+            playground_config(changes=changes)
+        assert refused.value.feature in {f.name for f in named}
+        assert f"`{FEATURES[refused.value.feature].parameters[0]}` = " in str(refused.value)
+        assert "the playground has no" in str(refused.value)
+        return
+    browser = request.getfixturevalue("browser")  # skips, naming the package, without one
+    params = {k: v for k, v in CASES["free"].items() if k != "changes"}
+    base = CASES["free"]["changes"]
+    page = write_playground(tmp_path / "play.html", changes={**base, **changes})
+    open_offline(browser, page)
+    # The page says which terms beyond the paper it runs.
+    wait_for(browser, "document.getElementById('status').textContent.includes('Beyond the paper')")
+    out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
+    ds = metrosync.simulate(
+        None, None, **params, duration=100.0, dt=0.01, record_every=1, trajectories=True,
+        backend="numpy", changes={**base, **changes},
+    ).isel(run=0)  # fmt: skip
+    assert out["status"] == int(ds.status) == 0
+    if "disk_dry_friction" in changes:
+        held = np.count_nonzero(np.array(out["phi_dot"][1:]) == 0.0)  # after the start
+        assert held > 0, "the disk never stuck"
     for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
         np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
                                    err_msg=name)  # fmt: skip

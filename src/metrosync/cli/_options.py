@@ -12,6 +12,7 @@ import argparse
 import math
 import warnings
 
+from ..capabilities import describe_lacks
 from ..errors import ParameterError
 from ..groups import Group, parse_group
 from ..integrators import BACKENDS, REGISTRY, get_integrator, integrator_names
@@ -128,7 +129,10 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
         "--integrator",
         choices=integrator_names(),
         default=integrator_names()[0],
-        help="; ".join(f"{i.name}: {i.summary}" for i in REGISTRY.values()),
+        help="; ".join(
+            f"{i.name}: {i.summary}" + (f" ({lacks})" if (lacks := describe_lacks(i.name)) else "")
+            for i in REGISTRY.values()
+        ),
     )
     g.add_argument(
         "--backend",

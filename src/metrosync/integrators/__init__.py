@@ -1,10 +1,12 @@
 """Integrators, picked by name from one table (as scipy's ``solve_ivp`` and diffrax do).
 
 Each `Integrator` declares its name, its convergence order without and with the
-escapement's kicks, the backends it runs on, which of them record trajectories, and
-the module of each backend (imported on first use, so that importing metrosync does
-not load numba or scipy). `simulate` looks a name up with `get_integrator`; the CLI's
-``--integrator`` choices are `integrator_names()`; an unknown name lists the valid ones.
+escapement's kicks, the backends it runs on, and the module of each backend (imported
+on first use, so that importing metrosync does not load numba or scipy). Which model
+features and records each backend has is the table of `metrosync.capabilities`
+(``Integrator.trajectories`` reads it); `simulate` asks that table before it runs.
+`simulate` looks a name up with `get_integrator`; the CLI's ``--integrator`` choices
+are `integrator_names()`; an unknown name lists the valid ones.
 
 There are two kinds. A *fixed-step* scheme advances a `StepState` chunk by chunk:
 `Integrator.stepper` gives the backend's module, whose ``advance_state(state, sys, *,
@@ -23,6 +25,7 @@ import importlib
 from dataclasses import dataclass, field
 from types import ModuleType
 
+from ..capabilities import backends_running, consumer_of, require
 from ..errors import ParameterError
 
 #: The backends a user can ask for, with what each is.
@@ -43,7 +46,6 @@ class Integrator:
     order_with_kicks : the same with the escapement's impulses.
     modules : backend name → where it is implemented, ``module`` or ``module:object``
         (the first is the default).
-    trajectories : the backends that can record θ, θ̇, φ, φ̇.
     fixed_step : True for a scheme driven step by step (see the module docstring).
     """
 
@@ -52,36 +54,50 @@ class Integrator:
     order: int
     order_with_kicks: int
     modules: dict[str, str] = field(repr=False)
-    trajectories: tuple[str, ...]
     fixed_step: bool
 
     @property
     def backends(self) -> tuple[str, ...]:
         return tuple(self.modules)
 
-    def stepper(self, backend: str, *, trajectories: bool) -> ModuleType:
-        """The module that advances this scheme on ``backend``; `ParameterError` if the
-        scheme lacks that backend, the backend cannot record the asked trajectories, or
-        it needs hardware this machine does not have."""
+    @property
+    def trajectories(self) -> tuple[str, ...]:
+        """The backends that record θ, θ̇, φ, φ̇ (`metrosync.capabilities`)."""
+        return backends_running(self.name, "trajectories")
+
+    def require(self, backend: str, *sources) -> None:
+        """Refuse what this scheme cannot run on ``backend``: `ParameterError` if it
+        lacks the backend, `metrosync.capabilities.UnsupportedFeature` for a feature on
+        in ``sources`` (model parameters, system arrays, a mapping of `simulate`'s
+        options) that the backend does not run. A whole-run integrator has one backend,
+        whatever ``backend`` says."""
+        if self.fixed_step:
+            self._check_backend(backend)
+        require(consumer_of(self.name, backend).name, *sources)
+
+    def _check_backend(self, backend: str) -> None:
         if backend not in self.modules:
             raise ParameterError(
                 f"`integrator` {self.name!r} has no backend {backend!r}; "
                 f"choose one of {list(self.modules)}."
             )
+
+    def stepper(self, backend: str, *, trajectories: bool) -> ModuleType:
+        """The module that advances this scheme on ``backend``; `ParameterError` if the
+        scheme lacks that backend, the backend cannot record the asked trajectories, or
+        it needs hardware this machine does not have."""
+        self._check_backend(backend)
         if backend == "gpu":
             _require_gpu()
-        if trajectories and backend not in self.trajectories:
-            raise ParameterError(
-                f"`backend` {backend!r} does not record trajectories yet; use "
-                f"backend={self.trajectories[0]!r} with `trajectories=True` (or `--save-every`)."
-            )
-        return _load(self.modules[backend])
+        if trajectories:
+            require(consumer_of(self.name, backend).name, {"trajectories": True})
+        return load_backend(self.modules[backend])
 
     def integrate(self, *args, **kwargs):
         """Run a whole-run integrator (see the module docstring for the arguments)."""
         if self.fixed_step:
             raise TypeError(f"{self.name!r} is a fixed-step scheme: drive its `stepper`.")
-        return _load(self.modules[self.backends[0]]).integrate(*args, **kwargs)
+        return load_backend(self.modules[self.backends[0]]).integrate(*args, **kwargs)
 
 
 REGISTRY: dict[str, Integrator] = {
@@ -95,7 +111,6 @@ REGISTRY: dict[str, Integrator] = {
             "numpy": "metrosync.integrators.twin:VERLET",
             "gpu": "metrosync.integrators.kernel_cuda",
         },
-        trajectories=("numba", "numpy"),
         fixed_step=True,
     ),
     "located": Integrator(
@@ -108,7 +123,6 @@ REGISTRY: dict[str, Integrator] = {
             "numba": "metrosync.integrators.located",
             "numpy": "metrosync.integrators.twin:LOCATED",
         },
-        trajectories=("numba", "numpy"),
         fixed_step=True,
     ),
     "exact": Integrator(
@@ -118,7 +132,6 @@ REGISTRY: dict[str, Integrator] = {
         order=8,  # DOP853's; its error is set by its tolerances, not by a step
         order_with_kicks=8,  # crossings located on the dense output, impulses exact
         modules={"scipy": "metrosync.integrators.exact"},
-        trajectories=("scipy",),
         fixed_step=False,
     ),
 }
@@ -139,7 +152,7 @@ def get_integrator(name: str) -> Integrator:
         ) from None
 
 
-def _load(where: str):
+def load_backend(where: str):
     """The module ``package.module``, or the object ``package.module:name`` in it."""
     module, _, name = where.partition(":")
     loaded = importlib.import_module(module)

@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import cuda, float64
 
+from ..capabilities import require
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from . import _kernel_parts, _physics
 from ._abi import Constants, Recording, State, constants_of, settings_of
@@ -236,9 +237,7 @@ def advance_state(
     the GPU in this version."""
     if state.traj_theta.shape[0]:
         raise NotImplementedError("trajectories are not recorded by the GPU backend yet")
-    sys.refuse_dry_friction(
-        "the GPU backend has no dry friction on the disk yet", "backend='numba' (or 'numpy')"
-    )
+    require("verlet/gpu", sys)
     b, n = state.theta.shape
     st = State(*(cuda.to_device(a) for a in state.kernel_state()))
     constants = Constants(*(cuda.to_device(a) for a in constants_of(sys)))

@@ -34,13 +34,15 @@ the escapement as an impulse, no torque; `impulse`: where in the step it acts an
 what it changes, from `_located_parts`) that the same loops as ``verlet``'s call
 (`layout_runs`, `layout_metronomes`); `twin` is its NumPy twin. It takes the forcing
 torque and the escapement's offset and reaction from `_physics` like ``verlet``; it
-refuses dry friction on the disk (`refuse_dry_friction`).
+refuses dry friction on the disk (`metrosync.capabilities` says so): its stick/slip
+events would need locating inside the step like the kicks.
 """
 
 from __future__ import annotations
 
 import numba as nb
 
+from ..capabilities import require
 from . import layout_metronomes, layout_runs
 from ._kernel_parts import drift
 from ._located_parts import crossing_fraction, kick
@@ -90,16 +92,8 @@ def advance_state(
 ):
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from the problem's size, as for ``verlet``)."""
-    refuse_dry_friction(sys)
+    require("located/numba", sys)
     advance_in_layout(
         LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
         overturn_angle=overturn_angle, layout=layout,
     )  # fmt: skip
-
-
-def refuse_dry_friction(sys) -> None:
-    """`ParameterError` for dry friction on the disk, which this scheme does not have:
-    its stick/slip events would need locating inside the step like the kicks."""
-    sys.refuse_dry_friction(
-        "integrator 'located' has no dry friction on the disk", "integrator='verlet' (or 'exact')"
-    )

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..capabilities import require
 from ..equations import (
     SystemArrays,
     accelerations,
@@ -64,10 +65,7 @@ class TwinScheme:
         overturn_angle: float,
     ) -> None:
         """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
-        if self.impulsive:
-            from .located import refuse_dry_friction
-
-            refuse_dry_friction(sys)
+        require(f"{self.name}/numpy", sys)
         step = _Step(sys, self, dt, record_every, overturn_angle, state.r.shape[1])
         if step0 == 0:
             _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)

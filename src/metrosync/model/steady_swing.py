@@ -279,6 +279,24 @@ def steady_swing_bpm_range(design) -> tuple[float, float]:
     return float(ticks[-1]), float(ticks[0])
 
 
+def steady_swing_spline(design) -> dict:
+    """The per-design spline of `steady_swing_l2`, for a twin in another language: its
+    ``knots`` (L2, m), the ``coefficients`` [c3, c2, c1, c0] of each piece in powers of
+    (L2 − knot), the ``natural_range`` (BPM) the iteration clips to, its
+    ``max_rounds``, and the ``drive`` and ``c_theta`` it was made for; the iteration is
+    `steady_swing_l2`'s."""
+    _check_swing(design)
+    ratio = _table(design).ratio
+    return {
+        "knots": ratio.x.tolist(),
+        "coefficients": ratio.c.T.tolist(),
+        "natural_range": list(design.small_amplitude_range()),
+        "max_rounds": MAX_ROUNDS,
+        "drive": design.drive,
+        "c_theta": design.c_theta,
+    }
+
+
 def steady_swing_l2(design, bpm):
     """Slider position ``L2`` (m) at which ``design`` ticks at ``bpm`` at its steady swing.
 

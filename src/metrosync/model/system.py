@@ -82,15 +82,6 @@ class SystemArrays:
         """The constants of run ``b`` alone, as a batch of one."""
         return SystemArrays(**{k: v[b : b + 1] for k, v in vars(self).items()})
 
-    def refuse_dry_friction(self, lacking: str, instead: str) -> None:
-        """`ParameterError` naming the threshold, what ``lacking`` it, and what to use
-        ``instead``, when any run has dry friction on the disk."""
-        if np.any(self.dry_friction > 0):
-            raise ParameterError(
-                f"`disk_dry_friction` = {float(np.max(self.dry_friction))!r} N m: {lacking}; "
-                f"use {instead}."
-            )
-
 
 def system_arrays(
     params: ModelParameters,

@@ -4,7 +4,10 @@ Unlike `write_page`, which plays back a run computed beforehand, the playground
 simulates while it is watched. Its JavaScript (``_playground/*.js``, package data)
 is a twin of the NumPy reference integrator: the same equations, eqs. (eqm1)–(eqm2),
 the same velocity-Verlet-type step with the ±M/dt escapement, the same tuning of L2
-from a BPM. Every number of the model (each preset's metronome design and platform,
+from a BPM (under the steady-swing tuning, with the package's per-design spline, sent as
+the constants' ``steady_swing``). It runs exactly the model terms that
+`metrosync.capabilities` lists for the playground; `playground_config` refuses any
+other by name. Every number of the model (each preset's metronome design and platform,
 the tunable BPM range, the time step) comes from this package as JSON embedded in
 the page; the JavaScript holds formulas only. ``window.metrosync.run(params, steps)``
 returns trajectories, so that tests can compare the browser's physics with
@@ -27,6 +30,7 @@ from pathlib import Path
 
 from .._files import write_text
 from .._version import __version__
+from ..capabilities import require
 from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
 
@@ -62,6 +66,11 @@ def preset_data(params: ModelParameters) -> dict:
     held = params.platform.rigid
     if held:
         constants["inertia"] = None
+    if params.metronome.tuning == "steady-swing":
+        # The page inverts the tuning as `steady_swing_l2` does, with the same spline.
+        from ..model.steady_swing import steady_swing_spline  # needs scipy; loaded on use
+
+        constants["steady_swing"] = steady_swing_spline(params.metronome)
     low, high = params.metronome.bpm_range()
     return {
         "description": params.description,
@@ -94,15 +103,8 @@ def playground_config(
     params = get_preset(preset, warn=False)
     if changes:
         params = params.with_changes(**changes)
-    if params.metronome.tuning != "small-amplitude":
-        # The page's twin of the integrator sets L2 by the closed-form small-amplitude
-        # inversion; the steady-swing tuning needs the half-swing map solved per design.
-        # A page labelled with one tuning and computing with the other would be wrong.
-        raise ParameterError(
-            f"the playground tunes a metronome by its small-amplitude frequency only; "
-            f"`tuning` = {params.metronome.tuning!r} is not available there. Leave out "
-            f"`tuning` (CLI: --set tuning=...)."
-        )
+    # The page runs the model terms the capability table says it has, and no other.
+    require("playground", params)
     _check_ranges(params)
     get_preset(params)  # warns if its pendulums overturn, once the values are known to fit
     presets = {name: preset_data(get_preset(name, warn=False)) for name in PRESETS}

@@ -103,6 +103,13 @@ class SimulationRequest:
             raise ParameterError(
                 f"unknown `backend` {self.backend!r}; choose one of {sorted(BACKENDS)}."
             )
+        # What runs where is one table (`metrosync.capabilities`): refuse before any work.
+        options = {
+            "trajectories": self.trajectories,
+            "groups": self.groups,
+            "escapement_stopped": True,
+        }
+        self.scheme.require(self.backend, params, options)
 
     def _set(self, **resolved) -> None:
         for name, value in resolved.items():

@@ -54,6 +54,10 @@
     $("hold").checked = s.hold;
     $("jlaw").checked = s.jLaw;
     drive.set(s.drive); cphi.set(s.cPhi); inertia.set(s.j);
+    // The steady-swing tuning's spline is the preset's drive's: M stays as tuned.
+    const steady = session.constants.tuning === "steady-swing";
+    $("drive").disabled = steady;
+    $("drive").title = steady ? "the steady-swing tuning holds M at the preset's value" : "";
     showValues();
   }
 
@@ -143,7 +147,22 @@
     if (st.status & Physics.STATUS_OVERTURNED) notes.push("a pendulum swung past the horizontal.");
     if (session.clipped) notes.push(session.clipped + " of " + n + " frequencies clipped to the "
       + "tunable range.");
+    const terms = modelTerms(session.constants);
+    if (terms.length) notes.push("Beyond the paper: " + terms.join(", ") + ".");
     $("status").textContent = notes.join(" ");
+  }
+
+  // The model's terms beyond the paper that the preset switches on, in words.
+  function modelTerms(c) {
+    const terms = [];
+    if (c.forcing_amplitude) {
+      terms.push("forcing " + sci(c.forcing_amplitude) + " N m at " + c.forcing_bpm + " BPM");
+    }
+    if (c.escapement_offset) terms.push("escapement at δ = " + c.escapement_offset + " rad");
+    if (!c.escapement_reaction) terms.push("no escapement reaction on the disk");
+    if (c.disk_dry_friction) terms.push("dry friction " + sci(c.disk_dry_friction) + " N m");
+    if (c.tuning === "steady-swing") terms.push("steady-swing tuning");
+    return terms;
   }
 
   // A canvas draws at the size the layout gives it (one canvas pixel per CSS pixel),

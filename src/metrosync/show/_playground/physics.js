@@ -1,16 +1,25 @@
 // The paper's model and its fixed-step scheme, in JavaScript: a line-by-line twin of
 // metrosync's NumPy reference integrator (integrators/reference.py), which the
-// package's tests compare with this file to 1e-9 over 10 000 steps.
+// package's tests compare with this file to 1e-9 over 10 000 steps, with every model
+// term the capability table (metrosync/capabilities.py) says the playground runs.
 //
-// Tuning (model/metronome.py): ω = π·BPM/60 and L2 from ω²(m h² + J_i) = m g h.
-// Equations (equations.py): the solved form (eqm1)-(eqm2) with the sums A, B, C, D.
+// Tuning (model/metronome.py): ω = π·BPM/60 and L2 from ω²(m h² + J_i) = m g h; under
+// the steady-swing tuning (theory/tuning.py) the same inversion of BPM/ρ(L2), iterated,
+// with the per-design spline ρ(L2) that the package sends.
+// Equations (equations.py): the solved form (eqm1)-(eqm2) with the sums A, B, C, D,
+// the disk's torque −c_φ φ̇ − r Σ𝕄 + A sin(Ω t) (r = 1 with the escapement's reaction
+// on the disk, 0 without) and its dry friction F_d (at most T).
 // Scheme (integrators/verlet.py), per step of length dt:
 //   1. θ' = θ + θ̇ dt + a dt²/2
-//   2. kick 𝕄_i = +M/dt if θ_i < 0 < θ_i', −M/dt if θ_i > 0 > θ_i', else 0
-//   3. a' = f(θ', θ̇ + a dt, φ̇ + φ̈ dt, 𝕄)
+//   2. kick 𝕄_i = +M/dt if θ_i < δ < θ_i', −M/dt if θ_i > δ > θ_i', else 0
+//      (δ the escapement's offset)
+//   3. a' = f(θ', θ̇ + a dt, φ̇ + φ̈ dt, 𝕄, t'), with the dry friction held, slipping
+//      (−T sign φ̇) or breaking free (±T) as the step starts
 //   4. θ̇' = θ̇ + (a + a') dt/2
-//   5. p_φ' = p_φ + (F + F') dt/2, F = −c_φ φ̇* − Σ𝕄, and φ̇' recovered from
-//      p_φ' = (J + R²Σm) φ̇' + R Σ m h cos θ' θ̇'.
+//   5. p_φ' = p_φ + (F + F') dt/2, F = −c_φ φ̇* − r Σ𝕄 + A sin(Ω t') + F_d, and φ̇'
+//      recovered from p_φ' = (J + R²Σm) φ̇' + R Σ m h cos θ' θ̇'; a disk whose velocity
+//      would pass 0 within the step stops (or reverses) with the friction's end value
+//      solved for, as verlet.py's docstring says.
 // A held disk has J = ∞: φ̇ = 0 and p_φ is not used.
 // Every number comes from the configuration the page embeds; none is written here.
 "use strict";
@@ -18,8 +27,9 @@
 const Physics = (function () {
   const STATUS_OVERTURNED = 1, STATUS_DIVERGED = 2;
 
-  // Slider position for a nominal BPM (MetronomeDesign.l2_for_bpm, the larger root).
-  function l2ForBpm(d, bpm) {
+  // Slider position whose small-amplitude frequency is `bpm`
+  // (MetronomeDesign.small_amplitude_l2, the larger root).
+  function smallAmplitudeL2(d, bpm) {
     const m = d.w1 + d.w2, a = d.w1 * d.l1, w2sq = d.w2 * d.w2;
     const omega = Math.PI * bpm / 60.0, omegaSq = omega * omega;
     const qa = omegaSq * (w2sq / m + d.w2);
@@ -27,6 +37,43 @@ const Physics = (function () {
     const qc = omegaSq * (a * a / m + d.w1 * d.l1 * d.l1) - d.g * a;
     const disc = Math.sqrt(Math.max(qb * qb - 4.0 * qa * qc, 0.0));
     return (-qb + disc) / (2.0 * qa);
+  }
+
+  // The spline ρ(L2) of a steady-swing table (scipy's CubicSpline: on [x_k, x_k+1],
+  // Σ_j c[k][j] (L2 − x_k)^(3−j), the end pieces extended beyond the knots).
+  function spline(table, x) {
+    const knots = table.knots;
+    let k = 0;
+    while (k < knots.length - 2 && x >= knots[k + 1]) k++;
+    const dx = x - knots[k], c = table.coefficients[k];
+    let value = 0.0, power = 1.0;  // summed from the constant term up, as scipy does
+    for (let j = c.length - 1; j >= 0; j--) {
+      value += c[j] * power;
+      power *= dx;
+    }
+    return value;
+  }
+
+  // Slider position for a nominal BPM under the design's tuning (l2_for_bpm): the
+  // small-amplitude inversion, or for "steady-swing" the iteration of
+  // theory/tuning.py's steady_swing_l2 with the table `d.steady_swing` it sends.
+  function l2ForBpm(d, bpm) {
+    if (d.tuning !== "steady-swing") return smallAmplitudeL2(d, bpm);
+    const table = d.steady_swing;
+    if (!table) throw new Error("the steady-swing tuning needs its spline from the package");
+    if (d.drive !== table.drive || d.c_theta !== table.c_theta) {
+      throw new Error("the steady-swing spline was made for another drive or friction");
+    }
+    const [lo, hi] = d.l2_bounds, [natLo, natHi] = table.natural_range;
+    let x = (lo + hi) / 2;
+    for (let round = 0; round < table.max_rounds; round++) {
+      const target = Math.min(natHi, Math.max(natLo, bpm / spline(table, x)));
+      const next = smallAmplitudeL2(d, target);
+      const done = Math.abs(next - x) < 1e-14;
+      x = next;
+      if (done) break;
+    }
+    return x;
   }
 
   // Energy-balance amplitude 2M/(π c_θ), rad (model.metronome.steady_amplitude).
@@ -43,8 +90,10 @@ const Physics = (function () {
     const sys = {
       n, l2: new Float64Array(n), mh: new Float64Array(n), mgh: new Float64Array(n),
       inertia: new Float64Array(n), cTheta: new Float64Array(n), drive: new Float64Array(n),
-      omega: new Float64Array(n), radius: c.radius, cPhi: c.c_phi, totalInertia: 0.0,
-      diskInertia: 0.0,
+      omega: new Float64Array(n), offset: new Float64Array(n), radius: c.radius, cPhi: c.c_phi,
+      totalInertia: 0.0, diskInertia: 0.0,
+      forcingAmplitude: c.forcing_amplitude, forcingOmega: Math.PI * c.forcing_bpm / 60.0,
+      reaction: c.escapement_reaction ? 1.0 : 0.0, dryFriction: c.disk_dry_friction,
     };
     const mass = c.w1 + c.w2;
     let massSum = 0.0;
@@ -59,6 +108,7 @@ const Physics = (function () {
       sys.mgh[i] = mass * c.g * h;
       sys.cTheta[i] = c.c_theta;
       sys.drive[i] = c.drive;
+      sys.offset[i] = c.escapement_offset;
       massSum += mass;
     }
     sys.diskInertia = c.inertia === null ? c.j0 + n * c.j_per_metronome : c.inertia;
@@ -66,9 +116,23 @@ const Physics = (function () {
     return sys;
   }
 
-  // Solved equations of motion, eqs. (eqm1)-(eqm2); writes θ̈ into thdd, returns φ̈.
-  // cos θ is left in cosOut for the momentum that follows; sinOut is scratch.
-  function accelerations(sys, th, thd, phd, kick, thdd, cosOut, sinOut) {
+  // The disk's torque from outside the pendulums' swing at time t (equations.disk_torque):
+  // bearing friction, the escapement's reaction and the applied torque A sin(Ω t).
+  function diskTorque(sys, phd, sumKick, t) {
+    return -sys.cPhi * phd - sys.reaction * sumKick
+      + sys.forcingAmplitude * Math.sin(sys.forcingOmega * t);
+  }
+
+  // The Coulomb law (equations.dry_friction): −T sign φ̇ on a moving disk; at rest the
+  // holding torque clipped to ±T.
+  function dryFriction(sys, phd, holding) {
+    const limit = sys.dryFriction;
+    return phd !== 0 ? -limit * Math.sign(phd) : Math.min(limit, Math.max(-limit, holding));
+  }
+
+  // Numerator without dry friction and denominator D of eq. (eqm1) (equations.
+  // _disk_equation); cos θ and sin θ are left in cosOut and sinOut.
+  function diskEquation(sys, th, thd, phd, kick, t, cosOut, sinOut) {
     const n = sys.n, radius = sys.radius;
     let sum1 = 0.0, sumKick = 0.0, sumAbc = 0.0, sumD = 0.0;
     for (let i = 0; i < n; i++) {
@@ -85,12 +149,26 @@ const Physics = (function () {
       sumKick += kick[i];
       sumAbc += a + b - cc;
     }
-    const phdd = (radius * sum1 - sys.cPhi * phd - sumKick + sumAbc) / (sys.totalInertia - sumD);
-    for (let i = 0; i < n; i++) {
-      thdd[i] = (kick[i] - radius * sys.mh[i] * phdd * cosOut[i] - sys.mgh[i] * sinOut[i]
+    const numerator = radius * sum1 + diskTorque(sys, phd, sumKick, t) + sumAbc;
+    return { numerator, denominator: sys.totalInertia - sumD, sumKick };
+  }
+
+  // Solved equations of motion, eqs. (eqm1)-(eqm2), from the disk's equation `eq` and
+  // its dry-friction torque; writes θ̈ into thdd, returns φ̈.
+  function solve(sys, eq, friction, thd, kick, thdd, cos, sin) {
+    const phdd = (eq.numerator + friction) / eq.denominator;
+    for (let i = 0; i < sys.n; i++) {
+      thdd[i] = (kick[i] - sys.radius * sys.mh[i] * phdd * cos[i] - sys.mgh[i] * sin[i]
         - sys.cTheta[i] * thd[i]) / sys.inertia[i];
     }
     return phdd;
+  }
+
+  // equations.accelerations: the dry friction by its law at φ̇; returns φ̈.
+  function accelerations(sys, th, thd, phd, kick, t, thdd, cosOut, sinOut) {
+    const eq = diskEquation(sys, th, thd, phd, kick, t, cosOut, sinOut);
+    const friction = dryFriction(sys, phd, -eq.numerator);
+    return solve(sys, eq, friction, thd, kick, thdd, cosOut, sinOut);
   }
 
   // The disk's angular momentum (observables.mechanics.platform_momentum).
@@ -102,8 +180,9 @@ const Physics = (function () {
   }
 
   // A state from positions and velocities (StepState.start): the derived quantities
-  // (accelerations, p_φ, the disk's torque) are evaluated for the system `sys`.
-  function startState(sys, theta, thetaDot, phi, phiDot) {
+  // (accelerations, p_φ, the disk's torque) are evaluated for the system `sys` at time
+  // step·dt (0 for a new run).
+  function startState(sys, theta, thetaDot, phi, phiDot, t = 0.0) {
     const n = sys.n;
     const st = {
       n, theta: Float64Array.from(theta), thetaDot: Float64Array.from(thetaDot),
@@ -112,14 +191,27 @@ const Physics = (function () {
       status: 0, step: 0,
       // scratch
       thNew: new Float64Array(n), velPred: new Float64Array(n), kick: new Float64Array(n),
-      thdd: new Float64Array(n), cos: new Float64Array(n), sin: new Float64Array(n),
+      thdd: new Float64Array(n), thdNew: new Float64Array(n), cos: new Float64Array(n),
+      sin: new Float64Array(n),
     };
-    st.accPhi = accelerations(sys, st.theta, st.thetaDot, st.phiDot, st.kick, st.accTheta, st.cos,
-      st.sin);
+    const eq = diskEquation(sys, st.theta, st.thetaDot, st.phiDot, st.kick, t, st.cos, st.sin);
+    const friction = dryFriction(sys, st.phiDot, -eq.numerator);
+    st.accPhi = solve(sys, eq, friction, st.thetaDot, st.kick, st.accTheta, st.cos, st.sin);
     st.pPhi = momentum(sys, st.theta, st.thetaDot, st.phiDot);
-    st.forcePhi = -sys.cPhi * st.phiDot;
+    st.forcePhi = diskTorque(sys, st.phiDot, 0.0, t)
+      + (sys.totalInertia === Infinity ? 0.0 : friction);
     if (!Number.isFinite(st.accPhi)) st.status |= STATUS_DIVERGED;
     return st;
+  }
+
+  // θ̇' = θ̇ + (a + a') dt/2 into out; returns R Σ m h cos θ' θ̇'.
+  function newVelocities(sys, st, thdd, dt, out) {
+    let coupling = 0.0;
+    for (let i = 0; i < sys.n; i++) {
+      out[i] = st.thetaDot[i] + 0.5 * (st.accTheta[i] + thdd[i]) * dt;
+      coupling += sys.mh[i] * st.cos[i] * out[i];
+    }
+    return sys.radius * coupling;
   }
 
   // Advance `st` by one step of length dt. onTick(i, t, up), if given, hears of every
@@ -127,39 +219,64 @@ const Physics = (function () {
   function step(st, sys, dt, overturnAngle, onTick) {
     if (st.status & STATUS_DIVERGED) return false;
     const n = st.n, th = st.theta, thd = st.thetaDot, acc = st.accTheta;
-    const thNew = st.thNew, vel = st.velPred, kick = st.kick;
-    const tOld = st.step * dt;
+    const thNew = st.thNew, vel = st.velPred, kick = st.kick, thdd = st.thdd;
+    const thdNew = st.thdNew;
+    const tOld = st.step * dt, tNew = (st.step + 1) * dt;
     const phdPred = st.phiDot + st.accPhi * dt;
+    const rigid = sys.totalInertia === Infinity, limit = sys.dryFriction;
+    const dry = limit > 0 && !rigid;
     let overturned = false;
     for (let i = 0; i < n; i++) {
       thNew[i] = th[i] + thd[i] * dt + 0.5 * acc[i] * dt * dt;
       vel[i] = thd[i] + acc[i] * dt;
-      const up = th[i] < 0 && thNew[i] > 0, down = th[i] > 0 && thNew[i] < 0;
-      kick[i] = up ? sys.drive[i] / dt : down ? -sys.drive[i] / dt : 0.0;
-      if ((up || down) && onTick) onTick(i, tOld + dt * th[i] / (th[i] - thNew[i]), up);
+      const at = sys.offset[i];
+      const up = th[i] < at && thNew[i] > at, down = th[i] > at && thNew[i] < at;
+      kick[i] = up ? sys.drive[i] / dt : down ? -(sys.drive[i] / dt) : 0.0;
+      if (onTick && ((th[i] < 0 && thNew[i] > 0) || (th[i] > 0 && thNew[i] < 0))) {
+        onTick(i, tOld + dt * th[i] / (th[i] - thNew[i]), th[i] < 0);
+      }
       if (Math.abs(thNew[i]) > overturnAngle) overturned = true;
     }
     if (overturned) st.status |= STATUS_OVERTURNED;
-    const phdd = accelerations(sys, thNew, vel, phdPred, kick, st.thdd, st.cos, st.sin);
+    const eq = diskEquation(sys, thNew, vel, phdPred, kick, tNew, st.cos, st.sin);
+    const others = diskTorque(sys, phdPred, eq.sumKick, tNew);
+    // The dry friction as the step starts (reference._dry_friction): held at rest when
+    // the holding torque is within ±T.
+    const holding = -eq.numerator;
+    let friction = dry ? dryFriction(sys, st.phiDot, holding) : 0.0;
+    let held = dry && st.phiDot === 0 && Math.abs(holding) <= limit;
+    let phdd = solve(sys, eq, friction, vel, kick, thdd, st.cos, st.sin);
     if (!Number.isFinite(phdd)) {
       st.status |= STATUS_DIVERGED;
       return false;
     }
-    let sumKick = 0.0, coupling = 0.0;
-    for (let i = 0; i < n; i++) {
-      sumKick += kick[i];
-      const newThd = thd[i] + 0.5 * (acc[i] + st.thdd[i]) * dt;
-      coupling += sys.mh[i] * st.cos[i] * newThd;
-      th[i] = thNew[i];
-      thd[i] = newThd;
-      acc[i] = st.thdd[i];
+    let force = others + friction;
+    let coupling = newVelocities(sys, st, thdd, dt, thdNew);
+    let newP = st.pPhi + 0.5 * (st.forcePhi + force) * dt;
+    if (dry && !held && friction * ((newP - coupling) / sys.totalInertia) >= 0) {
+      // The disk's velocity reached 0 within the step (reference._friction_at_stop):
+      // the friction's end value that stops it, if within ±T, else the reversed one.
+      const velocity = (newP - coupling) / sys.totalInertia;
+      const stop = friction - 2.0 * eq.denominator * velocity / dt;
+      const stops = Math.abs(stop) <= limit;
+      const end = stops ? stop : -friction;
+      solve(sys, eq, end, vel, kick, thdd, st.cos, st.sin);
+      coupling = newVelocities(sys, st, thdd, dt, thdNew);
+      newP = st.pPhi + 0.5 * (st.forcePhi + others + end) * dt;
+      friction = stops ? dryFriction(sys, 0.0, holding) : end;
+      phdd = solve(sys, eq, friction, vel, kick, thdd, st.cos, st.sin);
+      force = others + friction;
+      held = held || stops;
     }
-    const force = -sys.cPhi * phdPred - sumKick;
-    const rigid = sys.totalInertia === Infinity;
-    const newP = st.pPhi + 0.5 * (st.forcePhi + force) * dt;
+    if (held) newP = coupling;  // a disk at rest: p_φ = R Σ m h cos θ θ̇
+    for (let i = 0; i < n; i++) {
+      th[i] = thNew[i];
+      thd[i] = thdNew[i];
+      acc[i] = thdd[i];
+    }
     st.phi += st.phiDot * dt + 0.5 * st.accPhi * dt * dt;
     if (!rigid) st.pPhi = newP;
-    st.phiDot = rigid ? 0.0 : (newP - sys.radius * coupling) / sys.totalInertia;
+    st.phiDot = rigid ? 0.0 : (newP - coupling) / sys.totalInertia;
     st.forcePhi = force;
     st.accPhi = phdd;
     st.step += 1;
@@ -180,7 +297,7 @@ const Physics = (function () {
   }
 
   return {
-    STATUS_OVERTURNED, STATUS_DIVERGED, l2ForBpm, steadyAmplitude, buildSystem,
-    accelerations, momentum, startState, step, order,
+    STATUS_OVERTURNED, STATUS_DIVERGED, smallAmplitudeL2, l2ForBpm, steadyAmplitude,
+    buildSystem, accelerations, momentum, startState, step, order,
   };
 })();

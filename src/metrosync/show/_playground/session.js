@@ -135,7 +135,8 @@ class Session {
     }
     while (this.lastUp.length < n) this.lastUp.push([]);
     this.lastUp.length = n;
-    const st = Physics.startState(this.system, theta, thetaDot, old.phi, old.phiDot);
+    const st = Physics.startState(this.system, theta, thetaDot, old.phi, old.phiDot,
+      old.step * this.dt);
     st.step = old.step;
     st.status = old.status & Physics.STATUS_OVERTURNED;
     this.state = st;
