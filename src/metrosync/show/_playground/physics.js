@@ -1,5 +1,5 @@
-// The paper's model and its fixed-step scheme, in JavaScript: a line-by-line twin of
-// metrosync's NumPy reference integrator (integrators/reference.py), which the
+// The paper's model and its fixed-step scheme, in JavaScript: line by line as
+// metrosync's NumPy twin of the integrator (integrators/twin.py), which the
 // package's tests compare with this file to 1e-9 over 10 000 steps, with every model
 // term the capability table (metrosync/capabilities.py) says the playground runs.
 //
@@ -76,7 +76,7 @@ const Physics = (function () {
     return x;
   }
 
-  // Energy-balance amplitude 2M/(π c_θ), rad (model.metronome.steady_amplitude).
+  // Energy-balance amplitude 2M/(π c_θ), rad (model.metronome.balance_amplitude).
   function steadyAmplitude(drive, cTheta) {
     if (cTheta === 0) return drive > 0 ? Infinity : 0.0;
     return 2.0 * drive / (Math.PI * cTheta);
@@ -240,7 +240,7 @@ const Physics = (function () {
     if (overturned) st.status |= STATUS_OVERTURNED;
     const eq = diskEquation(sys, thNew, vel, phdPred, kick, tNew, st.cos, st.sin);
     const others = diskTorque(sys, phdPred, eq.sumKick, tNew);
-    // The dry friction as the step starts (reference._dry_friction): held at rest when
+    // The dry friction as the step starts (twin._Step._dry_friction): held at rest when
     // the holding torque is within ±T.
     const holding = -eq.numerator;
     let friction = dry ? dryFriction(sys, st.phiDot, holding) : 0.0;
@@ -254,7 +254,7 @@ const Physics = (function () {
     let coupling = newVelocities(sys, st, thdd, dt, thdNew);
     let newP = st.pPhi + 0.5 * (st.forcePhi + force) * dt;
     if (dry && !held && friction * ((newP - coupling) / sys.totalInertia) >= 0) {
-      // The disk's velocity reached 0 within the step (reference._friction_at_stop):
+      // The disk's velocity reached 0 within the step (twin._friction_at_stop):
       // the friction's end value that stops it, if within ±T, else the reversed one.
       const velocity = (newP - coupling) / sys.totalInertia;
       const stop = friction - 2.0 * eq.denominator * velocity / dt;
