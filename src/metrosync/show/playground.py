@@ -3,9 +3,9 @@
 Unlike `write_page`, which plays back a run computed beforehand, the playground
 simulates while it is watched. Its JavaScript (``_playground/*.js``, package data)
 follows the integrator's NumPy twin (`integrators.twin`) line by line: the same
-equations, eqs. (eqm1)–(eqm2), the same velocity-Verlet-type step with the ±M/dt escapement, the same tuning of L2
-from a BPM (under the steady-swing tuning, with the package's per-design spline, sent as
-the constants' ``steady_swing``). It runs exactly the model terms that
+equations, eqs. (eqm1)–(eqm2), the same velocity-Verlet-type step with the ±M/dt
+escapement, the same tuning of L2 from a BPM (under the steady-swing tuning, with the
+package's per-design spline, sent as the constants' ``steady_swing``). It runs exactly the model terms that
 `metrosync.capabilities` lists for the playground; `playground_config` refuses any
 other by name. Every number of the model (each preset's metronome design and platform,
 the tunable BPM range, the time step) comes from this package as JSON embedded in
