@@ -5,13 +5,13 @@ simulates while it is watched. Its JavaScript (``_playground/*.js``, package dat
 follows the integrator's NumPy twin (`integrators.twin`) line by line: the same
 equations, eqs. (eqm1)–(eqm2), the same velocity-Verlet-type step with the ±M/dt
 escapement, the same tuning of L2 from a BPM (under the steady-swing tuning, with the
-package's per-design spline, sent as the constants' ``steady_swing``). It runs exactly the model terms that
-`metrosync.capabilities` lists for the playground; `playground_config` refuses any
-other by name. Every number of the model (each preset's metronome design and platform,
-the tunable BPM range, the time step) comes from this package as JSON embedded in
-the page; the JavaScript holds formulas only. ``window.metrosync.run(params, steps)``
-returns trajectories, so that tests can compare the browser's physics with
-`metrosync.simulate(..., backend="numpy")`.
+package's per-design spline, sent as the constants' ``steady_swing``). It runs exactly
+the model terms that `metrosync.capabilities` lists for the playground;
+`playground_config` refuses any other by name. Every number of the model (each preset's
+metronome design and platform, the tunable BPM range, the time step) comes from this
+package as JSON embedded in the page; the JavaScript holds formulas only.
+``window.metrosync.run(params, steps)`` returns trajectories, so that tests can compare
+the browser's physics with `metrosync.simulate(..., backend="numpy")`.
 
 The page loads nothing: CSS and scripts are inline, the sound is synthesised, and it
 opens from the file system with no server and no network. Controls: N, nominal BPM,
