@@ -5,9 +5,10 @@ two passes of the CPU kernels, with the sums of eqs. (eqm1)–(eqm2) reduced in 
 memory; thread 0 then computes φ̈ and the disk's update. A crossing's phase is added
 to the shared records with atomic adds. Everything is float64.
 
-The physics is not written here: the functions of `_physics` and the scheme's updates
-of `_kernel_parts` are compiled again, from the same Python source, as CUDA device
-functions (`device_function`). The kernel takes the CPU kernels' argument list
+The physics is not written here: the functions of `_physics`, the updates of
+`_kernel_parts` and ``verlet``'s hook ``begin`` (the one the CPU loops call) are
+compiled again, from the same Python source, as CUDA device functions
+(`device_function`). The kernel takes the CPU kernels' argument list
 (`_abi`: State, Constants, Settings, Recording) plus three scratch arrays.
 
 Status: verified in numba's CUDA simulator against the NumPy reference (see
@@ -20,13 +21,14 @@ friction on the disk (refused with a `ParameterError`).
 from __future__ import annotations
 
 import math
+import types
 
 import numpy as np
 from numba import cuda, float64
 
 from ..capabilities import require
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from . import _kernel_parts, _physics
+from . import _kernel_parts, _physics, verlet
 from ._abi import Constants, Recording, State, constants_of, settings_of
 from ._state import StepState
 
@@ -35,10 +37,17 @@ MAX_THREADS = 256
 TWO_PI = 2.0 * math.pi
 
 
-def device_function(fn):
+def device_function(fn, **callees):
     """The CUDA device function compiled from the Python source of the CPU function
-    ``fn`` (an ``inline="always"`` leaf of `_physics` or `_kernel_parts`)."""
-    return cuda.jit(device=True)(fn.py_func)
+    ``fn``: a leaf of `_physics` or `_kernel_parts`, or a scheme's hook, whose calls
+    ``callees`` (name → device function) then stand for the CPU functions it calls."""
+    source = fn.py_func
+    if callees:
+        source = types.FunctionType(
+            source.__code__, {**source.__globals__, **callees}, source.__name__,
+            source.__defaults__, source.__closure__,
+        )  # fmt: skip
+    return cuda.jit(device=True)(source)
 
 
 escapement = device_function(_physics.escapement)
@@ -49,6 +58,8 @@ disk_acceleration = device_function(_physics.disk_acceleration)
 theta_ddot = device_function(_physics.theta_ddot)
 disk_velocity = device_function(_physics.disk_velocity)
 drift = device_function(_kernel_parts.drift)
+#: ``verlet``'s first-pass hook, the one the CPU loops call (`layouts`).
+begin = device_function(verlet.begin, drift=drift, escapement=escapement)
 velocity = device_function(_kernel_parts.velocity)
 momentum = device_function(_kernel_parts.momentum)
 upward = device_function(_kernel_parts.upward)
@@ -122,9 +133,7 @@ def advance(st, c, settings, rec, scratch):
         over = 0.0
         for i in range(tid, n, nt):
             th = theta[b, i]
-            tn, vp = drift(th, theta_dot[b, i], acc_theta[b, i], dt, dt2)
-            fires = escapement(c, (b, i), th, tn)
-            kick = fires * (c.drive[b, i] * (1.0 / dt))  # ``verlet``'s torque ±M/dt
+            tn, vp, fires, kick, _ = begin(c, (b, i), th, theta_dot[b, i], acc_theta[b, i], dt, dt2)
             if fires != 0.0:
                 last_kick[b, i] = (s + 1) * dt
             if upward(th, tn):

@@ -63,7 +63,7 @@ def loop(st, c, settings, rec, begin, impulse):
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
         scratch = _scratch(n)
-        th_new, rest, q, kicks, crossed = scratch
+        th_new, rest, q, crossed = scratch
         pinned = math.isinf(c.total_inertia[b])
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
@@ -103,15 +103,16 @@ def loop(st, c, settings, rec, begin, impulse):
                         t_cross = t_old + dt * th / (th - th_new[i])
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                         n_up -= 1
-                    if kicks[i] != 0.0:
-                        after, dv, dnum, dforce, jrest, jnum = impulse(c, (b, i), b, kicks[i], theta[b, i], th_new[i], theta_dot[b, i], dt)  # fmt: skip  # noqa: E501
-                        # The second pass adds dt/2 of the new accelerations, which include
-                        # the forces' change: the velocity's terms are net of that.
-                        theta_dot[b, i] += dv + (after - half) * jrest
-                        th_new[i] += after * dv
-                        rest[i] += jrest
-                        jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                        n_imp -= 1
+                    if n_imp > 0:
+                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt)  # fmt: skip  # noqa: E501
+                        if kick != 0.0:
+                            # The second pass adds dt/2 of the new accelerations, which
+                            # include the forces' change: the velocity's terms are net of it.
+                            theta_dot[b, i] += dv + (after - half) * jrest
+                            th_new[i] += after * dv
+                            rest[i] += jrest
+                            jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
+                            n_imp -= 1
                     if n_up == 0 and n_imp == 0:
                         break
             sum_p = 0.0
@@ -157,9 +158,9 @@ def loop(st, c, settings, rec, begin, impulse):
 
 @nb.njit(inline="always")
 def _scratch(n):
-    """A run's scratch arrays, (N,) each: new angles, ρ_i and q_i of the step, the
-    impulses of the step (0 where none), and the upward zero crossings."""
-    return np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    """A run's scratch arrays, (N,) each: new angles, ρ_i and q_i of the step, and its
+    upward zero crossings."""
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
 
 
 @nb.njit(inline="always")
@@ -183,7 +184,7 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
     vectorizable `sincos` or, for far-wound angles, libm's; ``t_new`` into
     ``last_kick`` (the run's row) where an escapement fires. Returns the three sums and
     the counts of upward crossings, impulses, overturned and far-wound angles."""
-    th_new, rest, q, kicks, crossed = scratch
+    th_new, rest, q, crossed = scratch
     sum_num = 0.0
     sum_den = 0.0
     sum_kick = 0.0
@@ -198,7 +199,6 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
         up = upward(th, tn)
         n_up += 1 if up else 0
         crossed[i] = up  # stored, not recomputed later: measurably faster (!)
-        kicks[i] = kick
         n_imp += 1 if kick != 0.0 else 0
         n_over += 1 if abs(tn) > overturn_angle else 0
         n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0

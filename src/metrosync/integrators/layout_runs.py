@@ -92,7 +92,6 @@ def loop(st, c, settings, rec, begin, impulse):
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
-        kicks = np.empty((n, LANES))  # the step's impulses, 0 where none
         ph_new = np.empty(LANES)
         phd_pred = np.empty(LANES)
         s_num = np.empty(LANES)
@@ -125,9 +124,9 @@ def loop(st, c, settings, rec, begin, impulse):
         for s in range(step0, step0 + n_steps):
             t_old = s * dt
             t_new = (s + 1) * dt
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -161,13 +160,14 @@ def loop(st, c, settings, rec, begin, impulse):
                         t_cross = t_old + dt * t0 / (t0 - tn)
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                         counts[0, w] -= 1
-                    if kicks[i, w] != 0.0:
-                        after, dv, dnum, dforce, jrest, jnum = impulse(c, (blk, i, w), (blk, w), kicks[i, w], t0, tn, thd[i, w], dt)  # fmt: skip  # noqa: E501
-                        thd[i, w] += dv + (after - half) * jrest
-                        tn_s[i, w] += after * dv
-                        rest[i, w] += jrest
-                        jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                        counts[1, w] -= 1
+                    if counts[1, w] > 0:
+                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt)  # fmt: skip  # noqa: E501
+                        if kick != 0.0:
+                            thd[i, w] += dv + (after - half) * jrest
+                            tn_s[i, w] += after * dv
+                            rest[i, w] += jrest
+                            jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
+                            counts[1, w] -= 1
                     if counts[0, w] == 0 and counts[1, w] == 0:
                         break
                 if impulses:
@@ -226,7 +226,7 @@ def loop(st, c, settings, rec, begin, impulse):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, kicks, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
     """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
     ``blk``, with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's;
     ``t_new`` into ``lk`` where a live lane's escapement fires. Fills the per-lane
@@ -246,7 +246,6 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, ki
             tn, vp, fires, torque, kick = begin(c, (blk, i, w), t0, thd[i, w], acc[i, w], dt, dt2)
             counts[0, w] += 1 if upward(t0, tn) else 0
             counts[1, w] += 1 if kick != 0.0 else 0
-            kicks[i, w] = kick
             fired = (fires != 0.0) & (alive[w] > 0.0)
             lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
             counts[2, w] += 1 if abs(tn) > overturn_angle else 0

@@ -9,11 +9,15 @@ A fixed-step scheme is two hooks, compiled functions that every layout's loop ca
     velocity the forces are evaluated at, whether the escapement fires (±1, 0:
     `_physics.escapement`), the torque it exerts over the step, and the impulse it
     gives inside the step (N m s; 0 for none). A scheme gives one or the other.
-``impulse(c, m, r, kick, theta, theta_next, theta_dot, dt)``
-    per impulse, in the scalar pass: returns the time left in the step after it, the
+``impulse(c, m, r, theta, theta_next, theta_dot, dt)``
+    per metronome in the scalar pass of a step that has impulses (never for a scheme
+    whose ``begin`` gives none): returns the impulse the step gives metronome ``m``
+    (0 for none, and then nothing else), the time left in the step after it, the
     pendulum's velocity jump, its share of φ̈'s numerator and of the disk's torque, and
     what the jump changes in ρ_i and in φ̈'s numerator per unit time
     (`_located_parts.kick`). The loop applies them and the disk's jumps they imply.
+    Nothing of the impulses is stored in the first pass: a scheme without them pays
+    nothing for them.
 
 The layouts (`layout_runs`, `layout_metronomes`) own the loops, the memory order, the
 crossing and record bookkeeping, the disk's update and its dry friction; the forces

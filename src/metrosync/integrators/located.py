@@ -61,12 +61,17 @@ def begin(c, m, theta, theta_dot, acc, dt, dt2):
 
 
 @nb.njit(cache=True, inline="always")
-def impulse(c, m, r, kick_, theta, theta_next, theta_dot, dt):
-    """Steps 1–3 of the module docstring for one impulse ``kick_`` (N m s): the time
-    left after it, and `_located_parts.kick`'s jumps."""
+def impulse(c, m, r, theta, theta_next, theta_dot, dt):
+    """Steps 1–3 of the module docstring for metronome ``m``'s escapement in a step
+    from ``theta`` to ``theta_next``: its impulse (N m s; 0, and nothing else, when it
+    does not fire), the time left after it, and `_located_parts.kick`'s jumps."""
+    fires = escapement(c, m, theta, theta_next)
+    if fires == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    given = fires * c.drive[m]
     after = dt - crossing_fraction(c, m, theta, theta_next) * dt
-    dv, dnum, dforce, jrest, jnum = kick(c, m, r, kick_, theta_dot)
-    return after, dv, dnum, dforce, jrest, jnum
+    dv, dnum, dforce, jrest, jnum = kick(c, m, r, given, theta_dot)
+    return given, after, dv, dnum, dforce, jrest, jnum
 
 
 # Reassociated and contracted in both layouts (within 1e-10 of the NumPy twin, as

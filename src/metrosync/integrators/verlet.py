@@ -73,9 +73,9 @@ def begin(c, m, theta, theta_dot, acc, dt, dt2):
 
 
 @nb.njit(cache=True, inline="always")
-def impulse(c, m, r, kick, theta, theta_next, theta_dot, dt):
+def impulse(c, m, r, theta, theta_next, theta_dot, dt):
     """Never called: this scheme has no impulses inside the step (`begin` gives none)."""
-    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
 
 @nb.njit(parallel=True, cache=True)
