@@ -104,7 +104,11 @@ def loop(st, c, settings, rec, begin, impulse):
         block_forced = False
         for w in range(LANES):
             block_forced |= forced(c, (blk, w))
-        counts = np.empty((3, LANES), dtype=np.int64)  # per lane: crossings, impulses, overturns
+        # Per-lane counts of the step's upward crossings, impulses and overturns: scan only
+        # the lanes that need it.
+        ups = np.empty(LANES, dtype=np.int64)
+        imps = np.empty(LANES, dtype=np.int64)
+        overs = np.empty(LANES, dtype=np.int64)
         lk = load_last_kick(last_kick, b0, lanes)
         dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
@@ -124,9 +128,9 @@ def loop(st, c, settings, rec, begin, impulse):
         for s in range(step0, step0 + n_steps):
             t_old = s * dt
             t_new = (s + 1) * dt
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
+            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
+                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -141,16 +145,16 @@ def loop(st, c, settings, rec, begin, impulse):
             for w in range(lanes):
                 if alive[w] == 0.0:
                     continue
-                if counts[2, w] > 0:
+                if overs[w] > 0:
                     status[b0 + w] |= STATUS_OVERTURNED
                 if not math.isfinite(phdd[w]):
                     status[b0 + w] |= STATUS_DIVERGED
                     alive[w] = 0.0
                     continue
-                if counts[0, w] == 0 and counts[1, w] == 0:
+                if ups[w] == 0 and imps[w] == 0:
                     continue
                 # The scalar pass: crossings to book, impulses to apply (`layout_metronomes`).
-                impulses = counts[1, w] > 0
+                impulses = imps[w] > 0
                 any_impulse |= impulses
                 jumps = (0.0, 0.0, 0.0, 0.0, 0.0)
                 for i in range(n):
@@ -159,16 +163,16 @@ def loop(st, c, settings, rec, begin, impulse):
                     if upward(t0, tn):
                         t_cross = t_old + dt * t0 / (t0 - tn)
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
-                        counts[0, w] -= 1
-                    if counts[1, w] > 0:
+                        ups[w] -= 1
+                    if imps[w] > 0:
                         kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt)  # fmt: skip  # noqa: E501
                         if kick != 0.0:
                             thd[i, w] += dv + (after - half) * jrest
                             tn_s[i, w] += after * dv
                             rest[i, w] += jrest
                             jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                            counts[1, w] -= 1
-                    if counts[0, w] == 0 and counts[1, w] == 0:
+                            imps[w] -= 1
+                    if ups[w] == 0 and imps[w] == 0:
                         break
                 if impulses:
                     jump[w] = disk_acceleration(c, (blk, w), jumps[0], s_den[w], jumps[1])
@@ -198,18 +202,27 @@ def loop(st, c, settings, rec, begin, impulse):
                         th[i, w] = tn_s[i, w] if keep else th[i, w]
                         acc[i, w] = thdd if keep else acc[i, w]
                         s_p[w] += q[i, w] * v
-            for w in range(LANES):
-                if alive[w] > 0.0:
-                    pinned = math.isinf(c.total_inertia[blk, w])
-                    ph[w] = ph_new[w] + shift[w]
-                    pp[w] = momentum(pp[w], fph[w], force[w], dt, pinned)
-                    pp[w] += 0.0 if pinned else jump_p[w]
-                    phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
-                    fph[w] = force[w]
-                    aph[w] = phdd[w]
-                jump[w] = 0.0
-                shift[w] = 0.0
-                jump_p[w] = 0.0
+            if any_impulse:
+                for w in range(LANES):
+                    if alive[w] > 0.0:
+                        pinned = math.isinf(c.total_inertia[blk, w])
+                        ph[w] = ph_new[w] + shift[w]
+                        pp[w] = momentum(pp[w], fph[w], force[w], dt, pinned)
+                        pp[w] += 0.0 if pinned else jump_p[w]
+                        phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
+                        fph[w] = force[w]
+                        aph[w] = phdd[w]
+                    jump[w] = 0.0
+                    shift[w] = 0.0
+                    jump_p[w] = 0.0
+            else:
+                for w in range(LANES):
+                    if alive[w] > 0.0:
+                        ph[w] = ph_new[w]
+                        pp[w] = momentum(pp[w], fph[w], force[w], dt, math.isinf(c.total_inertia[blk, w]))  # fmt: skip  # noqa: E501
+                        phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
+                        fph[w] = force[w]
+                        aph[w] = phdd[w]
             if dry:
                 _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0)  # fmt: skip  # noqa: E501
             until_record -= 1
@@ -226,17 +239,17 @@ def loop(st, c, settings, rec, begin, impulse):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, counts, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
+def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
     """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
     ``blk``, with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's;
     ``t_new`` into ``lk`` where a live lane's escapement fires. Fills the per-lane
-    counts of upward crossings, impulses and overturns; returns the number of
-    far-wound angles."""
+    counts of upward crossings, impulses and overturns (``ups``, ``imps``, ``overs``);
+    returns the number of far-wound angles."""
     n_far = 0
     for w in range(th.shape[1]):
-        counts[0, w] = 0
-        counts[1, w] = 0
-        counts[2, w] = 0
+        ups[w] = 0
+        imps[w] = 0
+        overs[w] = 0
         s_num[w] = 0.0
         s_den[w] = 0.0
         s_kick[w] = 0.0
@@ -244,11 +257,11 @@ def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_
         for w in range(th.shape[1]):  # vectorized across runs
             t0 = th[i, w]
             tn, vp, fires, torque, kick = begin(c, (blk, i, w), t0, thd[i, w], acc[i, w], dt, dt2)
-            counts[0, w] += 1 if upward(t0, tn) else 0
-            counts[1, w] += 1 if kick != 0.0 else 0
+            ups[w] += 1 if upward(t0, tn) else 0
+            imps[w] += 1 if kick != 0.0 else 0
             fired = (fires != 0.0) & (alive[w] > 0.0)
             lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
-            counts[2, w] += 1 if abs(tn) > overturn_angle else 0
+            overs[w] += 1 if abs(tn) > overturn_angle else 0
             n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
             sn, cs = trig(tn)
             res, qi, num, den = pendulum_terms(c, (blk, i, w), torque, sn, cs, vp)
