@@ -156,15 +156,16 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
-    lines = rod_lines(pictures, bg, gain)
-    moving = sum(len(x) > 0 for x in lines)
+    per_picture = rod_lines(pictures, bg, gain)
+    moving = sum(len(x) > 0 for x in per_picture)
     if moving < max(3, 0.2 * f):
         raise DetectionError(
             f"nothing swings in the first {plural(f, 'frame')}: no rod moves against the "
             f"background. Check that the metronomes are running and in view, and that the "
             f"camera stands still; or give the pivots by hand with `regions`."
         )
-    acc = vote(lines, (h, w))
+    acc = vote(per_picture, (h, w))
+    lines = _stack(per_picture)
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
     floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
@@ -201,25 +202,29 @@ def _peaks(acc: np.ndarray, min_distance: int) -> list[tuple[int, int]]:
     return [(int(xs[i]), int(ys[i])) for i in order]
 
 
-def _region(pivot, lines, frames: int) -> Region | None:
-    """The sector swept by the lines that pass near ``pivot`` (the rod's lines)."""
+def _stack(lines: list[np.ndarray]) -> np.ndarray:
+    """The lines of every picture in one (M, 6) array: the picture's index, then the line."""
+    if not any(len(x) for x in lines):
+        return np.empty((0, 6))
+    return np.concatenate([np.column_stack([np.full(len(x), i), x])
+                           for i, x in enumerate(lines) if len(x)])  # fmt: skip
+
+
+def _region(pivot, lines: np.ndarray, frames: int) -> Region | None:
+    """The sector swept by the lines (`_stack`) that pass near ``pivot`` (the rod's lines)."""
     px, py = pivot
-    angles, near, far = [], [], []
-    for frame_lines in lines:
-        best = None
-        for cx, cy, ux, uy, half in frame_lines:
-            dx, dy = cx - px, cy - py
-            dist = abs(dx * uy - dy * ux)  # distance of the pivot from the line
-            along = np.hypot(dx, dy)
-            # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
-            if dist < max(3.0, 0.08 * along) and along > 0.8 * half:
-                if best is None or dist < best[0]:
-                    best = (dist, dx, dy, along, half)
-        if best is not None:
-            _, dx, dy, along, half = best
-            angles.append(np.arctan2(dx, -dy))
-            near.append(max(along - half, 0.0))
-            far.append(along + half)
+    frame, cx, cy, ux, uy, half = lines.T
+    dx, dy = cx - px, cy - py
+    dist = np.abs(dx * uy - dy * ux)  # distance of the pivot from the line
+    along = np.hypot(dx, dy)
+    # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
+    near_line = (dist < np.maximum(3.0, 0.08 * along)) & (along > 0.8 * half)
+    # in each picture, the line that passes nearest
+    order = np.flatnonzero(near_line)[np.lexsort((dist[near_line], frame[near_line]))]
+    best = order[np.unique(frame[order], return_index=True)[1]]
+    angles = np.arctan2(dx[best], -dy[best])
+    near = np.maximum(along[best] - half[best], 0.0)
+    far = along[best] + half[best]
     support = len(angles) / frames
     if support < MIN_SUPPORT or len(angles) < 3:
         return None
@@ -263,7 +268,7 @@ def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> lis
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
-    lines = rod_lines(pictures, bg, gain)
+    lines = _stack(rod_lines(pictures, bg, gain))
     out = []
     for given in regions:
         if len(given) == 4:
