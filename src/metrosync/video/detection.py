@@ -22,13 +22,13 @@ The method:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy import ndimage
 
 from .._words import plural
 from ..errors import MetrosyncError
+from .fans import arc_regions
+from .sectors import Region, covers
 
 #: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
 MIN_SUPPORT = 0.25
@@ -50,26 +50,6 @@ MIN_PIECE = 6e-5
 
 class DetectionError(MetrosyncError, ValueError):
     """No metronome, or not the number asked for, could be found in the picture."""
-
-
-@dataclass(frozen=True)
-class Region:
-    """Where one metronome is in the picture.
-
-    pivot : (x, y) of the rod's pivot, pixels (x right, y down).
-    centre : direction of the middle of the swing from the pivot, rad, measured from
-        the picture's upward direction, positive clockwise (to the right).
-    half_width : half the swept angle, rad (the swing's amplitude seen in the picture).
-    r_inner, r_outer : radii from the pivot that the rod covers, pixels.
-    support : fraction of the pictures in which this rod was seen.
-    """
-
-    pivot: tuple[float, float]
-    centre: float
-    half_width: float
-    r_inner: float
-    r_outer: float
-    support: float
 
 
 def background(pictures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,6 +155,8 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     faint = [p for p in peaks if 0.25 * floor <= acc[p[1], p[0]] < floor]
     regions += [r for r in (_region(p, lines, f) for p in faint)
                 if r is not None and r.support >= FAINT_SUPPORT]  # fmt: skip
+    # a rod of its body's shade gives no lines at all, but its bob sweeps an arc
+    regions += arc_regions(pictures, bg, gain, regions)
     if count is not None:  # the strongest `count`, if not much weaker than the best
         weaker = [p for p in peaks if 0.6 * floor <= acc[p[1], p[0]] < floor]
         more = [r for r in (_region(p, lines, f) for p in weaker) if r is not None]
@@ -248,17 +230,9 @@ def _drop_duplicates(regions: list[Region]) -> list[Region]:
     lines meet, at the bob): keep the better supported of the two."""
     kept: list[Region] = []
     for r in sorted(regions, key=lambda r: -r.support):
-        if not any(_inside(r.pivot, k) for k in kept):
+        if not any(covers(k, *r.pivot) for k in kept):
             kept.append(r)
     return kept
-
-
-def _inside(point: tuple[float, float], region: Region) -> bool:
-    dx, dy = point[0] - region.pivot[0], point[1] - region.pivot[1]
-    radius = np.hypot(dx, dy)
-    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre)))
-    return bool(radius <= 1.1 * region.r_outer and (
-        radius < 4.0 or abs(off) <= region.half_width + 0.15))  # fmt: skip
 
 
 def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
