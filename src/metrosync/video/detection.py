@@ -149,7 +149,7 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
     floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
-    regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    regions = [r for r in (_region(p, lines, f) or _nearby(p, lines, f) for p in chosen) if r]
     # A faint rod (dark on a dark body) gives short, scattered lines: few votes, but
     # through its pivot in most pictures, which crossings of other rods never are.
     faint = [p for p in peaks if 0.25 * floor <= acc[p[1], p[0]] < floor]
@@ -225,14 +225,40 @@ def _region(pivot, lines: np.ndarray, frames: int) -> Region | None:
     )
 
 
+def _nearby(pivot, lines: np.ndarray, frames: int, reach: int = 8) -> Region | None:
+    """The best supported region about the points within ``reach`` pixels of ``pivot``.
+
+    The votes of a rod whose pieces reach nearly to its pivot can peak a few pixels
+    inside them, where `_region` finds no line ending short of the point."""
+    best = None
+    for dy in range(-reach, reach + 1, 2):
+        for dx in range(-reach, reach + 1, 2):
+            region = _region((pivot[0] + dx, pivot[1] + dy), lines, frames)
+            if region is not None and (best is None or region.support > best.support):
+                best = region
+    return best
+
+
 def _drop_duplicates(regions: list[Region]) -> list[Region]:
     """A peak inside another's swept sector is a point on that rod (where its pieces'
-    lines meet, at the bob): keep the better supported of the two."""
+    lines meet, at the bob): keep the better supported of the two. A peak just behind
+    another's pivot, on the far side from its rod, is where the lines of neighbouring
+    rods, prolonged past their pivots, meet: drop it, however well supported."""
+    ghosts = [r for r in regions if any(_behind(k, *r.pivot) for k in regions if k is not r)]
     kept: list[Region] = []
-    for r in sorted(regions, key=lambda r: -r.support):
+    for r in sorted((r for r in regions if r not in ghosts), key=lambda r: -r.support):
         if not any(covers(k, *r.pivot) for k in kept):
             kept.append(r)
     return kept
+
+
+def _behind(region: Region, x: float, y: float) -> bool:
+    """Whether (x, y) lies in ``region``'s sector mirrored through its pivot, within half
+    its outer radius (the rod's lines prolonged past the pivot)."""
+    dx, dy = x - region.pivot[0], y - region.pivot[1]
+    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre - np.pi)))
+    radius = np.hypot(dx, dy)
+    return bool(4.0 <= radius <= 0.5 * region.r_outer and abs(off) <= region.half_width + 0.15)
 
 
 def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
