@@ -15,7 +15,11 @@ The method:
 3. every line votes along its length into an accumulator: the lines of one rod, at
    different moments, all pass through its pivot, so pivots are the accumulator's
    peaks, while lines of different rods cross at scattered points;
-4. the lines near each pivot give the swept sector and the radii.
+4. the lines near each pivot give the swept sector and the radii (a peak a few pixels
+   off its pivot is moved to the best supported point near it); a peak just behind
+   another pivot, where neighbouring rods' lines prolonged past their pivots meet,
+   and a peak inside another's sector, a point on that rod, are dropped;
+5. a rod of its body's shade gives no lines: its bob's arc gives it (`fans`).
 
 `regions_given` builds the regions for pivots or boxes given by hand (``--regions``).
 """
