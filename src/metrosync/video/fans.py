@@ -13,7 +13,7 @@ through its middle, at a distance set by the arc's half chord: a swing of 0.3 to
 seen from 20 to 40° aside spans half a chord of 0.3 to 0.45 times the bob's radius.
 Neither the arc's curvature nor the faint fan gives that distance better: seen from
 aside the arc flattens into part of an ellipse, and the fan of a rod of its body's shade
-moves barely above the noise.
+moves barely above the noise. So such a pivot is rougher than one that rod lines give.
 """
 
 from __future__ import annotations
