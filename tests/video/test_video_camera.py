@@ -83,13 +83,10 @@ def test_the_sound_is_heard_30_ms_after_the_passes(at_60):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    reason="measured: 20 scenes of 24 (and 20 of a second set seeded 1000 higher), N = 1-8 "
-    "(2026-11-25), never too many. The missed rods are all in full view (`visibility`): "
-    "a rod of nearly its body's shade moves too faintly to give lines through its pivot.",
-    strict=False,
-)
-def test_the_number_of_metronomes_is_found_in_95_percent_of_scenes(tmp_path):
+@pytest.mark.parametrize("seeds", [0, 1000], ids=["scenes", "second-scenes"])
+def test_the_number_of_metronomes_is_found_in_95_percent_of_scenes(seeds, tmp_path):
+    # two sets of 24 scenes, N = 1 to 8: measured 23 of 24 in each (2026-11-27), never
+    # too many; the rods missed have their body's shade and a bob that hardly shows either
     from metrosync.video.detection import DetectionError, find_metronomes
     from metrosync.video.reader import open_video
     from metrosync.video.tracking import _learning_pictures
@@ -97,19 +94,21 @@ def test_the_number_of_metronomes_is_found_in_95_percent_of_scenes(tmp_path):
     found = []
     for n in range(1, 9):
         for seed in range(3):
-            rng = np.random.default_rng(100 * n + seed)
-            t, theta = run(7.0, n, 100 * n + seed)
+            rng = np.random.default_rng(100 * n + seed + seeds)
+            t, theta = run(7.0, n, 100 * n + seed + seeds)
             camera = Camera(fps=30, width=640, height=360, vfr_jitter_s=0.002,
                             drop_fraction=0.02,
                             yaw_deg=float(rng.uniform(20, 40) * rng.choice([-1, 1])))  # fmt: skip
-            scene = Scene.random(n, seed=100 * n + seed, overlap=0.0)
-            film(tmp_path / "scene.mp4", t, theta, scene=scene, camera=camera, seed=seed)
+            scene = Scene.random(n, seed=100 * n + seed + seeds, overlap=0.0)
+            film(tmp_path / "scene.mp4", t, theta, scene=scene, camera=camera, seed=seed + seeds)
             pictures = _learning_pictures(open_video(tmp_path / "scene.mp4"), 640, 6.0)
             try:
-                found.append(len(find_metronomes(pictures)) == n)
+                found.append(len(find_metronomes(pictures)) - n)
             except DetectionError:
-                found.append(False)
-    assert np.mean(found) >= 0.95, f"found the right number in {sum(found)} of {len(found)}"
+                found.append(-n)
+    right = sum(extra == 0 for extra in found)
+    assert right >= 0.95 * len(found), f"found the right number in {right} of {len(found)}"
+    assert max(found) <= 0, f"found too many in {sum(extra > 0 for extra in found)} scenes"
 
 
 def test_the_rolling_shutter_is_estimated_from_the_rods(at_60, at_30):

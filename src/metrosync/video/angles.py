@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .detection import Region
+from .sectors import Region
 
 MEASURED, INTERPOLATED, LOST = 0, 1, 2
 QUALITY_NAMES = "0 measured, 1 interpolated, 2 lost"

@@ -15,20 +15,24 @@ The method:
 3. every line votes along its length into an accumulator: the lines of one rod, at
    different moments, all pass through its pivot, so pivots are the accumulator's
    peaks, while lines of different rods cross at scattered points;
-4. the lines near each pivot give the swept sector and the radii.
+4. the lines near each pivot give the swept sector and the radii (a peak a few pixels
+   off its pivot is moved to the best supported point near it); a peak just behind
+   another pivot, where neighbouring rods' lines prolonged past their pivots meet,
+   and a peak inside another's sector, a point on that rod, are dropped;
+5. a rod of its body's shade gives no lines: its bob's arc gives it (`fans`).
 
 `regions_given` builds the regions for pivots or boxes given by hand (``--regions``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy import ndimage
 
 from .._words import plural
 from ..errors import MetrosyncError
+from .fans import arc_regions
+from .sectors import Region, covers
 
 #: Fewest pictures in which a rod is seen through a pivot, as a fraction, for it to count.
 MIN_SUPPORT = 0.25
@@ -50,26 +54,6 @@ MIN_PIECE = 6e-5
 
 class DetectionError(MetrosyncError, ValueError):
     """No metronome, or not the number asked for, could be found in the picture."""
-
-
-@dataclass(frozen=True)
-class Region:
-    """Where one metronome is in the picture.
-
-    pivot : (x, y) of the rod's pivot, pixels (x right, y down).
-    centre : direction of the middle of the swing from the pivot, rad, measured from
-        the picture's upward direction, positive clockwise (to the right).
-    half_width : half the swept angle, rad (the swing's amplitude seen in the picture).
-    r_inner, r_outer : radii from the pivot that the rod covers, pixels.
-    support : fraction of the pictures in which this rod was seen.
-    """
-
-    pivot: tuple[float, float]
-    centre: float
-    half_width: float
-    r_inner: float
-    r_outer: float
-    support: float
 
 
 def background(pictures: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -156,24 +140,27 @@ def find_metronomes(pictures: np.ndarray, *, count: int | None = None) -> list[R
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
-    lines = rod_lines(pictures, bg, gain)
-    moving = sum(len(x) > 0 for x in lines)
+    per_picture = rod_lines(pictures, bg, gain)
+    moving = sum(len(x) > 0 for x in per_picture)
     if moving < max(3, 0.2 * f):
         raise DetectionError(
             f"nothing swings in the first {plural(f, 'frame')}: no rod moves against the "
             f"background. Check that the metronomes are running and in view, and that the "
             f"camera stands still; or give the pivots by hand with `regions`."
         )
-    acc = vote(lines, (h, w))
+    acc = vote(per_picture, (h, w))
+    lines = _stack(per_picture)
     peaks = _peaks(acc, min_distance=max(4, int(0.02 * max(h, w))))
     floor = max(MIN_PEAK * acc[peaks[0][1], peaks[0][0]], 0.1 * f) if peaks else 0.0
     chosen = [p for p in peaks if acc[p[1], p[0]] >= floor]
-    regions = [r for r in (_region(p, lines, f) for p in chosen) if r is not None]
+    regions = [r for r in (_region(p, lines, f) or _nearby(p, lines, f) for p in chosen) if r]
     # A faint rod (dark on a dark body) gives short, scattered lines: few votes, but
     # through its pivot in most pictures, which crossings of other rods never are.
     faint = [p for p in peaks if 0.25 * floor <= acc[p[1], p[0]] < floor]
     regions += [r for r in (_region(p, lines, f) for p in faint)
                 if r is not None and r.support >= FAINT_SUPPORT]  # fmt: skip
+    # a rod of its body's shade gives no lines at all, but its bob sweeps an arc
+    regions += arc_regions(pictures, bg, gain, regions)
     if count is not None:  # the strongest `count`, if not much weaker than the best
         weaker = [p for p in peaks if 0.6 * floor <= acc[p[1], p[0]] < floor]
         more = [r for r in (_region(p, lines, f) for p in weaker) if r is not None]
@@ -201,25 +188,29 @@ def _peaks(acc: np.ndarray, min_distance: int) -> list[tuple[int, int]]:
     return [(int(xs[i]), int(ys[i])) for i in order]
 
 
-def _region(pivot, lines, frames: int) -> Region | None:
-    """The sector swept by the lines that pass near ``pivot`` (the rod's lines)."""
+def _stack(lines: list[np.ndarray]) -> np.ndarray:
+    """The lines of every picture in one (M, 6) array: the picture's index, then the line."""
+    if not any(len(x) for x in lines):
+        return np.empty((0, 6))
+    return np.concatenate([np.column_stack([np.full(len(x), i), x])
+                           for i, x in enumerate(lines) if len(x)])  # fmt: skip
+
+
+def _region(pivot, lines: np.ndarray, frames: int) -> Region | None:
+    """The sector swept by the lines (`_stack`) that pass near ``pivot`` (the rod's lines)."""
     px, py = pivot
-    angles, near, far = [], [], []
-    for frame_lines in lines:
-        best = None
-        for cx, cy, ux, uy, half in frame_lines:
-            dx, dy = cx - px, cy - py
-            dist = abs(dx * uy - dy * ux)  # distance of the pivot from the line
-            along = np.hypot(dx, dy)
-            # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
-            if dist < max(3.0, 0.08 * along) and along > 0.8 * half:
-                if best is None or dist < best[0]:
-                    best = (dist, dx, dy, along, half)
-        if best is not None:
-            _, dx, dy, along, half = best
-            angles.append(np.arctan2(dx, -dy))
-            near.append(max(along - half, 0.0))
-            far.append(along + half)
+    frame, cx, cy, ux, uy, half = lines.T
+    dx, dy = cx - px, cy - py
+    dist = np.abs(dx * uy - dy * ux)  # distance of the pivot from the line
+    along = np.hypot(dx, dy)
+    # the pivot lies beyond the end of a rod's piece, not inside it (where rods cross)
+    near_line = (dist < np.maximum(3.0, 0.08 * along)) & (along > 0.8 * half)
+    # in each picture, the line that passes nearest
+    order = np.flatnonzero(near_line)[np.lexsort((dist[near_line], frame[near_line]))]
+    best = order[np.unique(frame[order], return_index=True)[1]]
+    angles = np.arctan2(dx[best], -dy[best])
+    near = np.maximum(along[best] - half[best], 0.0)
+    far = along[best] + half[best]
     support = len(angles) / frames
     if support < MIN_SUPPORT or len(angles) < 3:
         return None
@@ -238,22 +229,40 @@ def _region(pivot, lines, frames: int) -> Region | None:
     )
 
 
+def _nearby(pivot, lines: np.ndarray, frames: int, reach: int = 8) -> Region | None:
+    """The best supported region about the points within ``reach`` pixels of ``pivot``.
+
+    The votes of a rod whose pieces reach nearly to its pivot can peak a few pixels
+    inside them, where `_region` finds no line ending short of the point."""
+    best = None
+    for dy in range(-reach, reach + 1, 2):
+        for dx in range(-reach, reach + 1, 2):
+            region = _region((pivot[0] + dx, pivot[1] + dy), lines, frames)
+            if region is not None and (best is None or region.support > best.support):
+                best = region
+    return best
+
+
 def _drop_duplicates(regions: list[Region]) -> list[Region]:
     """A peak inside another's swept sector is a point on that rod (where its pieces'
-    lines meet, at the bob): keep the better supported of the two."""
+    lines meet, at the bob): keep the better supported of the two. A peak just behind
+    another's pivot, on the far side from its rod, is where the lines of neighbouring
+    rods, prolonged past their pivots, meet: drop it, however well supported."""
+    ghosts = [r for r in regions if any(_behind(k, *r.pivot) for k in regions if k is not r)]
     kept: list[Region] = []
-    for r in sorted(regions, key=lambda r: -r.support):
-        if not any(_inside(r.pivot, k) for k in kept):
+    for r in sorted((r for r in regions if r not in ghosts), key=lambda r: -r.support):
+        if not any(covers(k, *r.pivot) for k in kept):
             kept.append(r)
     return kept
 
 
-def _inside(point: tuple[float, float], region: Region) -> bool:
-    dx, dy = point[0] - region.pivot[0], point[1] - region.pivot[1]
+def _behind(region: Region, x: float, y: float) -> bool:
+    """Whether (x, y) lies in ``region``'s sector mirrored through its pivot, within half
+    its outer radius (the rod's lines prolonged past the pivot)."""
+    dx, dy = x - region.pivot[0], y - region.pivot[1]
+    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre - np.pi)))
     radius = np.hypot(dx, dy)
-    off = np.angle(np.exp(1j * (np.arctan2(dx, -dy) - region.centre)))
-    return bool(radius <= 1.1 * region.r_outer and (
-        radius < 4.0 or abs(off) <= region.half_width + 0.15))  # fmt: skip
+    return bool(4.0 <= radius <= 0.5 * region.r_outer and abs(off) <= region.half_width + 0.15)
 
 
 def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
@@ -263,7 +272,7 @@ def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> lis
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
-    lines = rod_lines(pictures, bg, gain)
+    lines = _stack(rod_lines(pictures, bg, gain))
     out = []
     for given in regions:
         if len(given) == 4:
