@@ -36,3 +36,15 @@ def test_no_message_prints_a_bare_count_before_these_plural_nouns():
                 if not re.fullmatch(r"\{[A-Z_]+\}", placeholder) and ":" not in placeholder:
                     found.append(f"{path.relative_to(SRC)}:{number}: {match[0]}")
     assert not found, "\n".join(found)
+
+
+def test_no_message_hedges_a_count_with_s_in_brackets():
+    """ "{n} metronome(s)" reads badly for every n: counts go through `plural`."""
+    pattern = re.compile(r"\{[^{}]+\} [a-z]\w*\(s\)")
+    found = [
+        f"{path.relative_to(SRC)}:{number}: {match[0]}"
+        for path in sorted(SRC.rglob("*.py"))
+        for number, line in enumerate(path.read_text().splitlines(), 1)
+        for match in pattern.finditer(line)
+    ]
+    assert not found, "\n".join(found)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._words import plural
 from .errors import ParameterError, describe
 from .groups import Group, as_groups, group_bounds
 from .model import (
@@ -291,7 +292,8 @@ def _require_explicit(name: str, count: int, n, sigma_bpm) -> None:
     says otherwise rather than ignore it."""
     if n is not None and n != count:
         raise ParameterError(
-            f"`n` = {n!r} but `{name}` gives {count} metronome(s); pass n={count} or n=None."
+            f"`n` = {n!r} but `{name}` gives {plural(count, 'metronome')}; pass n={count} or "
+            f"n=None."
         )
     if sigma_bpm:
         raise ParameterError(

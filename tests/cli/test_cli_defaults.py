@@ -57,7 +57,7 @@ def test_an_overturning_start_warns_and_prints_no_equilibrium_r(capsys):
     assert main(["simulate", "--amplitude", "2", "--runs", "3", "--duration", "3"]) == 0
     captured = capsys.readouterr()
     assert "warning: `amplitude` = 2.0 rad is beyond `overturn_angle`" in captured.err
-    assert "3 of 3 run(s) start overturned" in captured.err
+    assert "3 of 3 runs start overturned" in captured.err
     out = captured.out
     assert "crossing phases): not meaningful, every run is flagged" in out
     assert "runs flagged: 3 of 3 (3 overturned, 0 diverged, 0 stopped)" in out

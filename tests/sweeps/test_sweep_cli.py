@@ -62,7 +62,7 @@ def test_ignored_or_failing_settings_are_not_silent(tmp_path, capsys):
         capsys.readouterr().err
     )
     assert main([*base, "--dt", "0.5", "--out", out]) == 1  # every point fails: not a success
-    assert "2 point(s) without a result" in capsys.readouterr().out
+    assert "2 points without a result" in capsys.readouterr().out
 
 
 def test_critical_marks_estimates_at_the_end_of_the_grid(tmp_path, capsys):

@@ -72,7 +72,7 @@ def test_failed_points_are_counted_apart_from_flagged_runs(tmp_path):
     assert int(ds.n_flagged.sel(bpm=190)) == 3 and int(ds.n_flagged.sel(bpm=236)) == 0
     text = result.summary()
     assert "runs flagged (overturned/diverged/stopped): 3 of 3 runs simulated" in text
-    assert "1 point(s) without a result: 1 failed (the simulation raised" in text
+    assert "1 point without a result: 1 failed (the simulation raised" in text
     assert "metrosync.status" in text
 
 

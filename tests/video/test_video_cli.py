@@ -67,7 +67,7 @@ def test_bad_files_get_one_line_and_no_traceback(tmp_path, capsys):
     one = tmp_path / "one.mp4"
     synth_video.write_video(one, [0.0], [picture])
     cases = [(text, "as a video"), (tmp_path / "gone.mp4", "does not exist"),
-             (still, "nothing swings"), (one, "1 frame(s)")]  # fmt: skip
+             (still, "nothing swings"), (one, "holds 1 frame in")]  # fmt: skip
     for path, message in cases:
         code, out, err = run(capsys, path)
         assert code == 2, (path, err)

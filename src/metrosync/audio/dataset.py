@@ -174,10 +174,11 @@ def analyze_audio(
         n = busiest
         source = "most ticks per beat in a window (95th percentile), rounded"
     if trains and n != len(trains):
-        note = (f"{len(trains)} metronome(s) told apart, {n} expected"
+        note = (f"{plural(len(trains), 'metronome')} told apart, {n} expected"
                 + (f"; {note}" if note else ""))  # fmt: skip
     elif trains and busiest > len(trains):
-        note = (f"up to {busiest} ticks per beat are heard but only {len(trains)} metronome(s) "
+        note = (f"up to {busiest} ticks per beat are heard but only "
+                f"{plural(len(trains), 'metronome')} "
                 f"told apart; the others sound alike and keep the same tempo")  # fmt: skip
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)

@@ -54,7 +54,8 @@ def plot_audio(ds, path: Path | str | None = None):
     ax.legend(loc="upper right", fontsize="small")
     sure = f", attribution {a['attribution_sureness']}" if a.get("attribution_sureness") else ""
     ax.set_title(
-        f"{Path(a['path']).name}: {a['bpm_ensemble']:.2f} BPM, {a['metronomes']} metronome(s){sure}"
+        f"{Path(a['path']).name}: {a['bpm_ensemble']:.2f} BPM, "
+        f"{plural(int(a['metronomes']), 'metronome')}{sure}"
     )
 
     ax = axes[1]

@@ -21,7 +21,7 @@ def summary_text(ds) -> str:
     k = ds.sizes["tick"]
     n = int(a["metronomes"])
     lines = [
-        f"metrosync analyze: {a['path']} ({a['format']}, {a['channels']} channel(s), "
+        f"metrosync analyze: {a['path']} ({a['format']}, {plural(int(a['channels']), 'channel')}, "
         f"{a['sample_rate']} Hz, {a['duration']:.1f} s)",
         f"  ticks: {k}, beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
         f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",

@@ -19,7 +19,9 @@ def plot_analysis(ds, path: Path | str | None = None):
     t = ds.time.values
     for k in range(ds.sizes["log"]):
         ax.plot(t, ds.r_runs.values[k], lw=0.6, alpha=0.5, color="0.5")
-    ax.plot(t, ds.r.values, lw=1.5, color="C0", label=f"r, mean of {ds.sizes['log']} log(s)")
+    ax.plot(
+        t, ds.r.values, lw=1.5, color="C0", label=f"r, mean of {plural(ds.sizes['log'], 'log')}"
+    )
     ax.set_title(
         f"light gate: {plural(ds.sizes['metronome'], 'metronome')}, "
         f"σ = {ds.attrs['sigma_bpm']:.3f} BPM"

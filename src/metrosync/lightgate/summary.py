@@ -9,7 +9,7 @@ def summary_text(ds) -> str:
     """The printed summary: frequencies, jitter, σ, r_eq and the cleaning report."""
     a = ds.attrs
     lines = [
-        f"metrosync analyze: {ds.sizes['log']} log(s), "
+        f"metrosync analyze: {plural(ds.sizes['log'], 'log')}, "
         f"{plural(ds.sizes['metronome'], 'metronome')}, "
         f"common span {float(ds.time[0]):.1f} .. {float(ds.time[-1]):.1f} s",
         "  metronome  frequency (BPM)  period jitter (ms, mean over logs)  passes bridged",

@@ -176,7 +176,7 @@ def _warn_overturned_start(ensemble: Ensemble, amplitude, overturn_angle: float)
     )
     warnings.warn(
         f"{given} is beyond `overturn_angle` = {overturn_angle:.4g} rad: {runs} of "
-        f"{ensemble.runs} run(s) start overturned, are flagged in `status`, and their r is "
+        f"{plural(ensemble.runs, 'run')} start overturned, are flagged in `status`, and their r is "
         f"not meaningful. Start below {overturn_angle:.4g} rad.",
         OverturnWarning,
         stacklevel=_CALLER_LEVEL,

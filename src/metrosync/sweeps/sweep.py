@@ -85,8 +85,9 @@ class SweepResult:
         failures = self.failures()
         if failures:
             lines.append(
-                f"  {len(failures)} point(s) without a result: {failed} failed (the simulation "
-                f"raised; its runs are not counted above), {missing} missing (not computed yet):"
+                f"  {plural(len(failures), 'point')} without a result: {failed} failed (the "
+                f"simulation raised; its runs are not counted above), {missing} missing (not "
+                f"computed yet):"
             )
             for coords, message in failures[:20]:
                 where = ", ".join(f"{k}={v}" for k, v in coords.items())

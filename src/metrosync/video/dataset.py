@@ -14,6 +14,7 @@ import numpy as np
 import xarray as xr
 
 from .._version import __version__
+from .._words import plural
 from ..errors import AnalysisError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
@@ -57,8 +58,8 @@ def tracking_dataset(
         if kept.size < 2:
             x, y = (v / scale for v in region.pivot)
             raise AnalysisError(
-                f"{video.path}: metronome {j} (pivot at {x:.0f}, {y:.0f} px) passes the "
-                f"vertical {kept.size} time(s), too few for a phase: film longer, check that "
+                f"{video.path}: metronome {j} (pivot at {x:.0f}, {y:.0f} px) passes the vertical "
+                f"{plural(kept.size, 'time')}, too few for a phase: film longer, check that "
                 f"its rod is in view and swings, or give the others' pivots with `regions`."
             )
         spans.append((float(kept[0]), float(kept[-1])))

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._words import plural
 from ..plots import finish_figure, new_figure, order_axes
 
 
@@ -49,7 +50,7 @@ def plot_preview(ds, path: Path | str | None = None):
     ax.set_xlim(0, w)
     ax.set_ylim(h, 0)
     ax.set_axis_off()
-    ax.set_title(f"{ds.sizes['metronome']} metronome(s): sector searched, pivot (dot), "
+    ax.set_title(f"{plural(ds.sizes['metronome'], 'metronome')}: sector searched, pivot (dot), "
                  f"vertical (dashed)")  # fmt: skip
     return finish_figure(fig, path)
 
@@ -60,7 +61,7 @@ def plot_tracking(ds, path: Path | str | None = None, *, last: float = 6.0):
     top, bottom = fig.subplots(2, 1, height_ratios=(1.3, 1))
     t = ds.time.values
     top.plot(t, ds.r.values, lw=1.5, color="C0", label="r")
-    top.set_title(f"video: {ds.sizes['metronome']} metronome(s), "
+    top.set_title(f"video: {plural(ds.sizes['metronome'], 'metronome')}, "
                   f"σ = {ds.attrs['sigma_bpm']:.3f} BPM")  # fmt: skip
     order_axes(top, t[-1], ds.attrs["equilibrium_window"], xlabel="t since the first frame (s)",
                window_label=rf"$r_\mathrm{{eq}}$ = {ds.attrs['r_eq']:.3f}")  # fmt: skip

@@ -114,8 +114,8 @@ def track(
         report(_estimate(video, pictures.shape[0], clock.perf_counter() - started, learn))
     if pictures.shape[0] < 3:
         raise detection.DetectionError(
-            f"{str(video.path)!r} holds {pictures.shape[0]} frame(s) in its first {learn:g} s: "
-            f"too few to see anything swing; film at least ten seconds."
+            f"{str(video.path)!r} holds {plural(pictures.shape[0], 'frame')} in its first "
+            f"{learn:g} s: too few to see anything swing; film at least ten seconds."
         )
     # the pictures analysed are smaller than the video: given regions are scaled
     scale = pictures.shape[2] / video.upright_size[0]
@@ -133,7 +133,7 @@ def track(
         warnings.warn(f"{video.path}: {video.loss}.", UserWarning, stacklevel=2)
     if times.size < 4:
         raise detection.DetectionError(
-            f"{str(video.path)!r} gave {times.size} frame(s): too few to time a swing."
+            f"{str(video.path)!r} gave {plural(times.size, 'frame')}: too few to time a swing."
         )
     n = len(found)
     angle = np.empty_like(raw)
