@@ -43,7 +43,7 @@ RECORD_BYTES = 56
 
 #: Wall time of the fixed-step scheme, s: per run-step and per oscillator-step with
 #: the compiled kernel (measured 100-250 ns and 8-36 ns), per step and per
-#: oscillator-step with the NumPy reference (measured 0.6-1.1 ms and < 1 µs).
+#: oscillator-step with the NumPy twin (measured 0.6-1.1 ms and < 1 µs).
 NUMBA_RUN_STEP, NUMBA_OSC_STEP = 150e-9, 15e-9
 NUMPY_STEP, NUMPY_OSC_STEP = 1e-3, 1e-7
 #: Wall time of the reference integrator per simulated second: per run and per

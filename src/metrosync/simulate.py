@@ -76,7 +76,7 @@ def simulate(
         paper's scheme), ``"located"`` (the same with each kick at its crossing
         instant: second order with kicks) or ``"exact"`` (reference).
     backend : for a fixed-step integrator, ``"numba"`` (compiled, parallel over runs),
-        ``"numpy"`` (plain reference, slow) or ``"gpu"`` (an NVIDIA GPU through
+        ``"numpy"`` (the plain NumPy twin, slow) or ``"gpu"`` (an NVIDIA GPU through
         numba.cuda; no trajectories yet); see `metrosync.integrators.BACKENDS`.
     frequencies_bpm, metronomes, amplitude, theta0, theta_dot0 : see `build_ensemble`.
     record_every : record every this many steps; default the step count of 0.1 s, or

@@ -208,15 +208,19 @@ def test_an_interrupted_sweep_prints_nothing_after_its_one_line(tmp_path):
             "--no-progress", "--out", str(out)]  # fmt: skip
     assert subprocess.run([sys.executable, "-m", "metrosync", *argv],
                           capture_output=True).returncode == 0  # fmt: skip
-    # How long the work lasts after its first line on this machine, now: the interrupts
-    # are spread over that, so that most land during it however loaded the machine is.
+    # How long the work lasts after its first line on this machine, now, until its
+    # result is written (not until the process ends: a loaded machine's interpreter
+    # shut-down would take the interrupts past the work): the interrupts are spread over
+    # that, so that most land during it however loaded the machine is.
     out.unlink()
     child = subprocess.Popen([sys.executable, "-m", "metrosync", *argv],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
     child.stdout.readline()
     begin = time.monotonic()
-    child.communicate(timeout=60)
+    while not out.is_file() and child.poll() is None:
+        time.sleep(0.005)
     work = time.monotonic() - begin
+    child.communicate(timeout=60)
     rng = np.random.default_rng(7)
     stopped = 0
     for delay in rng.uniform(0.0, 0.9 * work, 12):
