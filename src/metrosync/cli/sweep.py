@@ -118,7 +118,7 @@ def run(args) -> int:
     store = args.store if args.store is not None else args.out.with_suffix(".points")
     check_output(store, "--store", folder=True)
     shape = dict(zip(grid.axes, grid.shape, strict=True))
-    print(f"metrosync sweep: {plural(grid.size, 'point')}, grid {shape}, store {store}")
+    print(f"metrosync sweep: {plural(grid.size, 'point')}, grid {shape}, store {store}", flush=True)
     result = sweep(
         grid,
         store,
