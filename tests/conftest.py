@@ -42,7 +42,7 @@ def random_system(rng):
             c_theta=rng.uniform(0, 1e-4, (b, n)),
             drive=rng.uniform(0, 1e-3, (b, n)),
             omega=np.ones((b, n)),
-            radius=radius,
+            lever=radius,
             c_phi=rng.uniform(0, 1e-4, b),
             total_inertia=rng.uniform(0.05, 0.5, b) + radius**2 * mass.sum(axis=1),
             dry_friction=np.zeros(b),

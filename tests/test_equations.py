@@ -82,7 +82,7 @@ def test_solved_form_solves_the_equations_with_every_feature_on(rng, random_syst
 def paper_disk_equation(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, reaction):
     """Left minus right of eq. (metron2a) as the paper writes it, with the −Σ𝕄_i term
     kept (``reaction``) or dropped; no applied torque."""
-    lhs = sys.total_inertia * phi_ddot + sys.radius * np.sum(
+    lhs = sys.total_inertia * phi_ddot + sys.lever * np.sum(
         sys.mh * (theta_ddot * np.cos(theta) - theta_dot**2 * np.sin(theta)), axis=-1
     )
     rhs = -sys.c_phi * phi_dot - (np.sum(kick, axis=-1) if reaction else 0.0)
@@ -108,7 +108,7 @@ def test_without_escapement_reaction_the_disk_equation_loses_exactly_that_term(r
     # The solved form: φ̈ gains Σ𝕄_i / D and nothing else (the C term stays), with D
     # the paper's denominator.
     d = on.total_inertia - np.sum(
-        (on.radius[:, None] * on.mh * np.cos(theta)) ** 2 / on.inertia, axis=-1
+        (on.lever[:, None] * on.mh * np.cos(theta)) ** 2 / on.inertia, axis=-1
     )
     np.testing.assert_allclose(
         acc_off[0] - acc_on[0], np.sum(kick, axis=-1) / d, rtol=1e-9, atol=1e-12 * scale

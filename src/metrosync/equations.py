@@ -97,7 +97,7 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, 
     phi_ddot = (numerator + friction) / denominator
     theta_ddot = (
         kick
-        - sys.radius[:, None] * sys.mh * phi_ddot[:, None] * cos_t
+        - sys.lever[:, None] * sys.mh * phi_ddot[:, None] * cos_t
         - sys.mgh * sin_t
         - sys.c_theta * theta_dot
     ) / sys.inertia
@@ -124,7 +124,7 @@ def dry_friction(sys: SystemArrays, phi_dot, holding):
 def effective_inertia(sys: SystemArrays, theta):
     """D of eq. (eqm1), (B,) kg m²: J + R²Σm − R² Σ_i (m_i h_i cos θ_i)² / I_i. An extra
     torque ΔF on the disk changes φ̈ by ΔF/D (and each θ̈_i by −R m_i h_i cos θ_i ΔF/(D I_i))."""
-    d_sum = (sys.radius[:, None] * sys.mh) ** 2 / sys.inertia * np.cos(theta) ** 2
+    d_sum = (sys.lever[:, None] * sys.mh) ** 2 / sys.inertia * np.cos(theta) ** 2
     return sys.total_inertia - np.sum(d_sum, axis=-1)
 
 
@@ -132,13 +132,13 @@ def _disk_equation(sys, theta, theta_dot, phi_dot, kick, t):
     """Numerator (without dry friction) and denominator of eq. (eqm1), sin θ, cos θ."""
     sin_t = np.sin(theta)
     cos_t = np.cos(theta)
-    radius = sys.radius[:, None]
+    lever = sys.lever[:, None]
     mh_over_i = sys.mh / sys.inertia
-    a_sum = radius * mh_over_i * sys.mgh * sin_t * cos_t  # A = m²gR Σ h² sin cos / I
-    b_sum = radius * mh_over_i * sys.c_theta * theta_dot * cos_t  # B
-    c_sum = radius * mh_over_i * kick * cos_t  # C
+    a_sum = lever * mh_over_i * sys.mgh * sin_t * cos_t  # A = m²gR Σ h² sin cos / I
+    b_sum = lever * mh_over_i * sys.c_theta * theta_dot * cos_t  # B
+    c_sum = lever * mh_over_i * kick * cos_t  # C
     numerator = (
-        sys.radius * np.sum(sys.mh * theta_dot**2 * sin_t, axis=-1)
+        sys.lever * np.sum(sys.mh * theta_dot**2 * sin_t, axis=-1)
         + disk_torque(sys, phi_dot, kick, t)
         + np.sum(a_sum + b_sum - c_sum, axis=-1)
     )
@@ -155,10 +155,10 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     """
     sin_t = np.sin(theta)
     cos_t = np.cos(theta)
-    radius = sys.radius[:, None]
+    lever = sys.lever[:, None]
     needed = (  # the dry-friction torque these accelerations need
         sys.total_inertia * phi_ddot
-        + sys.radius * np.sum(sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t), axis=-1)
+        + sys.lever * np.sum(sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t), axis=-1)
         - disk_torque(sys, phi_dot, kick, t)
     )
     limit = sys.dry_friction
@@ -169,7 +169,7 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     )
     pendulum = (
         sys.inertia * theta_ddot
-        + radius * sys.mh * phi_ddot[:, None] * cos_t
+        + lever * sys.mh * phi_ddot[:, None] * cos_t
         + sys.mgh * sin_t
         + sys.c_theta * theta_dot
         - kick

@@ -36,7 +36,7 @@ def test_energy_drifts_less_than_1e4_over_1000_s():
 
 def test_platform_momentum_is_conserved_to_rounding():
     _, momentum, ens = free_run(1000.0, 0.01)
-    scale = np.max(np.abs(ens.system.mh)) * ens.system.radius.max() * 10.0  # |R m h θ̇| bound
+    scale = np.max(np.abs(ens.system.mh)) * ens.system.lever.max() * 10.0  # |R m h θ̇| bound
     assert np.max(np.abs(momentum - momentum[0])) < 1e-12 * scale * 7
     assert np.max(np.abs(momentum[0])) > 1e-6 * scale  # not trivially zero
 

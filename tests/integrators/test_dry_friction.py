@@ -46,7 +46,7 @@ def test_below_the_threshold_the_disk_does_not_move(backend):
     assert np.all(got.traj_phi_dot == 0.0) and np.all(got.traj_phi == 0.0)
     assert np.all(got.phi_dot == 0.0) and np.all(got.acc_phi == 0.0)
     # The disk's angular momentum is that of a disk at rest, R Σ m h cos θ θ̇.
-    coupling = held.system.radius * np.sum(held.system.mh * np.cos(got.theta) * got.theta_dot, 1)
+    coupling = held.system.lever * np.sum(held.system.mh * np.cos(got.theta) * got.theta_dot, 1)
     np.testing.assert_allclose(got.p_phi, coupling, rtol=1e-13, atol=1e-18)
     # The pendulums move exactly as on a rigid support.
     rigid = run(BACKENDS[backend], pinned, 2000)
@@ -164,7 +164,7 @@ def test_friction_at_a_stop_brings_the_step_to_rest(rng, random_system):
         _, thdd = accelerations(sys, theta, theta_dot, phi_dot, no_kick, friction=friction)
         new_theta_dot = theta_dot + 0.5 * (acc + thdd) * DT
         p = p_phi + 0.5 * (force_prev - sys.c_phi * phi_dot + friction) * DT
-        coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * new_theta_dot, axis=1)
+        coupling = sys.lever * np.sum(sys.mh * np.cos(theta) * new_theta_dot, axis=1)
         return (p - coupling) / sys.total_inertia
 
     start = -1e-3 * np.sign(phi_dot)

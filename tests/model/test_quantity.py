@@ -15,7 +15,7 @@ from metrosync.simulation.request import SimulationRequest
 from metrosync.sweeps.grid import MODEL_PARAMETERS, UNITS
 
 #: Fields that are a name or a switch: no unit.
-UNITLESS = {"tuning", "escapement_reaction"}
+UNITLESS = {"tuning", "platform", "escapement_reaction"}
 
 
 @pytest.mark.parametrize("cls", [MetronomeDesign, Metronome, Platform])
@@ -53,4 +53,4 @@ def test_a_value_out_of_its_declared_bounds_is_named_with_its_unit(make, message
 
 def test_the_docstrings_list_the_declarations():
     assert "c_theta            kg m²/s    >= 0" in MetronomeDesign.__doc__
-    assert "inertia            kg m²      > 0" in Platform.__doc__
+    assert "inertia             kg m²      > 0" in Platform.__doc__

@@ -117,6 +117,7 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
     g.add_argument("--dt", type=float, default=0.01, help="time step, s")
     g.add_argument("--seed", type=int, default=0, help="random seed")
     g.add_argument("--preset", default="default", help="parameter preset (see `metrosync presets`)")
+    add_platform_option(g)
     g.add_argument(
         "--set",
         dest="changes",
@@ -211,20 +212,51 @@ def ensemble_defaults(args) -> tuple[float, int, dict[str, str]]:
 PAIR_PARAMETERS = ("l2_bounds",)
 
 
+def add_platform_option(group) -> None:
+    """``--platform``, beside every ``--preset``: the same as ``--set platform=NAME``."""
+    from ..model.platform import PLATFORMS
+
+    group.add_argument(
+        "--platform",
+        choices=PLATFORMS,
+        default=None,
+        help="what carries the metronomes: the paper's rotating disk, or a board on rollers "
+        "(Pantaleone 2002); the same as --set platform=NAME (default: the preset's)",
+    )
+
+
+def model_changes(args) -> dict[str, float | tuple[float, ...] | str]:
+    """The model changes of ``--set`` items and ``--platform``, which must agree."""
+    changes = parse_changes(args.changes)
+    platform = getattr(args, "platform", None)
+    given = changes.get("platform")
+    if platform is not None and given is not None and given != platform:
+        raise ParameterError(
+            f"`--platform {platform}` and `--set platform={given}` disagree; give the platform "
+            f"once."
+        )
+    if platform is not None:
+        changes["platform"] = platform
+    return changes
+
+
 def parse_changes(items: list[str]) -> dict[str, float | tuple[float, ...] | str]:
     """``--set NAME=VALUE`` items as a dict of numbers; ``A,B`` gives a pair
-    (``--set l2_bounds=0,0.12``) and ``tuning`` takes a name."""
-    from ..model import TUNINGS
+    (``--set l2_bounds=0,0.12``) and ``tuning`` and ``platform`` take a name."""
+    from ..model import MetronomeDesign, Platform
+    from ..model.quantity import named
 
+    choices = named(MetronomeDesign, Platform)
     changes: dict[str, float | tuple[float, ...] | str] = {}
     for item in items:
         name, sep, value = item.partition("=")
-        if name.strip() == "tuning" and sep:
-            if value.strip() not in TUNINGS:
+        if name.strip() in choices and sep:
+            allowed = choices[name.strip()]
+            if value.strip() not in allowed:
                 raise ParameterError(
-                    f"`--set tuning` takes one of {list(TUNINGS)}, got {value.strip()!r}."
+                    f"`--set {name.strip()}` takes one of {list(allowed)}, got {value.strip()!r}."
                 )
-            changes["tuning"] = value.strip()
+            changes[name.strip()] = value.strip()
             continue
         try:
             parts = [float(part) for part in value.split(",")]
@@ -274,7 +306,7 @@ def simulate_from_args(args, **extra):
         dt=args.dt,
         seed=args.seed,
         preset=args.preset,
-        changes=parse_changes(args.changes) or None,
+        changes=model_changes(args) or None,
         integrator=args.integrator,
         backend=args.backend or "numba",
         amplitude=args.amplitude,

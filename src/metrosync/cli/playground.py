@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases, parse_changes
+from ._options import HelpFormatter, add_aliases, add_platform_option, model_changes
 
 
 def register(subparsers) -> None:
@@ -25,6 +25,7 @@ def register(subparsers) -> None:
     g.add_argument("--sigma", type=float, default=0.0,
                    help="spread (std) of the natural frequencies, BPM (0 to 10)")  # fmt: skip
     g.add_argument("--preset", default="default", help="parameter preset (see `metrosync presets`)")
+    add_platform_option(g)
     g.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=VALUE",
                    help="change a model parameter, e.g. --set drive=1e-4 (repeatable)")  # fmt: skip
     g.add_argument("--dt", type=float, default=0.01, help="time step, s")
@@ -40,7 +41,7 @@ def run(args) -> int:
 
     check_output(args.out, "--out", suffixes=(".html", ".htm"))
     path = write_playground(
-        args.out, preset=args.preset, changes=parse_changes(args.changes) or None, n=args.n,
+        args.out, preset=args.preset, changes=model_changes(args) or None, n=args.n,
         bpm=args.bpm, sigma_bpm=args.sigma, dt=args.dt, seed=args.seed,
     )  # fmt: skip
     print(f"wrote {path} ({path.stat().st_size / 1e3:.0f} kB); open it in a browser, "

@@ -19,13 +19,14 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     del args
-    from ..model import PRESETS, MetronomeDesign, Platform
+    from ..model import PRESETS, MetronomeDesign
     from ..model.quantity import units
 
-    unit = units(MetronomeDesign, Platform)
+    design_units = units(MetronomeDesign)
     width = max(16, *(len(key) for params in PRESETS.values() for key in params.as_dict()))
     for name, params in PRESETS.items():
         print(f"{name}: {params.description}")
+        unit = {**design_units, **params.platform.units()}
         for key, value in params.as_dict().items():
             if key != "preset":
                 print(f"    {key:{width}s} {value} {unit.get(key, '')}".rstrip())

@@ -7,7 +7,7 @@ from pathlib import Path
 from .._words import plural
 from ..errors import ParameterError
 from ._io import NETCDF, check_output
-from ._options import HelpFormatter, add_aliases, group_spec
+from ._options import HelpFormatter, add_aliases, add_platform_option, group_spec
 
 #: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
 GRID_OPTIONS = {
@@ -49,6 +49,7 @@ def register(subparsers) -> None:
     g.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=SPEC",
                    help="any model parameter, e.g. --set l1=0.035 (repeatable)")  # fmt: skip
     g.add_argument("--preset", default=None, help="parameter preset (default: 'default')")
+    add_platform_option(g)
     g.add_argument("--group", dest="groups", type=group_spec, action="append", default=None,
                    metavar="N@BPM[:SIGMA]",
                    help="a group of N metronomes at BPM (repeat for several; replaces --n "
@@ -82,6 +83,7 @@ def grid_from_args(args):
         if not sep or not spec.strip():
             raise ParameterError(f"`--set` expects NAME=SPEC, got {item!r}.")
         items.append((name.strip(), spec.strip()))
+    items.append(("platform", args.platform))
     given: dict[str, str] = {}
     for name, spec in items:
         if spec is None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import FIGURE, NETCDF, check_output, write_outputs
-from ._options import HelpFormatter, add_aliases, parse_changes
+from ._options import HelpFormatter, add_aliases, add_platform_option, model_changes
 
 
 def register(subparsers) -> None:
@@ -25,6 +25,7 @@ def register(subparsers) -> None:
     )
     g = parser.add_argument_group("model")
     g.add_argument("--preset", default="default", help="parameter preset (see `metrosync presets`)")
+    add_platform_option(g)
     g.add_argument(
         "--set",
         dest="changes",
@@ -125,7 +126,7 @@ def run(args) -> int:
         raise ParameterError(f"`--bpm` needs at least 2 values to interpolate, got {args.bpm!r}.")
     n = _n(args.n)
     params = get_preset(args.preset, warn=False)
-    changes = parse_changes(args.changes)
+    changes = model_changes(args)
     given = changes.get("tuning")
     if args.tuning is not None and given is not None and given != args.tuning:
         raise ParameterError(

@@ -119,14 +119,14 @@ def forced(c, r):
 def disk_acceleration(c, r, sum_num, sum_den, force):
     """φ̈ of eq. (eqm1) from the per-metronome sums and the disk torque F. A pinned
     disk (J + R²Σm = ∞) gives 0."""
-    rad = c.radius[r]
+    rad = c.lever[r]
     return (rad * sum_num + force) / (c.total_inertia[r] - rad * rad * sum_den)
 
 
 @nb.njit(cache=True, inline="always")
 def theta_ddot(c, m, r, rest, q, phi_ddot):
     """θ̈_i of eq. (eqm2) from ρ_i, q_i and φ̈."""
-    return rest - c.radius[r] * q * c.inv_inertia[m] * phi_ddot
+    return rest - c.lever[r] * q * c.inv_inertia[m] * phi_ddot
 
 
 @nb.njit(cache=True, inline="always")
@@ -136,7 +136,7 @@ def disk_velocity(c, r, p_phi, sum_q_theta_dot):
     total = c.total_inertia[r]
     if math.isinf(total):
         return 0.0
-    return (p_phi - c.radius[r] * sum_q_theta_dot) / total
+    return (p_phi - c.lever[r] * sum_q_theta_dot) / total
 
 
 @nb.njit(cache=True, inline="always")
@@ -152,7 +152,7 @@ def disk_friction(c, r, phi_dot, sum_num, force):
     limit = c.dry_friction[r]
     if phi_dot != 0.0:
         return (-limit if phi_dot > 0.0 else limit), False
-    need = -(c.radius[r] * sum_num + force)
+    need = -(c.lever[r] * sum_num + force)
     if abs(need) <= limit:
         return need, True
     return (limit if need > 0.0 else -limit), False
@@ -169,7 +169,7 @@ def disk_friction_stop(c, r, friction, phi_dot_next, sum_den, dt):
     φ̇' = 0 and True when it is within ±T (the disk stops); else −``friction`` and False
     (the disk reverses, and the friction turns against the new direction).
     """
-    rad = c.radius[r]
+    rad = c.lever[r]
     stop = friction - 2.0 * (c.total_inertia[r] - rad * rad * sum_den) * phi_dot_next / dt
     if abs(stop) <= c.dry_friction[r]:
         return stop, True
@@ -179,7 +179,7 @@ def disk_friction_stop(c, r, friction, phi_dot_next, sum_den, dt):
 @nb.njit(cache=True, inline="always")
 def momentum_at_rest(c, r, sum_q_theta_dot):
     """p_φ of a disk at rest (φ̇ = 0): R Σ_i q_i θ̇_i."""
-    return c.radius[r] * sum_q_theta_dot
+    return c.lever[r] * sum_q_theta_dot
 
 
 #: Every function above, for `kernel_cuda` and the tests.

@@ -55,7 +55,7 @@ def arrange(constants):
     """The constants blocked for this layout: per-metronome (B, N) → (block, N, LANES),
     per-run (B,) → (block, LANES). Missing lanes of the last block repeat its last run
     (they are computed, never written back)."""
-    runs = constants.radius.shape[0]
+    runs = constants.lever.shape[0]
     n_blocks = (runs + LANES - 1) // LANES
     rows = np.minimum(np.arange(n_blocks * LANES), runs - 1)
     blocked = {}

@@ -122,7 +122,7 @@ class _Step:
         force = others + friction
         self._book_crossings(state, th, th_new, ok, t_old)
         q_new = sys.mh * np.cos(th_new)
-        through_disk = sys.radius[:, None] * (1.0 / sys.inertia)
+        through_disk = sys.lever[:, None] * (1.0 / sys.inertia)
         own, own_change, after, jump, shift, change, momentum_jump = self._impulses(
             state, kicks, th, th_new, ok, q_new
         )
@@ -150,7 +150,7 @@ class _Step:
             phdd, thdd = accelerations(*forces, friction=friction)
             force = others + friction
             held |= stops
-        coupling = sys.radius * np.sum(q_new * new_theta_dot, axis=1)
+        coupling = sys.lever * np.sum(q_new * new_theta_dot, axis=1)
         new_p = np.where(held, coupling, new_p)  # a disk at rest: p_φ = R Σ m h cos θ θ̇
         state.rest_steps[held & ok] += 1
         with np.errstate(invalid="ignore"):
@@ -226,7 +226,7 @@ LOCATED = TwinScheme("located", impulsive=True)
 
 
 def _disk_velocity(sys, p_phi, theta, theta_dot):
-    coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=1)
+    coupling = sys.lever * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=1)
     with np.errstate(invalid="ignore"):
         return (p_phi - coupling) / sys.total_inertia
 

@@ -124,6 +124,17 @@ def units(*classes: type) -> dict[str, str]:
     }
 
 
+def named(*classes: type) -> dict[str, tuple[str, ...]]:
+    """The fields that take a name rather than a number (``tuning``, ``platform``), with
+    their choices, by name."""
+    return {
+        f.name: f.metadata["choices"]
+        for cls in classes
+        for f in dataclasses.fields(cls)
+        if f.metadata.get("choices")
+    }
+
+
 def ascii_unit(unit: str) -> str:
     """``"kg m²/s"`` -> ``"kg m2/s"``: the unit as UDUNITS and NetCDF attributes read it."""
     return unit.translate(_SUPERSCRIPTS)

@@ -32,18 +32,21 @@ class SystemArrays:
     mh : m_i h_i.   mgh : m_i g h_i.   inertia : m_i h_i² + J_i.
     c_theta, drive : friction c_θ and escapement impulse M of each metronome.
     omega : small-amplitude natural frequency on a rigid support, rad/s.
-    radius : R.   c_phi : c_φ.   total_inertia : J + R² Σ m_i (the coefficient of φ̈
-    in eq. (metron2a)); ``inf`` pins the disk.
+    lever : ℓ, how far a pivot moves per unit of the platform's coordinate φ: the
+        disk's radius R, or 1 m for the board (`model.platform`).
+    c_phi : the platform's viscous damping (the disk's c_φ, the board's damping).
+    total_inertia : J_p + ℓ² Σ m_i (the coefficient of φ̈ in eq. (metron2a)); ``inf``
+        pins the platform.
 
     Beyond the paper (each defaults to "off" when not given, so that a caller that
     builds the arrays by hand need not know them):
-    forcing_amplitude, forcing_omega : (B,) A (N m) and Ω (rad/s) of the external
-        torque A sin(Ω t) on the disk; A = 0 switches it off.
+    forcing_amplitude, forcing_omega : (B,) A (N m on the disk, N on the board) and
+        Ω (rad/s) of the external drive A sin(Ω t) on the platform; A = 0 switches it off.
     escapement_offset : (B, N) angle δ_i at which metronome i's escapement acts, rad.
     escapement_reaction : (B,) 1.0 when the escapement's reaction −Σ𝕄_i acts on the
-        disk (the paper), 0.0 when it does not.
-    dry_friction : (B,) the disk's Coulomb friction torque, N m
-        (``Platform.disk_dry_friction``); 0 for none.
+        disk (the paper), 0.0 when it does not (and always on the board).
+    dry_friction : (B,) the platform's Coulomb friction, N m on the disk
+        (``disk_dry_friction``), N on the board (``board_dry_friction``); 0 for none.
     """
 
     mh: np.ndarray
@@ -52,7 +55,7 @@ class SystemArrays:
     c_theta: np.ndarray
     drive: np.ndarray
     omega: np.ndarray
-    radius: np.ndarray
+    lever: np.ndarray
     c_phi: np.ndarray
     total_inertia: np.ndarray
     forcing_amplitude: np.ndarray | None = None
@@ -62,7 +65,7 @@ class SystemArrays:
     dry_friction: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        runs = np.shape(self.radius)
+        runs = np.shape(self.lever)
         off = {
             "forcing_amplitude": np.zeros(runs),
             "forcing_omega": np.zeros(runs),
@@ -99,7 +102,8 @@ def system_arrays(
 
     Returns
     -------
-    The `SystemArrays`, and the disk's own inertia J, (B,) kg m².
+    The `SystemArrays`, and the platform's own inertia J_p, (B,) (kg m² for the disk,
+    kg for the board).
     """
     runs, n = l2.shape
     design = params.metronome
@@ -118,9 +122,9 @@ def system_arrays(
             "is inverted); lower its slider `l2` below w1*l1/w2."
         )
     mass = w1 + w2
-    platform = params.platform
-    disk = np.full(runs, platform.disk_inertia(n))
-    radius = np.full(runs, platform.radius)
+    terms = params.platform.terms(n)
+    own = np.full(runs, terms.own_inertia)
+    lever = np.full(runs, terms.lever)
     system = SystemArrays(
         mh=mass * h,
         mgh=mass * g * h,
@@ -128,13 +132,13 @@ def system_arrays(
         c_theta=np.array(values["c_theta"], dtype=float),
         drive=np.array(values["drive"], dtype=float),
         omega=natural_omega(w1, w2, l1, l2, g),
-        radius=radius,
-        c_phi=np.full(runs, platform.c_phi),
-        total_inertia=disk + radius**2 * mass.sum(axis=1),
-        forcing_amplitude=np.full(runs, platform.forcing_amplitude),
-        forcing_omega=np.full(runs, float(bpm_to_omega(platform.forcing_bpm))),
+        lever=lever,
+        c_phi=np.full(runs, terms.damping),
+        total_inertia=own + lever**2 * mass.sum(axis=1),
+        forcing_amplitude=np.full(runs, terms.forcing_amplitude),
+        forcing_omega=np.full(runs, float(bpm_to_omega(params.platform.forcing_bpm))),
         escapement_offset=np.array(values["escapement_offset"], dtype=float),
-        escapement_reaction=np.full(runs, 1.0 if platform.escapement_reaction else 0.0),
-        dry_friction=np.full(runs, platform.disk_dry_friction),
+        escapement_reaction=np.full(runs, 1.0 if terms.escapement_reaction else 0.0),
+        dry_friction=np.full(runs, terms.dry_friction),
     )
-    return system, disk
+    return system, own

@@ -22,12 +22,12 @@ def total_energy(sys: SystemArrays, theta, theta_dot, phi_dot):
     disk_inertia = np.where(rigid, 0.0, sys.total_inertia)
     phd = np.where(rigid, 0.0, phi_dot)
     pend = 0.5 * sys.inertia * theta_dot**2 + sys.mgh * (1 - np.cos(theta))
-    cross = sys.radius[:, None] * phd[..., None] * sys.mh * np.cos(theta) * theta_dot
+    cross = sys.lever[:, None] * phd[..., None] * sys.mh * np.cos(theta) * theta_dot
     return 0.5 * disk_inertia * phd**2 + np.sum(pend + cross, axis=-1)
 
 
 def platform_momentum(sys: SystemArrays, theta, theta_dot, phi_dot):
     rigid = np.isinf(sys.total_inertia)
     disk_inertia = np.where(rigid, 0.0, sys.total_inertia)
-    coupling = sys.radius * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
+    coupling = sys.lever * np.sum(sys.mh * np.cos(theta) * theta_dot, axis=-1)
     return np.where(rigid, 0.0, disk_inertia * np.asarray(phi_dot) + coupling)

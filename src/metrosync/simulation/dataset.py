@@ -196,8 +196,15 @@ def _add_when_present(data, ensemble: Ensemble, rec: Records, window: float, dur
             rec.theta_dot.transpose(1, 0, 2),
             {"units": "rad/s"},
         )
-        data["phi"] = (("time", "run"), rec.phi.T, {"units": "rad"})
-        data["phi_dot"] = (("time", "run"), rec.phi_dot.T, {"units": "rad/s"})
+        # φ is the platform's coordinate: the disk's angle, or the board's position.
+        board = ensemble.params.platform.platform == "board"
+        what, unit = ("board position", "m") if board else ("disk angle", "rad")
+        data["phi"] = (("time", "run"), rec.phi.T, {"units": unit, "long_name": what})
+        data["phi_dot"] = (
+            ("time", "run"),
+            rec.phi_dot.T,
+            {"units": f"{unit}/s", "long_name": f"rate of the {what}"},
+        )
 
 
 def _add_groups(data, coords, attrs, ensemble: Ensemble, rec: Records, time, window) -> None:

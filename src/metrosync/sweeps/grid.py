@@ -31,8 +31,8 @@ import numpy as np
 from .._version import __version__
 from ..errors import ParameterError, describe
 from ..groups import as_groups, describe_groups, shifted
-from ..model import TUNINGS, MetronomeDesign, Platform, get_preset
-from ..model.quantity import units
+from ..model import MetronomeDesign, Platform, get_preset
+from ..model.quantity import named, units
 from ..simulation.request import SimulationRequest
 from .points import PointSpec, canonical_json, make_point
 
@@ -59,7 +59,7 @@ MODEL_PARAMETERS = tuple(
     )
 )
 #: Model parameters that take a name rather than a number, and their choices.
-CHOICES = {"tuning": TUNINGS}
+CHOICES = named(MetronomeDesign, Platform)
 #: Other names people use for the same parameter.
 ALIASES = {
     "N": "n",

@@ -72,19 +72,21 @@ class Coupling:
 
 
 def disk_scale(n: int | float, params: ModelParameters | str = "default") -> float:
-    """N/D₀(N) with D₀ = J(N) + N m R²; its N → ∞ limit for ``n = math.inf``."""
+    """N/D₀(N) with D₀ = J_p(N) + N m ℓ² (J_p the platform's own inertia, ℓ its lever:
+    J(N) and R on the disk, the board's mass and 1 m on the board); its N → ∞ limit
+    for ``n = math.inf``."""
     params = get_preset(params, warn=False)
     p, mass = params.platform, params.metronome.mass
     if n == math.inf:
-        if p.inertia is not None:
+        if p.platform == "disk" and p.inertia is not None:
             raise ParameterError(
                 "`n` = inf needs the J(N) law, but this platform has a fixed `inertia`; with a "
                 "fixed J the coupling per metronome vanishes as N grows. Give a finite `n`."
             )
-        return 1.0 / (p.j_per_metronome + mass * p.radius**2)
+        return 1.0 / (p.inertia_per_metronome + mass * p.lever**2)
     if isinstance(n, bool) or int(n) != n or n < 1:
         raise ParameterError(f"`n` must be a whole number >= 1 of metronomes, got {n!r}.")
-    return n / (p.disk_inertia(int(n)) + n * mass * p.radius**2)
+    return n / (p.own_inertia(int(n)) + n * mass * p.lever**2)
 
 
 def tuned_metronome(bpm: float, params: ModelParameters):

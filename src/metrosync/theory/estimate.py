@@ -58,7 +58,7 @@ def estimate(
     metronome, swing = tuned_metronome(bpm, params)
     p = params.platform
     scale = disk_scale(n, params)
-    mu_per_n = (metronome.mass * p.radius * metronome.h) ** 2 / metronome.inertia * scale
+    mu_per_n = (metronome.mass * p.lever * metronome.h) ** 2 / metronome.inertia * scale
     omega = math.pi * swing.tick_bpm / 60.0
     amp = swing.amplitude
     c2 = _mean_cos_squared(amp)
