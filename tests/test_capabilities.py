@@ -136,7 +136,14 @@ def test_refusals_keep_the_project_s_words():
         simulate(2, 192, duration=1.0, integrator="located", changes={"disk_dry_friction": 5e-3})
     assert str(refused.value) == (
         "`disk_dry_friction` = 0.005 N m: integrator 'located' has no dry friction on the "
-        "disk; use integrator='verlet' (or 'exact')."
+        "platform; use integrator='verlet' (or 'exact')."
+    )
+    with pytest.raises(UnsupportedFeature) as refused:
+        simulate(2, 192, duration=1.0, integrator="located", preset="pantaleone2002",
+                 changes={"board_dry_friction": 0.02})  # fmt: skip
+    assert str(refused.value) == (
+        "`board_dry_friction` = 0.02 N: integrator 'located' has no dry friction on the "
+        "platform; use integrator='verlet' (or 'exact')."
     )
     with pytest.raises(UnsupportedFeature) as refused:
         require("verlet/gpu", get_preset("default").with_changes(disk_dry_friction=5e-3))

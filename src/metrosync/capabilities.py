@@ -115,7 +115,11 @@ FEATURES: dict[str, Feature] = {
             lacks="no external forcing torque on the disk",
             example={"forcing_amplitude": 0.02, "forcing_bpm": 189.0},
             from_params=lambda p: (
-                ("forcing_amplitude", p.platform.forcing_amplitude, "N m")
+                (
+                    "forcing_amplitude",
+                    p.platform.forcing_amplitude,
+                    p.platform.units()["forcing_amplitude"],
+                )
                 if p.platform.forcing_amplitude != 0
                 else None
             ),
@@ -157,19 +161,31 @@ FEATURES: dict[str, Feature] = {
         ),
         Feature(
             name="dry-friction",
-            parameters=("disk_dry_friction",),
-            summary="Coulomb (dry) friction on the disk: it sticks and slips",
-            lacks="no dry friction on the disk",
+            parameters=("disk_dry_friction", "board_dry_friction"),
+            summary="Coulomb (dry) friction on the platform: it sticks and slips",
+            lacks="no dry friction on the platform",
             example={"disk_dry_friction": 5e-3},
             from_params=lambda p: (
                 ("disk_dry_friction", p.platform.disk_dry_friction, "N m")
                 if p.platform.disk_dry_friction > 0
+                else ("board_dry_friction", p.platform.board_dry_friction, "N")
+                if p.platform.board_dry_friction > 0
                 else None
             ),
             from_system=lambda s: (
                 ("disk_dry_friction", _largest(s.dry_friction), "N m")
                 if np.any(s.dry_friction > 0)
                 else None
+            ),
+        ),
+        Feature(
+            name="board",
+            parameters=("platform",),
+            summary="the metronomes on a board on rollers instead of the disk",
+            lacks="no board on rollers (only the disk)",
+            example={"platform": "board"},
+            from_params=lambda p: (
+                ("platform", "board", "") if p.platform.platform == "board" else None
             ),
         ),
         Feature(
