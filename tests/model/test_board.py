@@ -2,6 +2,7 @@
 and every integrator on it (docs/model.md §9)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -156,3 +157,18 @@ def test_the_dataset_says_what_phi_is():
                   record_every=10)  # fmt: skip
     assert ds.phi.attrs["units"] == "m" and ds.phi.attrs["long_name"] == "board position"
     assert ds.attrs["platform"] == "board" and "radius" not in ds.attrs
+
+
+def test_a_step_too_long_for_the_board_s_damping_is_refused_with_one_that_works():
+    kw = dict(preset="pantaleone2002", changes={"board_damping": 40.0}, duration=1.0)
+    with pytest.raises(
+        ParameterError, match=r"^`board_damping` = 40.0 damps the board at 1\d\d /s"
+    ):
+        simulate(2, 208.0, dt=0.01, **kw)
+    with pytest.raises(ParameterError, match=r"use dt <= 0\.00\d+ s") as refused:
+        simulate(2, 208.0, dt=0.01, integrator="located", **kw)
+    step = float(re.search(r"use dt <= (0\.00\d+) s", str(refused.value)).group(1))
+    ds = simulate(2, 208.0, dt=step, **kw)
+    assert np.isfinite(ds.r.values).all()
+    with pytest.raises(ParameterError, match=r"^`c_phi` = 100.0 damps the disk"):
+        simulate(2, 192.0, dt=0.01, changes={"c_phi": 100.0}, duration=1.0)

@@ -30,7 +30,8 @@ from ..errors import MetrosyncError
 #: Subcommand modules, in the order ``--help`` lists them.
 SUBCOMMANDS = (
     "simulate", "presets", "reproduce", "analyze", "calibrate", "sweep",
-    "critical", "theory", "animate", "listen", "page", "playground", "record", "track",
+    "critical", "theory", "pantaleone", "animate", "listen", "page", "playground", "record",
+    "track",
 )  # fmt: skip
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from .._words import plural
 from ..budget import simulation_budget
-from ..ensemble import Ensemble, check_time_step
+from ..ensemble import Ensemble, check_damping_step, check_time_step
 from ..errors import EscapementWarning, OverturnWarning
 from ..integrators._state import Records, StepState, records_of
 from ..observables.death import flag_stopped
@@ -54,6 +54,8 @@ class RunRecords:
 def run(request: SimulationRequest, ensemble: Ensemble) -> RunRecords:
     """Advance ``ensemble`` as ``request`` says, from its start to its end."""
     check_time_step(request.dt, ensemble)
+    if request.scheme.fixed_step:
+        check_damping_step(request.dt, ensemble)
     window = request.window()
     show = _sys.stderr.isatty() if request.progress is None else request.progress
     _warn_overturned_start(ensemble, request.amplitude, request.overturn_angle)
