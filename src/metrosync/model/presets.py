@@ -46,6 +46,11 @@ class ModelParameters:
         """True when the energy-balance amplitude passes the horizontal (π/2)."""
         return self.balance_amplitude > math.pi / 2
 
+    def on_rigid_support(self) -> ModelParameters:
+        """The same metronomes on a support that does not move (a pinned disk, whatever
+        the platform was): each swings alone."""
+        return replace(self, platform=Platform(inertia=math.inf), name=f"{self.name}+rigid")
+
     def with_changes(self, **changes) -> ModelParameters:
         """Copy with fields of the metronome design or the platform replaced by name.
 

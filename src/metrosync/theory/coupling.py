@@ -77,7 +77,7 @@ def _free_omega(metronome, swing, params: ModelParameters, dt: float) -> float:
         n=None,
         bpm=None,
         metronomes=[metronome],
-        preset=params,
+        preset=params.on_rigid_support(),
         theta0=theta0,
         theta_dot0=theta_dot0,
         duration=60.0,
@@ -85,7 +85,6 @@ def _free_omega(metronome, swing, params: ModelParameters, dt: float) -> float:
         trajectories=True,
         record_every=max(1, int(round(2.5e-3 / dt))),
         progress=False,
-        changes={"inertia": math.inf},
     )
     ticks = _upward_crossings(ds.theta.values[:, 0, 0], ds.time.values)
     ticks = ticks[ticks > 20.0]
