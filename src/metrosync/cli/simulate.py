@@ -233,7 +233,8 @@ def summary(
     if "disk_at_rest" in ds:
         rest = 100 * ds.disk_at_rest.values
         lines.append(
-            f"  disk held at rest by dry friction: {np.mean(rest):.0f} % of the final "
+            f"  {a.get('platform', 'disk')} held at rest by dry friction: {np.mean(rest):.0f} % "
+            f"of the final "
             f"{a['equilibrium_window']:g} s (mean over runs; {np.min(rest):.0f} .. "
             f"{np.max(rest):.0f} %)"
         )

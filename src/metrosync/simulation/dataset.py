@@ -171,8 +171,8 @@ def _add_when_present(data, ensemble: Ensemble, rec: Records, window: float, dur
             np.minimum(rec.rest_time / window, 1.0),
             {
                 "units": "1",
-                "long_name": "fraction of the final window with the disk held at "
-                "rest by its dry friction",
+                "long_name": f"fraction of the final window with the "
+                f"{ensemble.params.platform.platform} held at rest by its dry friction",
             },
         )
     offset = system.escapement_offset
