@@ -145,13 +145,23 @@ class Lag:
     spread: float
 
 
-def pair_lag(detuning_bpm: float, *, duration: float, window: float, dt: float = DT) -> Lag:
+def pair_lag(
+    detuning_bpm: float,
+    *,
+    duration: float,
+    window: float,
+    dt: float = DT,
+    changes: dict | None = None,
+) -> Lag:
     """Two metronomes marked ``BPM ± detuning/2`` (the first the faster), started in
     phase, measured over the last ``window`` seconds."""
     frequencies = [BPM + detuning_bpm / 2, BPM - detuning_bpm / 2]
-    amplitude = steady_amplitude()
+    params = get_preset(PRESET, warn=False)
+    if changes:
+        params = params.with_changes(**changes)
+    amplitude = steady_amplitude(params)
     ds = simulate(
-        None, None, frequencies_bpm=frequencies, preset=PRESET, integrator="located",
+        None, None, frequencies_bpm=frequencies, preset=params, integrator="located",
         theta0=[amplitude, amplitude], theta_dot0=[0.0, 0.0], duration=duration, dt=dt,
         record_every=1, trajectories=True,
     )  # fmt: skip
