@@ -76,7 +76,8 @@ def plot_order(ds, path: Path | str | None = None, *, ax=None):
         ensemble = f"N = {a['n']} in groups {' '.join(labels)} (N@BPM:σ)"
     else:
         ensemble = f"N = {a['n']}, {a['bpm']} BPM, σ = {a['sigma_bpm']} BPM"
-    ax.set_title(f"{ensemble}, mean of {plural(a['runs'], 'run')}")
+    on_board = ", on a board" if a.get("platform") == "board" else ""
+    ax.set_title(f"{ensemble}{on_board}, mean of {plural(a['runs'], 'run')}")
     order_axes(ax, t[-1], a.get("equilibrium_window"), xlabel="t (s)")
     return finish_figure(fig, path)
 
