@@ -9,7 +9,6 @@ import pytest
 
 from metrosync import ParameterError, build_ensemble, get_preset, simulate
 from metrosync.equations import accelerations
-from metrosync.integrators import REGISTRY
 from metrosync.model import Platform, system_arrays
 from metrosync.observables import platform_momentum, total_energy
 
@@ -121,24 +120,6 @@ def test_the_board_s_momentum_is_conserved_without_friction_and_drive(integrator
     tolerance = 1e-12 if integrator == "exact" else 1e-13
     np.testing.assert_allclose(momentum - momentum[0], 0, rtol=0, atol=tolerance)
     assert np.max(np.abs(energy / energy[0] - 1)) < (1e-8 if integrator == "exact" else 1e-3)
-
-
-def test_located_has_order_2_with_kicks_on_the_board():
-    kw = dict(frequencies_bpm=[208.0, 208.0], theta0=[0.1, -0.05], duration=5.0,
-              trajectories=True, preset="pantaleone2002")  # fmt: skip
-    exact = simulate(None, None, integrator="exact", dt=0.01, record_every=10, **kw)
-    dts = np.array([0.01, 0.001, 0.0001])
-    errors = []
-    for dt in dts:
-        ds = simulate(None, None, integrator="located", dt=dt, record_every=int(round(0.1 / dt)),
-                      **kw)  # fmt: skip
-        errors.append(np.max(np.abs(ds.theta.values - exact.theta.values)))
-    order = np.polyfit(np.log(dts), np.log(errors), 1)[0]
-    assert order == pytest.approx(REGISTRY["located"].order_with_kicks, abs=0.3), (order, errors)
-    # the board really moved the pendulums: a rigid support gives another swing
-    rigid = simulate(None, None, integrator="exact", dt=0.01, record_every=10,
-                     **{**kw, "preset": "default"}, changes={"inertia": math.inf})  # fmt: skip
-    assert not np.allclose(rigid.theta.values, exact.theta.values, atol=1e-3)
 
 
 def test_a_parameter_of_the_other_platform_is_refused_by_name():

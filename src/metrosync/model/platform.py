@@ -146,7 +146,7 @@ class Platform:
     escapement_reaction: bool = True
     disk_dry_friction: float = quantity(0.0, unit="N m", bounds=NON_NEGATIVE)
     board_mass: float = quantity(0.058, unit="kg", bounds=POSITIVE)
-    box_mass: float = quantity(0.0702, unit="kg", bounds=NON_NEGATIVE)
+    box_mass: float = quantity(0.0705, unit="kg", bounds=NON_NEGATIVE)
     roller_mass: float = quantity(0.0, unit="kg", bounds=NON_NEGATIVE)
     board_damping: float = quantity(0.0, unit="kg/s", bounds=NON_NEGATIVE)
     board_dry_friction: float = quantity(0.0, unit="N", bounds=NON_NEGATIVE)
