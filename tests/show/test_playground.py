@@ -55,7 +55,11 @@ def test_constants_come_from_the_package():
         sent = config["presets"][name]
         constants = {**vars(params.metronome), **vars(params.platform)}
         constants["l2_bounds"] = list(constants["l2_bounds"])
-        assert sent["constants"] == constants
+        # A steady-swing preset (pantaleone2002) also sends its spline, which the
+        # steady-swing test below checks.
+        sent_constants = {k: v for k, v in sent["constants"].items() if k != "steady_swing"}
+        assert sent_constants == constants
+        assert ("steady_swing" in sent["constants"]) == (params.metronome.tuning == "steady-swing")
         assert sent["bpm_range"] == list(params.metronome.bpm_range())
     assert config["dt"] == 0.01 and config["overturn_angle"] == math.pi / 2
     # ... and none of them is typed into the scripts.
