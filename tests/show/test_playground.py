@@ -107,6 +107,20 @@ def test_script_closing_tags_in_a_description_cannot_break_the_page(tmp_path):
         ({"changes": {"inertia": 1e6}}, "`inertia` = 1000000.0"),
         ({"changes": {"w2": 0.0}}, "`w2` = 0"),
         ({"changes": {"spin": 1.0}}, "unknown model parameter(s) ['spin']"),
+        # The board's parameters have slider ranges too; the disk's are not the board's.
+        (
+            {"preset": "pantaleone2002", "changes": {"board_mass": 1e3}},
+            "`board_mass` = 1000.0 is outside the playground's slider range [0.001, 100];",
+        ),
+        (
+            {"preset": "pantaleone2002", "changes": {"board_damping": 1e3}},
+            "`board_damping` = 1000.0 is outside the playground's slider range [0.0001, 100] (or",
+        ),
+        (
+            {"preset": "pantaleone2002", "changes": {"c_phi": 1e-4}},
+            "`c_phi` = 0.0001 is a parameter of the disk, but `platform` is 'board'",
+        ),
+        ({"changes": {"board_mass": 0.5}}, "`board_mass` = 0.5 is a parameter of the board"),
     ],
 )
 def test_bad_starting_points_are_refused(options, message):
@@ -233,6 +247,13 @@ CASES = {
         theta_dot0=[1.0, 0.0, 3.0, -2.0, 0.0],
         hold=True,
     ),
+    # The same nine on the board (the page's own preset switched by `changes`), damped.
+    "board": dict(
+        frequencies_bpm=[190.0, 192.5, 193.1, 188.7, 195.0, 191.2, 192.0, 189.9, 194.4],
+        theta0=[0.3, -0.5, 0.7, 0.1, -0.2, 0.0, 0.6, -0.7, 0.25],
+        theta_dot0=[0.0, 1.0, -2.0, 3.0, 0.5, -4.0, 0.0, 1.5, -1.0],
+        changes={"platform": "board", "drive": 8e-5, "board_damping": 0.05},
+    ),
 }
 
 
@@ -276,10 +297,41 @@ def test_the_page_tunes_by_the_steady_swing_as_the_package_does(browser, tmp_pat
 
 
 #: Every model feature of the capability table, and all of them together; the dry
-#: friction also strong enough to hold the disk between kicks.
+#: friction also strong enough to hold the disk between kicks. The board is the other
+#: platform, so "all" is every feature on the disk, and "board-all" every feature the
+#: board has (the disk's friction and reaction switch are not the board's).
 FEATURE_CASES = {name: dict(f.example) for name, f in FEATURES.items() if f.kind == "model"}
 FEATURE_CASES["dry-friction-held"] = {"disk_dry_friction": 2e-2}
-FEATURE_CASES["all"] = {k: v for name in MODEL_FEATURES for k, v in FEATURES[name].example.items()}
+FEATURE_CASES["all"] = {
+    k: v for name in MODEL_FEATURES if name != "board" for k, v in FEATURES[name].example.items()
+}
+FEATURE_CASES["board-all"] = {
+    "platform": "board", "forcing_amplitude": 0.02, "forcing_bpm": 189.0,
+    "escapement_offset": 0.07, "board_dry_friction": 0.02, "tuning": "steady-swing",
+}  # fmt: skip
+#: The disk's friction c_φ is not the board's: on the board the base changes damp it.
+BOARD_BASE = {"drive": 8e-5, "board_damping": 0.05}
+DRY = {"disk_dry_friction", "board_dry_friction"}
+
+
+def compare_with_numpy(browser, params: dict, **simulate_options):
+    """The open page's ``run(params, 10000)`` against `simulate(..., backend="numpy")`
+    with the same start: every trajectory to 1e-9; returns both."""
+    out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
+    run = {k: v for k, v in params.items() if k not in ("changes", "preset")}
+    ds = metrosync.simulate(
+        None, None, **run, duration=100.0, dt=0.01, record_every=1, trajectories=True,
+        backend="numpy", **simulate_options,
+    ).isel(run=0)  # fmt: skip
+    assert out["status"] == int(ds.status) == 0
+    for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
+        np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
+                                   err_msg=name)  # fmt: skip
+    np.testing.assert_allclose(out["l2"], ds["l2"].values, rtol=0, atol=1e-12)
+    assert np.ptp(ds["theta"].values) > 1.0  # it moved: the comparison is not of two constants
+    assert np.ptp(ds["phi"].values) > 0  # and so did the platform
+    assert requested(browser) == [browser.evaluate("location.href")]
+    return out, ds
 
 
 @pytest.mark.parametrize("case", sorted(FEATURE_CASES))
@@ -297,27 +349,63 @@ def test_the_page_runs_each_model_feature_or_refuses_it_by_name(request, tmp_pat
         return
     browser = request.getfixturevalue("browser")  # skips, naming the package, without one
     params = {k: v for k, v in CASES["free"].items() if k != "changes"}
-    base = CASES["free"]["changes"]
+    base = BOARD_BASE if changes.get("platform") == "board" else CASES["free"]["changes"]
     page = write_playground(tmp_path / "play.html", changes={**base, **changes})
     open_offline(browser, page)
     # The page says which terms beyond the paper it runs.
     wait_for(browser, "document.getElementById('status').textContent.includes('Beyond the paper')")
-    out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
-    ds = metrosync.simulate(
-        None, None, **params, duration=100.0, dt=0.01, record_every=1, trajectories=True,
-        backend="numpy", changes={**base, **changes},
-    ).isel(run=0)  # fmt: skip
-    assert out["status"] == int(ds.status) == 0
-    if "disk_dry_friction" in changes:
+    out, _ = compare_with_numpy(browser, params, changes={**base, **changes})
+    if DRY & set(changes):
         held = np.count_nonzero(np.array(out["phi_dot"][1:]) == 0.0)  # after the start
-        assert held > 0, "the disk never stuck"
-    for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
-        np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
-                                   err_msg=name)  # fmt: skip
-    np.testing.assert_allclose(out["l2"], ds["l2"].values, rtol=0, atol=1e-12)
-    assert out["status"] == int(ds["status"])
-    assert np.ptp(ds["theta"].values) > 1.0  # it moved: the comparison is not of two constants
-    assert requested(browser) == [browser.evaluate("location.href")]
+        assert held > 0, "the platform never stuck"
+
+
+#: Pantaleone's board (preset pantaleone2002, its steady-swing tuning) alone and with
+#: each feature the board has, then all of them: forcing (N), the escapement's offset,
+#: the board's dry friction (strong enough to stick at times) and its damping.
+BOARD_CASES = {
+    "preset": {},
+    "forcing": {"forcing_amplitude": 0.02, "forcing_bpm": 208.0},
+    "escapement-offset": {"escapement_offset": 0.07},
+    "dry-friction": {"board_dry_friction": 0.02},
+    "damped": {"board_damping": 2.0},
+}
+BOARD_CASES["all"] = {k: v for case in BOARD_CASES.values() for k, v in case.items()}
+
+
+@pytest.mark.parametrize("case", sorted(BOARD_CASES))
+def test_the_board_preset_runs_in_the_page_as_in_numpy(browser, tmp_path, case):
+    """Six metronomes on preset pantaleone2002's board: the page's physics is
+    `simulate(..., backend="numpy")`'s to 1e-9 over 10 000 steps, the board's constants
+    are the model's, and the page says it runs the board."""
+    from metrosync.model import get_preset
+
+    changes = BOARD_CASES[case]
+    page = write_playground(tmp_path / "play.html", preset="pantaleone2002", n=2, bpm=208.0,
+                            changes=changes or None)  # fmt: skip
+    name = "pantaleone2002+changes" if changes else "pantaleone2002"
+    params = {
+        "preset": name,
+        "frequencies_bpm": [206.0, 208.5, 207.1, 209.7, 205.0, 208.0],
+        "theta0": [0.3, -0.35, 0.39, 0.1, -0.2, 0.0],
+        "theta_dot0": [0.0, 2.0, -1.0, 3.0, 0.5, -4.0],
+    }
+    open_offline(browser, page)
+    out, ds = compare_with_numpy(browser, params, preset="pantaleone2002",
+                                 changes=changes or None)  # fmt: skip
+    assert ds.attrs["platform"] == "board" and ds.phi.attrs["units"] == "m"
+    if DRY & set(changes):
+        assert np.count_nonzero(np.array(out["phi_dot"][1:]) == 0.0) > 0, "the board never stuck"
+    model = get_preset("pantaleone2002", warn=False).with_changes(**changes).platform.terms(6)
+    system = browser.evaluate(
+        f"(() => {{ const c = window.metrosync.config.presets[{json.dumps(name)}].constants;"
+        " const s = Physics.buildSystem(c, [206, 208, 207, 209, 205, 208], false);"
+        " return [s.lever, s.ownInertia, s.cPhi, s.dryFriction, s.reaction]; })()"
+    )
+    assert system == [model.lever, model.own_inertia, model.damping, model.dry_friction, 0.0]
+    status = browser.evaluate("document.getElementById('status').textContent")
+    assert "the board on rollers" in status
+    assert browser.console_errors() == []
 
 
 def test_playground_smoke(browser, tmp_path):
