@@ -456,6 +456,63 @@ def test_playground_smoke(browser, tmp_path):
     assert "offline" in browser.console_errors()
 
 
+def colour_pixels(png: bytes, rgb: tuple[int, int, int]) -> int:
+    """How many pixels of a screenshot have (nearly) the colour ``rgb``."""
+    import io
+
+    from PIL import Image
+
+    shot = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    return int(np.count_nonzero(np.abs(shot - rgb).sum(axis=2) < 12))
+
+
+BOARD_WOOD, ROLLER = (0xE8, 0xD9, 0xBF), (0xD9, 0xDD, 0xE3)  # view.js's board and cans
+
+
+def test_the_board_is_offered_drawn_and_locks(browser, tmp_path):
+    """Pantaleone's two metronomes: the page opens on the board with the board's
+    controls, draws a board on two rollers that moves, and the pair locks in phase;
+    the platform choice switches to the disk and back, the platform starting at rest."""
+    page = write_playground(tmp_path / "play.html", preset="pantaleone2002", n=2, bpm=208.0)
+    url = open_offline(browser, page)
+    session = "window.metrosync.session"
+    shown = "(id) => !document.getElementById(id).hidden"
+    assert browser.evaluate(f"[document.getElementById('platform').value, {session}.system.lever,"
+                            f" ({shown})('board-controls'), ({shown})('disk-controls'),"
+                            " document.getElementById('platform-name').textContent]") == [
+        "board", 1.0, True, False, "a board on rollers"]  # fmt: skip
+    wait_for(browser, "window.metrosync.frames > 5")
+    platform = canvas_rect(browser, "disk")
+    first = browser.screenshot(platform)
+    assert colour_pixels(first, BOARD_WOOD) > 500 and colour_pixels(first, ROLLER) > 200
+    click(browser, "play")
+    set_control(browser, "speed", 50)
+    browser.pump(0.3)
+    assert browser.screenshot(platform) != first
+    wait_for(browser, f"{session}.t > 120")
+    # In phase (Pantaleone's Fig. 2), and the board moved.
+    assert browser.evaluate("window.metrosync.r") > 0.95
+    assert browser.evaluate(f"{session}.boardCentre") is not None
+    click(browser, "play")  # pause
+    set_control(browser, "boarddamping", 800)
+    set_control(browser, "boardmass", 500)
+    damping, mass = browser.evaluate(f"[{session}.system.cPhi, {session}.settings.boardMass]")
+    assert 1.0 < damping < 100.0 and 0.1 < mass < 1.0  # log sliders over their LIMITS
+    own = browser.evaluate(f"{session}.system.ownInertia")
+    assert own == pytest.approx(mass + 2 * PRESETS["pantaleone2002"].platform.box_mass, rel=1e-12)
+    set_control(browser, "platform", "disk")
+    disk = PRESETS["pantaleone2002"].platform.radius
+    assert browser.evaluate(f"[{session}.system.lever, {session}.state.phi, {session}.state.phiDot,"
+                            f" ({shown})('disk-controls'), ({shown})('board-controls')]") == [
+        disk, 0.0, 0.0, True, False]  # fmt: skip
+    set_control(browser, "platform", "board")
+    assert browser.evaluate(f"{session}.markers.map((m) => m[1])")[-2:] == ["disk", "board"]
+    assert browser.evaluate(f"{session}.system.lever") == 1.0
+    assert browser.console_errors() == []
+    assert requested(browser) == [url]
+    (tmp_path / "board.png").write_bytes(browser.screenshot(platform))
+
+
 def test_controls_take_effect_and_continue_from_the_state(browser, tmp_path):
     open_offline(browser, write_playground(tmp_path / "play.html", n=5, seed=3))
     before = browser.evaluate("Array.from(window.metrosync.session.state.theta)")
