@@ -147,6 +147,13 @@ def test_cli_writes_the_page(tmp_path, capsys):
     assert config["presets"]["default+changes"]["constants"]["c_phi"] == 2e-5
 
 
+def test_cli_writes_a_board_page(tmp_path):
+    out = tmp_path / "board.html"
+    assert main(["playground", "--platform", "board", "--n", "2", "--out", str(out)]) == 0
+    config = embedded_config(out.read_text(encoding="utf-8"))
+    assert config["presets"]["default+changes"]["constants"]["platform"] == "board"
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
@@ -156,6 +163,7 @@ def test_cli_writes_the_page(tmp_path, capsys):
         (["--sigma", "-2"], "`sigma_bpm` (--sigma) = -2.0"),
         (["--bpm", "500"], "`bpm` = 500.0"),
         (["--set", "drive"], "`--set` expects NAME=VALUE"),
+        (["--platform", "board", "--set", "c_phi=1e-4"], "`c_phi` = 0.0001 is a parameter of"),
     ],
 )
 def test_cli_errors_name_the_option(tmp_path, capsys, argv, message):
