@@ -75,7 +75,7 @@
     $("drive-out").textContent = sci(s.drive);
     $("cphi-out").textContent = sci(s.cPhi);
     $("inertia-out").textContent = s.j.toPrecision(3);
-    $("boardmass-out").textContent = s.boardMass.toPrecision(3) + " kg";
+    $("boardmass-out").textContent = s.boardMass.toPrecision(3);
     $("boarddamping-out").textContent = sci(s.boardDamping);
     if (s.jLaw) inertia.set(s.j);  // the law moves J with N
   }
