@@ -121,12 +121,31 @@ def test_script_closing_tags_in_a_description_cannot_break_the_page(tmp_path):
             "`c_phi` = 0.0001 is a parameter of the disk, but `platform` is 'board'",
         ),
         ({"changes": {"board_mass": 0.5}}, "`board_mass` = 0.5 is a parameter of the board"),
+        # A wet table's damping needs a finer step than the page's default.
+        (
+            {"preset": "pantaleone2002", "changes": {"board_damping": 100.0}, "n": 2, "bpm": 208.0},
+            "`board_damping` = 100.0 kg/s damps the board at 416 /s, too fast for the step `dt` "
+            "= 0.01 s (the page's step needs rate x dt <= 1, or it diverges): lower it to at "
+            "most 24 kg/s, or give `dt` <= 0.0024 s.",
+        ),
     ],
 )
 def test_bad_starting_points_are_refused(options, message):
     with pytest.raises(ParameterError) as error:
         playground_config(**options)
     assert message in str(error.value)
+
+
+def test_a_wet_table_runs_at_the_step_it_needs():
+    """The damping check's advice works: at dt = 0.001 s the wet table is accepted, and
+    its rate is the one the message gave."""
+    from metrosync.show.playground import damping_rate
+
+    wet = {"board_damping": 100.0}
+    config = playground_config(preset="pantaleone2002", changes=wet, n=2, bpm=208.0, dt=0.001)
+    assert config["max_damping_per_step"] == 1.0
+    params = PRESETS["pantaleone2002"].with_changes(**wet)
+    assert damping_rate(params, 2, 208.0) == pytest.approx(416.3, abs=0.1)
 
 
 def test_an_overturning_preset_warns():
@@ -506,6 +525,13 @@ def test_the_board_is_offered_drawn_and_locks(browser, tmp_path):
     set_control(browser, "boardmass", 500)
     damping, mass = browser.evaluate(f"[{session}.system.cPhi, {session}.settings.boardMass]")
     assert 1.0 < damping < 100.0 and 0.1 < mass < 1.0  # log sliders over their LIMITS
+    # A damping the page's step cannot follow is said, with the fix, as the start's is.
+    set_control(browser, "boarddamping", 1000)
+    status = "document.getElementById('status').textContent"
+    wait_for(browser, f"{status}.includes('too fast for the step 0.01 s')")
+    assert "The board's damping 1.0e+2 damps it at" in browser.evaluate(status)
+    set_control(browser, "boarddamping", 800)
+    wait_for(browser, f"!{status}.includes('too fast')")
     own = browser.evaluate(f"{session}.system.ownInertia")
     assert own == pytest.approx(mass + 2 * PRESETS["pantaleone2002"].platform.box_mass, rel=1e-12)
     set_control(browser, "platform", "disk")

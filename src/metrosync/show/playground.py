@@ -63,6 +63,10 @@ MIN_DT = 1e-3
 MIN_STEPS_PER_PERIOD = 10
 #: |θ| beyond which the page reports an overturned pendulum, rad (as `simulate`).
 OVERTURN_ANGLE = math.pi / 2
+#: The most a step may be of the platform's damping time, rate × dt: the step takes
+#: the damping force explicitly and diverges beyond about 1.2 (a wet table's board,
+#: 100 kg/s, needs dt = 0.001 s).
+MAX_DAMPING_PER_STEP = 1.0
 
 
 def preset_data(params: ModelParameters) -> dict:
@@ -143,10 +147,12 @@ def playground_config(
         )
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
         raise ParameterError(f"`seed` must be an integer in [0, 2**32), got {describe(seed)}.")
+    _check_damping_step(params, n, float(bpm), float(dt))
     return {
         "version": __version__,
         "dt": float(dt),
         "overturn_angle": OVERTURN_ANGLE,
+        "max_damping_per_step": MAX_DAMPING_PER_STEP,
         "presets": presets,
         "start": {
             "preset": params.name,
@@ -222,3 +228,40 @@ def _check_ranges(params: ModelParameters) -> None:
                 f"`{name}` = {value!r} is outside the playground's slider range "
                 f"[{lo:g}, {hi:g}]{' (or 0)' if zero else ''}; choose a value in it."
             )
+
+
+def damping_rate(params: ModelParameters, n: int, bpm: float) -> float:
+    """The platform's viscous damping rate c/D₀, 1/s, for ``n`` metronomes tuned to
+    ``bpm`` (D₀ the coefficient of φ̈ in eq. (eqm1) with the pendulums hanging); 0 for a
+    held disk. The page computes the same (`Physics.buildSystem`'s ``dampingRate``)."""
+    import numpy as np
+
+    from ..model.system import system_arrays
+    from ..model.tuning import l2_for_bpm
+
+    if params.platform.rigid:
+        return 0.0
+    design = params.metronome
+    l2 = np.full((1, n), l2_for_bpm(design, bpm, tuning=design.tuning))
+    system, _ = system_arrays(params, l2)
+    d0 = system.total_inertia - system.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
+    return float(system.c_phi[0] / d0[0])
+
+
+def _check_damping_step(params: ModelParameters, n: int, bpm: float, dt: float) -> None:
+    """Refuse a start whose platform damping the step cannot follow (it would diverge)."""
+    rate = damping_rate(params, n, bpm)
+    if rate * dt <= MAX_DAMPING_PER_STEP:
+        return
+    board = params.platform.platform == "board"
+    name, unit = ("board_damping", "kg/s") if board else ("c_phi", "kg m²/s")
+    value = getattr(params.platform, name)
+    fixes = f"lower it to at most {value * MAX_DAMPING_PER_STEP / (rate * dt):.3g} {unit}"
+    finer = MAX_DAMPING_PER_STEP / rate
+    if finer >= MIN_DT:
+        fixes += f", or give `dt` <= {finer:.3g} s"
+    raise ParameterError(
+        f"`{name}` = {value!r} {unit} damps the {'board' if board else 'disk'} at {rate:.3g} /s, "
+        f"too fast for the step `dt` = {dt:g} s (the page's step needs rate x dt <= "
+        f"{MAX_DAMPING_PER_STEP:g}, or it diverges): {fixes}."
+    )

@@ -165,6 +165,15 @@
     const notes = [];
     if (st.status & Physics.STATUS_DIVERGED) notes.push("the run diverged: press Restart.");
     if (st.status & Physics.STATUS_OVERTURNED) notes.push("a pendulum swung past the horizontal.");
+    const rate = session.system.dampingRate, limit = config.max_damping_per_step;
+    if (rate * session.dt > limit) {
+      // As playground_config refuses such a start: the step cannot follow the damping.
+      const board = session.settings.platform === "board";
+      const value = board ? session.settings.boardDamping : session.settings.cPhi;
+      notes.push((board ? "The board's damping " : "The disk's friction c_φ ") + sci(value)
+        + " damps it at " + rate.toPrecision(3) + " /s, too fast for the step " + session.dt
+        + " s: lower it to at most " + sci(value * limit / (rate * session.dt)) + ".");
+    }
     if (session.clipped) notes.push(session.clipped + " of " + n + " frequencies clipped to the "
       + "tunable range.");
     const terms = modelTerms(session.constants);

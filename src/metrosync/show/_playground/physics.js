@@ -118,7 +118,7 @@ const Physics = (function () {
       reaction: terms.reaction, dryFriction: terms.dryFriction,
     };
     const mass = c.w1 + c.w2;
-    let massSum = 0.0;
+    let massSum = 0.0, hanging = 0.0;
     for (let i = 0; i < n; i++) {
       const l2 = l2ForBpm(c, freqs[i]);
       const h = (c.w1 * c.l1 - c.w2 * l2) / mass;
@@ -132,8 +132,13 @@ const Physics = (function () {
       sys.drive[i] = c.drive;
       sys.offset[i] = c.escapement_offset;
       massSum += mass;
+      hanging += sys.mh[i] * sys.mh[i] / sys.inertia[i];
     }
     sys.totalInertia = hold ? Infinity : sys.ownInertia + (terms.lever * terms.lever) * massSum;
+    // The damping rate c/D₀ (D₀: eq. (eqm1)'s denominator, pendulums hanging), which the
+    // step must resolve (playground.damping_rate); 0 for a held platform.
+    sys.dampingRate = hold ? 0.0
+      : sys.cPhi / (sys.totalInertia - (terms.lever * terms.lever) * hanging);
     return sys;
   }
 
