@@ -64,6 +64,7 @@ circle, the arrow is r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and 
   const speedSelect = document.getElementById("speed");
   const readout = document.getElementById("readout");
   let t = D.start, playing = false, last = null;
+  if (D.platform === "board") disk.canvas.setAttribute("aria-label", "board seen from the side");
   seek.min = D.start; seek.max = D.end; seek.value = D.start;
 
   // Cubic Hermite interpolation between records, from values and derivatives.
