@@ -265,15 +265,16 @@ class Consumer:
 #: compared between every layout and its NumPy twin (tests/integrators/test_kernels.py).
 _ALL = frozenset(FEATURES)
 #: The playground's JavaScript (`metrosync.show.playground`): every term of the model
-#: (the forcing torque, the escapement's offset and reaction switch, dry friction on
-#: the disk) and the steady-swing tuning; ``run(params, steps)`` returns trajectories;
-#: no groups' orders, no kick records.
+#: (the forcing, the escapement's offset and reaction switch, dry friction on the
+#: platform, the board on rollers) and the steady-swing tuning; ``run(params, steps)``
+#: returns trajectories; no groups' orders, no kick records.
 PLAYGROUND_RUNS = frozenset(
     {
         "forcing",
         "escapement-offset",
         "no-escapement-reaction",
         "dry-friction",
+        "board",
         "steady-swing",
         "trajectories",
     }

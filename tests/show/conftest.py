@@ -44,3 +44,10 @@ def browser(chromium_executable, tmp_path):
     profile.mkdir()
     with Browser(chromium_executable, profile) as b:  # closing kills its process group
         yield b
+
+
+@pytest.fixture(scope="session")
+def board_ds():
+    """Pantaleone's two metronomes on his board, 20 s, every step recorded."""
+    return metrosync.simulate(2, 208, preset="pantaleone2002", duration=20, trajectories=True,
+                              record_every=1)  # fmt: skip

@@ -55,7 +55,11 @@ def test_constants_come_from_the_package():
         sent = config["presets"][name]
         constants = {**vars(params.metronome), **vars(params.platform)}
         constants["l2_bounds"] = list(constants["l2_bounds"])
-        assert sent["constants"] == constants
+        # A steady-swing preset (pantaleone2002) also sends its spline, which the
+        # steady-swing test below checks.
+        sent_constants = {k: v for k, v in sent["constants"].items() if k != "steady_swing"}
+        assert sent_constants == constants
+        assert ("steady_swing" in sent["constants"]) == (params.metronome.tuning == "steady-swing")
         assert sent["bpm_range"] == list(params.metronome.bpm_range())
     assert config["dt"] == 0.01 and config["overturn_angle"] == math.pi / 2
     # ... and none of them is typed into the scripts.
@@ -103,12 +107,45 @@ def test_script_closing_tags_in_a_description_cannot_break_the_page(tmp_path):
         ({"changes": {"inertia": 1e6}}, "`inertia` = 1000000.0"),
         ({"changes": {"w2": 0.0}}, "`w2` = 0"),
         ({"changes": {"spin": 1.0}}, "unknown model parameter(s) ['spin']"),
+        # The board's parameters have slider ranges too; the disk's are not the board's.
+        (
+            {"preset": "pantaleone2002", "changes": {"board_mass": 1e3}},
+            "`board_mass` = 1000.0 is outside the playground's slider range [0.001, 100];",
+        ),
+        (
+            {"preset": "pantaleone2002", "changes": {"board_damping": 1e3}},
+            "`board_damping` = 1000.0 is outside the playground's slider range [0.0001, 100] (or",
+        ),
+        (
+            {"preset": "pantaleone2002", "changes": {"c_phi": 1e-4}},
+            "`c_phi` = 0.0001 is a parameter of the disk, but `platform` is 'board'",
+        ),
+        ({"changes": {"board_mass": 0.5}}, "`board_mass` = 0.5 is a parameter of the board"),
+        # A wet table's damping needs a finer step than the page's default.
+        (
+            {"preset": "pantaleone2002", "changes": {"board_damping": 100.0}, "n": 2, "bpm": 208.0},
+            "`board_damping` = 100.0 kg/s damps the board at 416 /s, too fast for the step `dt` "
+            "= 0.01 s (the page's step needs rate x dt <= 1, or it diverges): lower it to at "
+            "most 24 kg/s, or give `dt` <= 0.0024 s.",
+        ),
     ],
 )
 def test_bad_starting_points_are_refused(options, message):
     with pytest.raises(ParameterError) as error:
         playground_config(**options)
     assert message in str(error.value)
+
+
+def test_a_wet_table_runs_at_the_step_it_needs():
+    """The damping check's advice works: at dt = 0.001 s the wet table is accepted, and
+    its rate is the one the message gave."""
+    from metrosync.show.playground import damping_rate
+
+    wet = {"board_damping": 100.0}
+    config = playground_config(preset="pantaleone2002", changes=wet, n=2, bpm=208.0, dt=0.001)
+    assert config["max_damping_per_step"] == 1.0
+    params = PRESETS["pantaleone2002"].with_changes(**wet)
+    assert damping_rate(params, 2, 208.0) == pytest.approx(416.3, abs=0.1)
 
 
 def test_an_overturning_preset_warns():
@@ -129,6 +166,13 @@ def test_cli_writes_the_page(tmp_path, capsys):
     assert config["presets"]["default+changes"]["constants"]["c_phi"] == 2e-5
 
 
+def test_cli_writes_a_board_page(tmp_path):
+    out = tmp_path / "board.html"
+    assert main(["playground", "--platform", "board", "--n", "2", "--out", str(out)]) == 0
+    config = embedded_config(out.read_text(encoding="utf-8"))
+    assert config["presets"]["default+changes"]["constants"]["platform"] == "board"
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
@@ -138,6 +182,7 @@ def test_cli_writes_the_page(tmp_path, capsys):
         (["--sigma", "-2"], "`sigma_bpm` (--sigma) = -2.0"),
         (["--bpm", "500"], "`bpm` = 500.0"),
         (["--set", "drive"], "`--set` expects NAME=VALUE"),
+        (["--platform", "board", "--set", "c_phi=1e-4"], "`c_phi` = 0.0001 is a parameter of"),
     ],
 )
 def test_cli_errors_name_the_option(tmp_path, capsys, argv, message):
@@ -229,6 +274,13 @@ CASES = {
         theta_dot0=[1.0, 0.0, 3.0, -2.0, 0.0],
         hold=True,
     ),
+    # The same nine on the board (the page's own preset switched by `changes`), damped.
+    "board": dict(
+        frequencies_bpm=[190.0, 192.5, 193.1, 188.7, 195.0, 191.2, 192.0, 189.9, 194.4],
+        theta0=[0.3, -0.5, 0.7, 0.1, -0.2, 0.0, 0.6, -0.7, 0.25],
+        theta_dot0=[0.0, 1.0, -2.0, 3.0, 0.5, -4.0, 0.0, 1.5, -1.0],
+        changes={"platform": "board", "drive": 8e-5, "board_damping": 0.05},
+    ),
 }
 
 
@@ -272,10 +324,41 @@ def test_the_page_tunes_by_the_steady_swing_as_the_package_does(browser, tmp_pat
 
 
 #: Every model feature of the capability table, and all of them together; the dry
-#: friction also strong enough to hold the disk between kicks.
+#: friction also strong enough to hold the disk between kicks. The board is the other
+#: platform, so "all" is every feature on the disk, and "board-all" every feature the
+#: board has (the disk's friction and reaction switch are not the board's).
 FEATURE_CASES = {name: dict(f.example) for name, f in FEATURES.items() if f.kind == "model"}
 FEATURE_CASES["dry-friction-held"] = {"disk_dry_friction": 2e-2}
-FEATURE_CASES["all"] = {k: v for name in MODEL_FEATURES for k, v in FEATURES[name].example.items()}
+FEATURE_CASES["all"] = {
+    k: v for name in MODEL_FEATURES if name != "board" for k, v in FEATURES[name].example.items()
+}
+FEATURE_CASES["board-all"] = {
+    "platform": "board", "forcing_amplitude": 0.02, "forcing_bpm": 189.0,
+    "escapement_offset": 0.07, "board_dry_friction": 0.02, "tuning": "steady-swing",
+}  # fmt: skip
+#: The disk's friction c_φ is not the board's: on the board the base changes damp it.
+BOARD_BASE = {"drive": 8e-5, "board_damping": 0.05}
+DRY = {"disk_dry_friction", "board_dry_friction"}
+
+
+def compare_with_numpy(browser, params: dict, **simulate_options):
+    """The open page's ``run(params, 10000)`` against `simulate(..., backend="numpy")`
+    with the same start: every trajectory to 1e-9; returns both."""
+    out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
+    run = {k: v for k, v in params.items() if k not in ("changes", "preset")}
+    ds = metrosync.simulate(
+        None, None, **run, duration=100.0, dt=0.01, record_every=1, trajectories=True,
+        backend="numpy", **simulate_options,
+    ).isel(run=0)  # fmt: skip
+    assert out["status"] == int(ds.status) == 0
+    for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
+        np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
+                                   err_msg=name)  # fmt: skip
+    np.testing.assert_allclose(out["l2"], ds["l2"].values, rtol=0, atol=1e-12)
+    assert np.ptp(ds["theta"].values) > 1.0  # it moved: the comparison is not of two constants
+    assert np.ptp(ds["phi"].values) > 0  # and so did the platform
+    assert requested(browser) == [browser.evaluate("location.href")]
+    return out, ds
 
 
 @pytest.mark.parametrize("case", sorted(FEATURE_CASES))
@@ -293,27 +376,63 @@ def test_the_page_runs_each_model_feature_or_refuses_it_by_name(request, tmp_pat
         return
     browser = request.getfixturevalue("browser")  # skips, naming the package, without one
     params = {k: v for k, v in CASES["free"].items() if k != "changes"}
-    base = CASES["free"]["changes"]
+    base = BOARD_BASE if changes.get("platform") == "board" else CASES["free"]["changes"]
     page = write_playground(tmp_path / "play.html", changes={**base, **changes})
     open_offline(browser, page)
     # The page says which terms beyond the paper it runs.
     wait_for(browser, "document.getElementById('status').textContent.includes('Beyond the paper')")
-    out = browser.evaluate(f"window.metrosync.run({json.dumps(params)}, 10000)")
-    ds = metrosync.simulate(
-        None, None, **params, duration=100.0, dt=0.01, record_every=1, trajectories=True,
-        backend="numpy", changes={**base, **changes},
-    ).isel(run=0)  # fmt: skip
-    assert out["status"] == int(ds.status) == 0
-    if "disk_dry_friction" in changes:
+    out, _ = compare_with_numpy(browser, params, changes={**base, **changes})
+    if DRY & set(changes):
         held = np.count_nonzero(np.array(out["phi_dot"][1:]) == 0.0)  # after the start
-        assert held > 0, "the disk never stuck"
-    for name in ("theta", "theta_dot", "phi", "phi_dot", "r"):
-        np.testing.assert_allclose(np.array(out[name]), ds[name].values, rtol=0, atol=1e-9,
-                                   err_msg=name)  # fmt: skip
-    np.testing.assert_allclose(out["l2"], ds["l2"].values, rtol=0, atol=1e-12)
-    assert out["status"] == int(ds["status"])
-    assert np.ptp(ds["theta"].values) > 1.0  # it moved: the comparison is not of two constants
-    assert requested(browser) == [browser.evaluate("location.href")]
+        assert held > 0, "the platform never stuck"
+
+
+#: Pantaleone's board (preset pantaleone2002, its steady-swing tuning) alone and with
+#: each feature the board has, then all of them: forcing (N), the escapement's offset,
+#: the board's dry friction (strong enough to stick at times) and its damping.
+BOARD_CASES = {
+    "preset": {},
+    "forcing": {"forcing_amplitude": 0.02, "forcing_bpm": 208.0},
+    "escapement-offset": {"escapement_offset": 0.07},
+    "dry-friction": {"board_dry_friction": 0.02},
+    "damped": {"board_damping": 2.0},
+}
+BOARD_CASES["all"] = {k: v for case in BOARD_CASES.values() for k, v in case.items()}
+
+
+@pytest.mark.parametrize("case", sorted(BOARD_CASES))
+def test_the_board_preset_runs_in_the_page_as_in_numpy(browser, tmp_path, case):
+    """Six metronomes on preset pantaleone2002's board: the page's physics is
+    `simulate(..., backend="numpy")`'s to 1e-9 over 10 000 steps, the board's constants
+    are the model's, and the page says it runs the board."""
+    from metrosync.model import get_preset
+
+    changes = BOARD_CASES[case]
+    page = write_playground(tmp_path / "play.html", preset="pantaleone2002", n=2, bpm=208.0,
+                            changes=changes or None)  # fmt: skip
+    name = "pantaleone2002+changes" if changes else "pantaleone2002"
+    params = {
+        "preset": name,
+        "frequencies_bpm": [206.0, 208.5, 207.1, 209.7, 205.0, 208.0],
+        "theta0": [0.3, -0.35, 0.39, 0.1, -0.2, 0.0],
+        "theta_dot0": [0.0, 2.0, -1.0, 3.0, 0.5, -4.0],
+    }
+    open_offline(browser, page)
+    out, ds = compare_with_numpy(browser, params, preset="pantaleone2002",
+                                 changes=changes or None)  # fmt: skip
+    assert ds.attrs["platform"] == "board" and ds.phi.attrs["units"] == "m"
+    if DRY & set(changes):
+        assert np.count_nonzero(np.array(out["phi_dot"][1:]) == 0.0) > 0, "the board never stuck"
+    model = get_preset("pantaleone2002", warn=False).with_changes(**changes).platform.terms(6)
+    system = browser.evaluate(
+        f"(() => {{ const c = window.metrosync.config.presets[{json.dumps(name)}].constants;"
+        " const s = Physics.buildSystem(c, [206, 208, 207, 209, 205, 208], false);"
+        " return [s.lever, s.ownInertia, s.cPhi, s.dryFriction, s.reaction]; })()"
+    )
+    assert system == [model.lever, model.own_inertia, model.damping, model.dry_friction, 0.0]
+    status = browser.evaluate("document.getElementById('status').textContent")
+    assert "the board on rollers" in status
+    assert browser.console_errors() == []
 
 
 def test_playground_smoke(browser, tmp_path):
@@ -362,6 +481,70 @@ def test_playground_smoke(browser, tmp_path):
     browser.pump(0.3)
     assert requested(browser) == [url, "https://example.org/"]
     assert "offline" in browser.console_errors()
+
+
+def colour_pixels(png: bytes, rgb: tuple[int, int, int]) -> int:
+    """How many pixels of a screenshot have (nearly) the colour ``rgb``."""
+    import io
+
+    from PIL import Image
+
+    shot = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    return int(np.count_nonzero(np.abs(shot - rgb).sum(axis=2) < 12))
+
+
+BOARD_WOOD, ROLLER = (0xE8, 0xD9, 0xBF), (0xD9, 0xDD, 0xE3)  # view.js's board and cans
+
+
+def test_the_board_is_offered_drawn_and_locks(browser, tmp_path):
+    """Pantaleone's two metronomes: the page opens on the board with the board's
+    controls, draws a board on two rollers that moves, and the pair locks in phase;
+    the platform choice switches to the disk and back, the platform starting at rest."""
+    page = write_playground(tmp_path / "play.html", preset="pantaleone2002", n=2, bpm=208.0)
+    url = open_offline(browser, page)
+    session = "window.metrosync.session"
+    shown = "(id) => !document.getElementById(id).hidden"
+    assert browser.evaluate(f"[document.getElementById('platform').value, {session}.system.lever,"
+                            f" ({shown})('board-controls'), ({shown})('disk-controls'),"
+                            " document.getElementById('platform-name').textContent]") == [
+        "board", 1.0, True, False, "a board on rollers"]  # fmt: skip
+    wait_for(browser, "window.metrosync.frames > 5")
+    platform = canvas_rect(browser, "disk")
+    first = browser.screenshot(platform)
+    assert colour_pixels(first, BOARD_WOOD) > 500 and colour_pixels(first, ROLLER) > 200
+    click(browser, "play")
+    set_control(browser, "speed", 50)
+    browser.pump(0.3)
+    assert browser.screenshot(platform) != first
+    wait_for(browser, f"{session}.t > 120")
+    # In phase (Pantaleone's Fig. 2), and the board moved.
+    assert browser.evaluate("window.metrosync.r") > 0.95
+    assert browser.evaluate(f"{session}.boardCentre") is not None
+    click(browser, "play")  # pause
+    set_control(browser, "boarddamping", 800)
+    set_control(browser, "boardmass", 500)
+    damping, mass = browser.evaluate(f"[{session}.system.cPhi, {session}.settings.boardMass]")
+    assert 1.0 < damping < 100.0 and 0.1 < mass < 1.0  # log sliders over their LIMITS
+    # A damping the page's step cannot follow is said, with the fix, as the start's is.
+    set_control(browser, "boarddamping", 1000)
+    status = "document.getElementById('status').textContent"
+    wait_for(browser, f"{status}.includes('too fast for the step 0.01 s')")
+    assert "The board's damping 1.0e+2 damps it at" in browser.evaluate(status)
+    set_control(browser, "boarddamping", 800)
+    wait_for(browser, f"!{status}.includes('too fast')")
+    own = browser.evaluate(f"{session}.system.ownInertia")
+    assert own == pytest.approx(mass + 2 * PRESETS["pantaleone2002"].platform.box_mass, rel=1e-12)
+    set_control(browser, "platform", "disk")
+    disk = PRESETS["pantaleone2002"].platform.radius
+    assert browser.evaluate(f"[{session}.system.lever, {session}.state.phi, {session}.state.phiDot,"
+                            f" ({shown})('disk-controls'), ({shown})('board-controls')]") == [
+        disk, 0.0, 0.0, True, False]  # fmt: skip
+    set_control(browser, "platform", "board")
+    assert browser.evaluate(f"{session}.markers.map((m) => m[1])")[-2:] == ["disk", "board"]
+    assert browser.evaluate(f"{session}.system.lever") == 1.0
+    assert browser.console_errors() == []
+    assert requested(browser) == [url]
+    (tmp_path / "board.png").write_bytes(browser.screenshot(platform))
 
 
 def test_controls_take_effect_and_continue_from_the_state(browser, tmp_path):

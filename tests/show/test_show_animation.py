@@ -157,3 +157,27 @@ def test_memory_does_not_grow_with_the_number_of_frames(tmp_path):
         peaks[speedup] = int(out.stdout.split()[-1]) * 1024
     held = 900 * 640 * 320 * 4  # the 900 extra frames, were they kept: 737 MB
     assert peaks[1.0] - peaks[10.0] < 0.05 * held
+
+
+def test_a_board_run_is_drawn_as_a_board(board_ds, recorded_ds, tmp_path):
+    """A board run: the board from the side on two cans (its colours), no disk; the
+    pendulums and the board move from frame to frame."""
+
+    def pixels(frame, rgb):
+        return int(np.count_nonzero(np.abs(frame.astype(int) - rgb).sum(axis=2) < 12))
+
+    wood, can, disk = (0xE8, 0xD9, 0xBF), (0xD9, 0xDD, 0xE3), (237, 237, 237)
+    for name, ds in (("board", board_ds), ("disk", recorded_ds)):
+        assert animate(ds, tmp_path / f"{name}.gif", fps=4.0, speedup=4.0, end=8.0, dpi=40) == 9
+    board, on_disk = gif_frames(tmp_path / "board.gif"), gif_frames(tmp_path / "disk.gif")
+    assert pixels(board[0], wood) > 100 and pixels(board[0], can) > 50
+    assert pixels(board[0], disk) < 20 < pixels(on_disk[0], disk)
+    assert pixels(on_disk[0], wood) == 0
+    moved = [
+        np.abs(a.astype(int) - b.astype(int)).sum()
+        for a, b in zip(board[:-1], board[1:], strict=True)
+    ]
+    assert min(moved) > 0
+    view = animation.BoardView(animation.RecordedRun.from_dataset(board_ds), 0.0, 8.0)
+    view.draw(5.0)
+    assert " cm" in view.clock.get_text() and "rad" not in view.clock.get_text()

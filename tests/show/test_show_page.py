@@ -147,3 +147,61 @@ def living_members(group: int) -> list[int]:
         if int(fields[2]) == group and fields[0] != "Z":
             found.append(int(entry))
     return found
+
+
+# -- a board run ---------------------------------------------------------------------
+
+
+def colour_pixels(png: bytes, rgb: tuple[int, int, int]) -> int:
+    """How many pixels of a screenshot have (nearly) the colour ``rgb``."""
+    import io
+
+    from PIL import Image
+
+    shot = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(int)
+    return int(np.count_nonzero(np.abs(shot - rgb).sum(axis=2) < 12))
+
+
+WOOD, CAN, DISK = (0xE8, 0xD9, 0xBF), (0xD9, 0xDD, 0xE3), (0xEE, 0xEE, 0xEE)  # the drawings'
+
+
+def test_a_board_run_sends_its_platform_and_mean_motion(board_ds, recorded_ds):
+    run = RecordedRun.from_dataset(board_ds)
+    data = page_data(run)
+    assert run.platform == data["platform"] == "board"
+    a, b = data["phi_trend"]
+    # The board about its mean motion: what is left has no drift and mean 0.
+    left = run.phi - (a + b * run.time)
+    assert abs(left.mean()) < 1e-12 and abs(np.polyfit(run.time, left, 1)[0]) < 1e-12
+    disk = page_data(RecordedRun.from_dataset(recorded_ds))
+    assert disk["platform"] == "disk" and disk["phi_trend"] is None
+
+
+def test_a_board_run_plays_as_a_board(board_ds, recorded_ds, tmp_path, browser):
+    """The board from the side on two cans, moving; a disk run still shows its disk."""
+    shots = {}
+    for name, ds in (("board", board_ds), ("disk", recorded_ds)):
+        path = write_page(ds, tmp_path / f"{name}.html")
+        browser.open_page(path.resolve().as_uri())
+        rect = browser.evaluate(
+            "(() => { const r = document.getElementById('disk').getBoundingClientRect();"
+            " return {x: r.x, y: r.y, width: r.width, height: r.height}; })()"
+        )
+        pictures = []
+        for seconds in (2.0, 4.0):
+            browser.evaluate(
+                f"(() => {{ const s = document.getElementById('seek'); s.value = {seconds};"
+                f" s.dispatchEvent(new Event('input')); }})()"
+            )
+            wait_for_frames(browser, 2)
+            assert browser.evaluate("window.metrosyncTime") == seconds
+            pictures.append(browser.screenshot(rect))
+        shots[name] = pictures
+        readout = browser.evaluate("document.getElementById('readout').textContent")
+        assert (" cm" in readout) == (name == "board") and ("rad" in readout) == (name == "disk")
+        assert browser.console_errors() == []
+    board, disk = shots["board"][0], shots["disk"][0]
+    assert colour_pixels(board, WOOD) > 300 and colour_pixels(board, CAN) > 300
+    assert colour_pixels(board, DISK) < 1000 < colour_pixels(disk, DISK)  # edges aside
+    assert colour_pixels(disk, WOOD) == 0
+    assert shots["board"][0] != shots["board"][1]  # the pendulums swing

@@ -24,3 +24,9 @@ def test_plot_run_draws_four_panels_and_marks_the_window(recorded_ds, tmp_path):
     path = tmp_path / "run.png"
     plot_run(recorded_ds, path, start=5.0, end=10.0)
     assert path.stat().st_size > 10_000
+
+
+def test_a_board_run_plots_the_board_position(board_ds):
+    fig = plot_run(board_ds, run=0)
+    assert fig.axes[2].get_ylabel() == "x (m)"
+    plt.close(fig)

@@ -13,8 +13,9 @@ def register(subparsers) -> None:
         "playground",
         help="write an offline HTML page that simulates live, with sliders and sound",
         description="Write one HTML file that runs the paper's model in the browser while "
-        "you watch: change N, BPM, the spread, the drive, the disk's inertia and friction, "
-        "or hold the disk, and see and hear the metronomes respond. The options set where "
+        "you watch: change N, BPM, the spread, the drive, the platform (the disk or a board "
+        "on rollers), the disk's inertia and friction or the board's mass and damping, or "
+        "hold the platform, and see and hear the metronomes respond. The options set where "
         "the page starts; every one can be changed on the page. It needs no server and no "
         "network.",
         formatter_class=HelpFormatter,

@@ -1,6 +1,7 @@
 """HTML, CSS and JavaScript of the playback page (see `metrosync.show.page`).
 
-``@TITLE@`` and ``@DATA@`` are replaced by the escaped title and the run's JSON.
+``@TITLE@`` and ``@DATA@`` are replaced by the escaped title and the run's JSON; a
+board run (``platform`` "board" in it) draws the board from the side instead of the disk.
 Nothing here loads from the network. After drawing each frame the page sets
 ``window.metrosyncFrame`` (frames drawn so far) and ``window.metrosyncTime`` (the
 simulated time shown, s), so that a test or a screen recorder can wait for frames
@@ -45,8 +46,9 @@ TEMPLATE = r"""<!DOCTYPE html>
   <canvas id="order" width="600" height="220" aria-label="order parameter r(t)"></canvas>
 </div>
 <p class="note">Disk seen from above: each pendulum swings along the rim; its bob is coloured
-by its phase. Phase wheel: each metronome's phase on the unit circle, the arrow is
-r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
+by its phase (on a board run, the board from the side on two rollers, drawn about its mean
+motion, each pendulum swinging along it). Phase wheel: each metronome's phase on the unit
+circle, the arrow is r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
 <script type="application/json" id="run-data">@DATA@</script>
 <script>
 "use strict";
@@ -62,6 +64,7 @@ r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
   const speedSelect = document.getElementById("speed");
   const readout = document.getElementById("readout");
   let t = D.start, playing = false, last = null;
+  if (D.platform === "board") disk.canvas.setAttribute("aria-label", "board seen from the side");
   seek.min = D.start; seek.max = D.end; seek.value = D.start;
 
   // Cubic Hermite interpolation between records, from values and derivatives.
@@ -130,6 +133,49 @@ r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
     disk.restore();
   }
 
+  // The board from the side on two rolling cans, the metronomes in a row on it, each
+  // rod (pivot to slider) swinging along it; in metres, as `animate`'s BoardView. It
+  // is drawn about its mean motion a + b t: an undamped board drifts steadily with the
+  // momentum of its start, which would take it out of view.
+  function drawBoard(st, time) {
+    const w = disk.canvas.width, h = disk.canvas.height, CAN = 0.033, THICK = 0.012;
+    const ROD = 0.08, PIVOT = 0.02, length = Math.max(0.09 * (N + 0.5), 10 * CAN);
+    const spacing = length / (N + 0.5), deck = 2 * CAN + THICK;
+    const scale = Math.min(0.8 * w / length, 0.8 * h / (deck + PIVOT + 1.3 * ROD));
+    const x = st.phi - (D.phi_trend[0] + D.phi_trend[1] * time), turn = x / (2 * CAN);
+    disk.clearRect(0, 0, w, h);
+    disk.save();
+    disk.translate(w / 2, 0.85 * h);
+    disk.scale(scale, -scale);  // y up, metres
+    disk.lineWidth = 1 / scale;
+    disk.strokeStyle = "#999";
+    disk.beginPath(); disk.moveTo(-w / scale, 0); disk.lineTo(w / scale, 0); disk.stroke();
+    for (const side of [-1, 1]) {
+      const cx = side * 0.3 * length + x / 2;  // rolling: half the board's travel
+      disk.fillStyle = "#d9dde3"; disk.strokeStyle = "#777";
+      disk.beginPath(); disk.arc(cx, CAN, CAN, 0, 2 * Math.PI); disk.fill(); disk.stroke();
+      disk.beginPath();
+      disk.moveTo(cx - CAN * Math.cos(turn), CAN + CAN * Math.sin(turn));
+      disk.lineTo(cx + CAN * Math.cos(turn), CAN - CAN * Math.sin(turn));
+      disk.stroke();
+    }
+    disk.fillStyle = "#e8d9bf"; disk.strokeStyle = "#9a8a70";
+    disk.fillRect(x - length / 2, 2 * CAN, length, THICK);
+    disk.strokeRect(x - length / 2, 2 * CAN, length, THICK);
+    for (let i = 0; i < N; i++) {
+      const px = x + (i - (N - 1) / 2) * spacing, py = deck + PIVOT;
+      // θ > 0 carries the centre of mass (below the pivot) along +x, the slider back.
+      const bx = px - ROD * Math.sin(st.theta[i]), by = py + ROD * Math.cos(st.theta[i]);
+      disk.fillStyle = "#777"; disk.fillRect(px - 0.006, deck, 0.012, PIVOT);
+      disk.strokeStyle = "#333"; disk.lineWidth = 2 / scale;
+      disk.beginPath(); disk.moveTo(px, py); disk.lineTo(bx, by); disk.stroke();
+      disk.lineWidth = 1 / scale;
+      disk.fillStyle = colour(st.phase[i]); disk.strokeStyle = "#333";
+      disk.beginPath(); disk.arc(bx, by, 7 / scale, 0, 2 * Math.PI); disk.fill(); disk.stroke();
+    }
+    disk.restore();
+  }
+
   function drawWheel(st) {
     const w = wheel.canvas.width, h = wheel.canvas.height, R = 0.4 * Math.min(w, h);
     wheel.clearRect(0, 0, w, h);
@@ -191,10 +237,12 @@ r e<sup>iψ</sup>. Click r(t) to seek; space bar plays and pauses.</p>
 
   function render() {
     const st = state(t);
-    drawDisk(st); drawWheel(st); drawOrder();
+    if (D.platform === "board") drawBoard(st, t); else drawDisk(st);
+    drawWheel(st); drawOrder();
     seek.value = t;
-    readout.textContent = "t = " + t.toFixed(2) + " s   r = " + st.r.toFixed(3)
-      + "   φ = " + st.phi.toFixed(3) + " rad";
+    readout.textContent = "t = " + t.toFixed(2) + " s   r = " + st.r.toFixed(3) + (D.platform
+      === "board" ? "   x = " + (100 * st.phi).toFixed(2) + " cm" : "   φ = " + st.phi.toFixed(3)
+      + " rad");
     window.metrosyncTime = t;
     window.metrosyncFrame = (window.metrosyncFrame || 0) + 1;
   }

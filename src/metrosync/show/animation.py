@@ -1,10 +1,13 @@
-"""Watch a run: the disk seen from above, beside r(t), as a GIF or an MP4.
+"""Watch a run: the disk seen from above (or the board on rollers from the side), beside
+r(t), as a GIF or an MP4.
 
 Each frame shows the disk turned by φ, every metronome as a box on the rim, and its
 pendulum seen from above: a rod along the rim's tangent (the plane it swings in)
 whose visible length is proportional to sin θ_i, with a bob coloured by the
 metronome's phase atan2(−θ̇/ω, θ) on a cyclic colour map. Synchronized metronomes
-share a colour. Beside it, r(t) of the run with the equilibrium window shaded and a
+share a colour. On a board run (the dataset's ``platform`` attribute) the frame shows
+instead the board from the side on its two rollers, the pendulums swinging along it
+(`BoardView`). Beside it, r(t) of the run with the equilibrium window shaded and a
 cursor at the frame's time.
 
 Frame k shows simulated time start + k·speedup/fps, so an animation of [start, end]
@@ -145,18 +148,10 @@ class DiskView:
         self.run = run
         self.fig = Figure(figsize=size, layout="constrained")
         disk_ax, order_ax = self.fig.subplots(1, 2, width_ratios=(1, 1.25))
-        radius = run.radius
-        reach = radius * (1 + 1.6 * ROD_SCALE)
-        disk_ax.set_xlim(-reach, reach)
-        disk_ax.set_ylim(-reach, reach)
         disk_ax.set_aspect("equal")
         disk_ax.set_axis_off()
-        disk_ax.add_patch(Circle((0, 0), radius, facecolor="0.93", edgecolor="0.55", lw=1.2))
-        self.spokes = LineCollection([], colors="0.75", lw=0.8)
-        self.guides = LineCollection([], colors="0.82", lw=0.8)
+        platform = self._setup_platform(disk_ax)
         self.rods = LineCollection([], colors="0.25", lw=1.6)
-        disk_ax.add_collection(self.spokes)
-        disk_ax.add_collection(self.guides)
         disk_ax.add_collection(self.rods)
         self.boxes = disk_ax.scatter(np.zeros(run.n), np.zeros(run.n), s=40, marker="s",
                                      c="0.45", zorder=3)  # fmt: skip
@@ -184,8 +179,22 @@ class DiskView:
         title = f"N = {run.n}, {a.get('bpm', '?')} BPM, σ = {a.get('sigma_bpm', '?')} BPM"
         order_ax.set_title(f"{title}, run {run.run}", fontsize=9)
         self.cursor = order_ax.axvline(start, color="C3", lw=1.2)
-        self.moving = (self.spokes, self.guides, self.rods, self.boxes, self.bobs, self.cursor)
+        self.moving = (*platform, self.rods, self.boxes, self.bobs, self.cursor)
         self._background = None
+
+    def _setup_platform(self, ax) -> tuple:
+        """Draw the platform's still parts on ``ax``; returns the artists that move
+        with it (besides rods, boxes and bobs)."""
+        radius = self.run.radius
+        reach = radius * (1 + 1.6 * ROD_SCALE)
+        ax.set_xlim(-reach, reach)
+        ax.set_ylim(-reach, reach)
+        ax.add_patch(Circle((0, 0), radius, facecolor="0.93", edgecolor="0.55", lw=1.2))
+        self.spokes = LineCollection([], colors="0.75", lw=0.8)
+        self.guides = LineCollection([], colors="0.82", lw=0.8)
+        ax.add_collection(self.spokes)
+        ax.add_collection(self.guides)
+        return self.spokes, self.guides
 
     def render(self, t: float, dpi: float) -> Image.Image:
         """The frame at simulated time ``t``, an RGB image.
@@ -228,6 +237,19 @@ class DiskView:
         theta = run.theta_at(times)[0]
         phase = run.phase_at(times)[0]
         phi = float(run.phi_at(times)[0])
+        self._move_platform(t, theta, phi)
+        self.bobs.set_array(phase)
+        r_now = float(run.r_at(times)[0])
+        self.clock.set_text(f"t = {t:6.1f} s   r = {r_now:.2f}   {self._position(phi)}")
+        self.cursor.set_xdata([t, t])
+
+    @staticmethod
+    def _position(phi: float) -> str:
+        return f"φ = {phi:+.2f} rad"
+
+    def _move_platform(self, t: float, theta: np.ndarray, phi: float) -> None:
+        """Turn the disk by φ and set each pendulum on it at angle θ."""
+        run = self.run
         angle = run.rim_angles + phi
         radial = np.stack([np.cos(angle), np.sin(angle)], axis=-1)
         tangent = np.stack([-np.sin(angle), np.cos(angle)], axis=-1)
@@ -243,10 +265,65 @@ class DiskView:
         self.rods.set_segments([[p, q] for p, q in zip(pivot, tip, strict=True)])
         self.boxes.set_offsets(pivot)
         self.bobs.set_offsets(tip)
-        self.bobs.set_array(phase)
-        r_now = float(run.r_at(times)[0])
-        self.clock.set_text(f"t = {t:6.1f} s   r = {r_now:.2f}   φ = {phi:+.2f} rad")
-        self.cursor.set_xdata([t, t])
+
+
+class BoardView(DiskView):
+    """A board on rollers seen from the side (Pantaleone 2002), in metres: the
+    metronomes stand in a row on it, each pendulum's rod (pivot to slider) swinging
+    along the board. The board is drawn about its mean motion (`RecordedRun.
+    board_offset_at`), so that a drifting undamped board stays in view; the cans
+    under it roll without slipping, moving half as far and turning by x/(2a)."""
+
+    #: A 12 fl. oz can's radius, the board's thickness, the rod drawn above the pivot,
+    #: the pivot's height above the board, m (drawing sizes, not model parameters).
+    CAN, THICK, ROD, PIVOT = 0.033, 0.012, 0.08, 0.02
+
+    def _setup_platform(self, ax) -> tuple:
+        from matplotlib.patches import Rectangle
+
+        n = self.run.n
+        self.length = max(0.09 * (n + 0.5), 10 * self.CAN)
+        self.spacing = self.length / (n + 0.5)
+        self.deck = 2 * self.CAN + self.THICK  # the board's top
+        reach = 0.62 * self.length
+        ax.set_xlim(-reach, reach)
+        ax.set_ylim(-0.01, self.deck + self.PIVOT + 1.6 * self.ROD)
+        ax.axhline(0.0, color="0.6", lw=1)
+        self.board = Rectangle((-self.length / 2, 2 * self.CAN), self.length, self.THICK,
+                               facecolor="#e8d9bf", edgecolor="#9a8a70", lw=1)  # fmt: skip
+        ax.add_patch(self.board)
+        self.cans = [Circle((0, self.CAN), self.CAN, facecolor="#d9dde3", edgecolor="0.45",
+                            lw=1) for _ in range(2)]  # fmt: skip
+        for can in self.cans:
+            ax.add_patch(can)
+        self.can_marks = LineCollection([], colors="0.45", lw=0.8)
+        ax.add_collection(self.can_marks)
+        return self.board, *self.cans, self.can_marks
+
+    @staticmethod
+    def _position(phi: float) -> str:
+        return f"x = {100 * phi:+.2f} cm"
+
+    def _move_platform(self, t: float, theta: np.ndarray, phi: float) -> None:
+        x = float(self.run.board_offset_at(np.array([t]))[0])
+        self.board.set_x(x - self.length / 2)
+        marks, turn = [], x / (2 * self.CAN)
+        for side, can in zip((-1, 1), self.cans, strict=True):
+            centre = np.array([side * 0.3 * self.length + x / 2, self.CAN])
+            can.set_center(centre)
+            # turning clockwise as it rolls to +x
+            u = self.CAN * np.array([np.cos(-turn), np.sin(-turn)])
+            marks.append([centre - u, centre + u])
+        self.can_marks.set_segments(marks)
+        n = self.run.n
+        pivot = np.stack([x + (np.arange(n) - (n - 1) / 2) * self.spacing,
+                          np.full(n, self.deck + self.PIVOT)], axis=-1)  # fmt: skip
+        # θ > 0 moves the centre of mass (below the pivot) along +x: the rod's top, the
+        # slider, the other way.
+        tip = pivot + self.ROD * np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+        self.rods.set_segments([[p, q] for p, q in zip(pivot, tip, strict=True)])
+        self.boxes.set_offsets(pivot - [0.0, 0.5 * self.PIVOT])
+        self.bobs.set_offsets(tip)
 
 
 def animate(
@@ -290,7 +367,8 @@ def animate(
                                   path=path)  # fmt: skip
     budget.check()
     times = frame_times(start, end, fps, speedup)
-    view = DiskView(recorded, start, end, size=size)
+    view = (BoardView if recorded.platform == "board" else DiskView)(recorded, start, end,
+                                                                      size=size)  # fmt: skip
     width, height = frame_pixels(dpi, size)
     show = sys.stderr.isatty() if progress is None else progress
     with progress_bar(total=times.size, unit="frame", enabled=show, desc="animate") as bar:

@@ -2,7 +2,8 @@
 
 The page holds its CSS and JavaScript inline and the run's data as JSON in a
 ``<script type="application/json">`` element, so it opens from the file system with
-no server and no network. It shows the disk seen from above (as in `animate`), r(t)
+no server and no network. It shows the disk seen from above (as in `animate`; on a
+board run, the board from the side on its two rollers, drawn about its mean motion), r(t)
 with a cursor (click it to seek), and a phase wheel: each metronome's phase as a dot
 on the unit circle, with the order parameter r e^{iψ} as an arrow. Controls: play /
 pause (space bar), a seek slider, and the playback speed.
@@ -67,6 +68,9 @@ def page_data(run: RecordedRun, *, start=None, end=None, max_rate: float = 50.0)
         f"run {run.run}",
         "n": run.n,
         "radius": run.radius,
+        "platform": run.platform,
+        # The board is drawn about its mean motion, φ − (a + b t) (`RecordedRun.phi_trend`).
+        "phi_trend": list(run.phi_trend) if run.platform == "board" else None,
         "t0": float(run.time[index[0]]),
         "dt": float(run.record_interval * stride),
         "count": int(index.size),

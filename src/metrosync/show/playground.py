@@ -15,8 +15,9 @@ the browser's physics with `metrosync.simulate(..., backend="numpy")`.
 
 The page loads nothing: CSS and scripts are inline, the sound is synthesised, and it
 opens from the file system with no server and no network. Controls: N, nominal BPM,
-σ, two frequency groups, the drive M, the disk's inertia and friction, holding the
-disk, restart, pause and speed (1×–50×). The control ranges are `LIMITS`.
+σ, two frequency groups, the drive M, the platform (the disk or the board on rollers),
+the disk's inertia and friction or the board's mass and damping, holding the platform,
+restart, pause and speed (1×–50×). The control ranges are `LIMITS`.
 """
 
 from __future__ import annotations
@@ -38,8 +39,9 @@ from ..model import PRESETS, ModelParameters, get_preset
 SCRIPTS = ("physics.js", "session.js", "view.js", "audio.js", "app.js")
 
 #: Ranges of the page's controls: N, σ (BPM), speed (× real time), the second group's
-#: offset (BPM), and the log-scale sliders for M (N m s), c_φ (kg m²/s) and J (kg m²).
-#: M and c_φ also reach 0.
+#: offset (BPM), and the log-scale sliders for M (N m s), the disk's c_φ (kg m²/s) and
+#: J (kg m²), and the board's mass (kg) and damping (kg/s). M, c_φ and the board's
+#: damping also reach 0.
 LIMITS = {
     "n": (1, 100),
     "sigma_bpm": (0.0, 10.0),
@@ -48,13 +50,23 @@ LIMITS = {
     "drive": (1e-6, 1e-3),
     "c_phi": (1e-7, 1e-1),
     "inertia": (1e-3, 1e2),
+    # From a few grams (Pantaleone's board is 58 g) to a heavy table top; a wet
+    # table's damping, tens of kg/s, is inside.
+    "board_mass": (1e-3, 1e2),
+    "board_damping": (1e-4, 1e2),
 }
+#: The sliders that may also stand at 0.
+_ZERO_ALLOWED = ("drive", "c_phi", "board_damping")
 #: The finest time step offered: finer ones cannot keep up with 50× real time at N = 100.
 MIN_DT = 1e-3
 #: A period must span at least this many steps (as `metrosync.ensemble.check_time_step`).
 MIN_STEPS_PER_PERIOD = 10
 #: |θ| beyond which the page reports an overturned pendulum, rad (as `simulate`).
 OVERTURN_ANGLE = math.pi / 2
+#: The most a step may be of the platform's damping time, rate × dt: the step takes
+#: the damping force explicitly and diverges beyond about 1.2 (a wet table's board,
+#: 100 kg/s, needs dt = 0.001 s).
+MAX_DAMPING_PER_STEP = 1.0
 
 
 def preset_data(params: ModelParameters) -> dict:
@@ -135,10 +147,12 @@ def playground_config(
         )
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**32:
         raise ParameterError(f"`seed` must be an integer in [0, 2**32), got {describe(seed)}.")
+    _check_damping_step(params, n, float(bpm), float(dt))
     return {
         "version": __version__,
         "dt": float(dt),
         "overturn_angle": OVERTURN_ANGLE,
+        "max_damping_per_step": MAX_DAMPING_PER_STEP,
         "presets": presets,
         "start": {
             "preset": params.name,
@@ -198,13 +212,56 @@ def _check_ranges(params: ModelParameters) -> None:
             "`w2` = 0: the playground tunes each metronome by its sliding weight, and there "
             "is none; give `w2` > 0 kg."
         )
-    values = {"drive": params.metronome.drive, "c_phi": params.platform.c_phi}
-    if params.platform.inertia is not None and not params.platform.rigid:
-        values["inertia"] = params.platform.inertia
+    platform = params.platform
+    values = {"drive": params.metronome.drive}
+    if platform.platform == "board":  # the disk's own values are then unused defaults
+        values.update(board_mass=platform.board_mass, board_damping=platform.board_damping)
+    else:
+        values["c_phi"] = platform.c_phi
+        if platform.inertia is not None and not platform.rigid:
+            values["inertia"] = platform.inertia
     for name, value in values.items():
         lo, hi = LIMITS[name]
-        if value != 0 and not lo <= value <= hi:
+        zero = name in _ZERO_ALLOWED
+        if not (zero and value == 0) and not lo <= value <= hi:
             raise ParameterError(
                 f"`{name}` = {value!r} is outside the playground's slider range "
-                f"[{lo:g}, {hi:g}]{'' if name == 'inertia' else ' (or 0)'}; choose a value in it."
+                f"[{lo:g}, {hi:g}]{' (or 0)' if zero else ''}; choose a value in it."
             )
+
+
+def damping_rate(params: ModelParameters, n: int, bpm: float) -> float:
+    """The platform's viscous damping rate c/D₀, 1/s, for ``n`` metronomes tuned to
+    ``bpm`` (D₀ the coefficient of φ̈ in eq. (eqm1) with the pendulums hanging); 0 for a
+    held disk. The page computes the same (`Physics.buildSystem`'s ``dampingRate``)."""
+    import numpy as np
+
+    from ..model.system import system_arrays
+    from ..model.tuning import l2_for_bpm
+
+    if params.platform.rigid:
+        return 0.0
+    design = params.metronome
+    l2 = np.full((1, n), l2_for_bpm(design, bpm, tuning=design.tuning))
+    system, _ = system_arrays(params, l2)
+    d0 = system.total_inertia - system.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
+    return float(system.c_phi[0] / d0[0])
+
+
+def _check_damping_step(params: ModelParameters, n: int, bpm: float, dt: float) -> None:
+    """Refuse a start whose platform damping the step cannot follow (it would diverge)."""
+    rate = damping_rate(params, n, bpm)
+    if rate * dt <= MAX_DAMPING_PER_STEP:
+        return
+    board = params.platform.platform == "board"
+    name, unit = ("board_damping", "kg/s") if board else ("c_phi", "kg m²/s")
+    value = getattr(params.platform, name)
+    fixes = f"lower it to at most {value * MAX_DAMPING_PER_STEP / (rate * dt):.3g} {unit}"
+    finer = MAX_DAMPING_PER_STEP / rate
+    if finer >= MIN_DT:
+        fixes += f", or give `dt` <= {finer:.3g} s"
+    raise ParameterError(
+        f"`{name}` = {value!r} {unit} damps the {'board' if board else 'disk'} at {rate:.3g} /s, "
+        f"too fast for the step `dt` = {dt:g} s (the page's step needs rate x dt <= "
+        f"{MAX_DAMPING_PER_STEP:g}, or it diverges): {fixes}."
+    )

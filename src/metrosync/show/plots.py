@@ -55,10 +55,10 @@ def plot_phase_differences(run: RecordedRun, ax, *, start=None, end=None) -> Non
 
 
 def plot_disk_angle(run: RecordedRun, ax, *, start=None, end=None) -> None:
-    """The disk angle φ(t), rad."""
+    """The disk angle φ(t), rad, or on a board run the board's position, m."""
     keep = _keep(run, start, end)
     ax.plot(run.time[keep], run.phi[keep], lw=0.8, color="0.2")
-    ax.set_ylabel("φ (rad)")
+    ax.set_ylabel("x (m)" if run.platform == "board" else "φ (rad)")
 
 
 def plot_run_order(run: RecordedRun, ax, *, start=None, end=None) -> None:

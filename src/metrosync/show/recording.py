@@ -7,7 +7,9 @@ polynomials that use the recorded velocities θ̇ and φ̇, which keeps a pendul
 swing smooth even when records are several steps apart.
 
 Geometry (a display convention; the equations do not depend on it): metronome i sits
-on the rim at angle α_i = 2π i / N from the x axis, and the disk turns by φ.
+on the rim at angle α_i = 2π i / N from the x axis, and the disk turns by φ. On the
+board (``platform == "board"``, the dataset's attribute) the metronomes stand in a row
+along it and φ is the board's position, m.
 """
 
 from __future__ import annotations
@@ -31,11 +33,12 @@ class RecordedRun:
 
     time : (T,) record times, s.
     theta, theta_dot : (T, N) pendulum angles (rad) and velocities (rad/s).
-    phi, phi_dot : (T,) disk angle (rad) and velocity (rad/s).
+    phi, phi_dot : (T,) disk angle (rad) and velocity (rad/s), or on the board its
+        position (m) and velocity (m/s).
     r : (T,) analytic-phase order parameter.
     r_crossing : (T,) crossing-phase order parameter (NaN where undefined).
     omega : (N,) natural angular frequencies, rad/s (ω = π·BPM/60).
-    radius : disk radius, m.
+    radius : disk radius, m (the dataset's; the default disk's on the board).
     step : integration time step dt, s.
     equilibrium_window : length of the final window that r_eq averages, s.
     r_eq : equilibrium r of this run (crossing phases), NaN if undefined.
@@ -43,6 +46,8 @@ class RecordedRun:
     attrs : the dataset's attributes.
     escapement_offset : (N,) angle δ_i at which each metronome's escapement acts, rad;
         None for 0, the vertical (see `tick_angles`).
+    platform : ``"disk"`` or ``"board"`` (the dataset's ``platform`` attribute; a
+        dataset from before the board has none and is the disk's).
     """
 
     time: np.ndarray
@@ -60,6 +65,7 @@ class RecordedRun:
     run: int
     attrs: dict
     escapement_offset: np.ndarray | None = None
+    platform: str = "disk"
 
     @classmethod
     def from_dataset(cls, ds, run: int = 0) -> RecordedRun:
@@ -109,6 +115,7 @@ class RecordedRun:
             run=run,
             attrs=dict(ds.attrs),
             escapement_offset=_escapement_offset(ds, sel),
+            platform=str(ds.attrs.get("platform", "disk")),
         )
 
     @property
@@ -160,6 +167,22 @@ class RecordedRun:
     def phase_at(self, times) -> np.ndarray:
         """(K, N) analytic phase atan2(−θ̇/ω, θ) at ``times``, rad in (−π, π]."""
         return np.arctan2(-self.theta_dot_at(times) / self.omega, self.theta_at(times))
+
+    @property
+    def phi_trend(self) -> tuple[float, float]:
+        """(a, b) of the straight line a + b t fitted to φ(t) over the recording: the
+        board's mean motion. Without damping the board keeps the momentum its start
+        gave it and drifts at a steady speed; drawn about this line it stays in view."""
+        if self.time.size < 2:
+            return float(self.phi[0]), 0.0
+        slope, intercept = np.polyfit(self.time - self.time[0], self.phi, 1)
+        return float(intercept - slope * self.time[0]), float(slope)
+
+    def board_offset_at(self, times) -> np.ndarray:
+        """(K,) φ less its mean motion (`phi_trend`) at ``times``: where to draw the board."""
+        a, b = self.phi_trend
+        times = np.asarray(times, dtype=float)
+        return self.phi_at(times) - (a + b * times)
 
     def r_at(self, times) -> np.ndarray:
         """(K,) recorded r at ``times`` (linear interpolation)."""

@@ -34,6 +34,8 @@
   const drive = logSlider("drive", limits.drive, true);
   const cphi = logSlider("cphi", limits.c_phi, true);
   const inertia = logSlider("inertia", limits.inertia, false);
+  const boardMass = logSlider("boardmass", limits.board_mass, false);
+  const boardDamping = logSlider("boarddamping", limits.board_damping, true);
   const sci = (v) => (v === 0 ? "0" : v.toExponential(1));
 
   function setRange(id, [low, high], value) {
@@ -54,6 +56,8 @@
     $("hold").checked = s.hold;
     $("jlaw").checked = s.jLaw;
     drive.set(s.drive); cphi.set(s.cPhi); inertia.set(s.j);
+    boardMass.set(s.boardMass); boardDamping.set(s.boardDamping);
+    showPlatform();
     // The steady-swing tuning's spline is the preset's drive's: M stays as tuned.
     const steady = session.constants.tuning === "steady-swing";
     $("drive").disabled = steady;
@@ -71,7 +75,18 @@
     $("drive-out").textContent = sci(s.drive);
     $("cphi-out").textContent = sci(s.cPhi);
     $("inertia-out").textContent = s.j.toPrecision(3);
+    $("boardmass-out").textContent = s.boardMass.toPrecision(3);
+    $("boarddamping-out").textContent = sci(s.boardDamping);
     if (s.jLaw) inertia.set(s.j);  // the law moves J with N
+  }
+
+  // The chosen platform's own controls show; the other's hide.
+  function showPlatform() {
+    const board = session.settings.platform === "board";
+    $("platform").value = session.settings.platform;
+    $("disk-controls").hidden = board;
+    $("board-controls").hidden = !board;
+    $("platform-name").textContent = board ? "a board on rollers" : "a rotating disk";
   }
 
   for (const name of Object.keys(config.presets)) {
@@ -104,6 +119,11 @@
     () => "J=" + s.j.toPrecision(2));
   onChange("jlaw", (el) => { s.jLaw = el.checked; }, () => (s.jLaw ? "J(N)" : "J fixed"));
   onChange("hold", (el) => { s.hold = el.checked; }, () => (s.hold ? "held" : "free"));
+  onChange("boardmass", () => { s.boardMass = boardMass.get(); },
+    () => "m_b=" + s.boardMass.toPrecision(2));
+  onChange("boarddamping", () => { s.boardDamping = boardDamping.get(); },
+    () => "c_b=" + sci(s.boardDamping));
+  onChange("platform", (el) => { s.platform = el.value; showPlatform(); }, () => s.platform);
   $("preset").addEventListener("input", () => { session.usePreset($("preset").value); showSettings(); });
   $("speed").addEventListener("input", showValues);
   $("mute").addEventListener("input", () => { clicks.muted = $("mute").checked; });
@@ -145,6 +165,15 @@
     const notes = [];
     if (st.status & Physics.STATUS_DIVERGED) notes.push("the run diverged: press Restart.");
     if (st.status & Physics.STATUS_OVERTURNED) notes.push("a pendulum swung past the horizontal.");
+    const rate = session.system.dampingRate, limit = config.max_damping_per_step;
+    if (rate * session.dt > limit) {
+      // As playground_config refuses such a start: the step cannot follow the damping.
+      const board = session.settings.platform === "board";
+      const value = board ? session.settings.boardDamping : session.settings.cPhi;
+      notes.push((board ? "The board's damping " : "The disk's friction c_φ ") + sci(value)
+        + " damps it at " + rate.toPrecision(3) + " /s, too fast for the step " + session.dt
+        + " s: lower it to at most " + sci(value * limit / (rate * session.dt)) + ".");
+    }
     if (session.clipped) notes.push(session.clipped + " of " + n + " frequencies clipped to the "
       + "tunable range.");
     const terms = modelTerms(session.constants);
@@ -152,15 +181,23 @@
     $("status").textContent = notes.join(" ");
   }
 
-  // The model's terms beyond the paper that the preset switches on, in words.
+  // The model's terms beyond the paper that the preset switches on, in words; on the
+  // board only the board's own (it reads none of the disk's fields).
   function modelTerms(c) {
-    const terms = [];
+    const terms = [], board = c.platform === "board";
+    if (board) terms.push("the board on rollers (Pantaleone 2002)");
     if (c.forcing_amplitude) {
-      terms.push("forcing " + sci(c.forcing_amplitude) + " N m at " + c.forcing_bpm + " BPM");
+      terms.push((board ? "forcing " + sci(c.forcing_amplitude) + " N"
+        : "forcing " + sci(c.forcing_amplitude) + " N m") + " at " + c.forcing_bpm + " BPM");
     }
     if (c.escapement_offset) terms.push("escapement at δ = " + c.escapement_offset + " rad");
-    if (!c.escapement_reaction) terms.push("no escapement reaction on the disk");
-    if (c.disk_dry_friction) terms.push("dry friction " + sci(c.disk_dry_friction) + " N m");
+    if (!board && !c.escapement_reaction) terms.push("no escapement reaction on the disk");
+    if (!board && c.disk_dry_friction) {
+      terms.push("dry friction " + sci(c.disk_dry_friction) + " N m");
+    }
+    if (board && c.board_dry_friction) {
+      terms.push("dry friction " + sci(c.board_dry_friction) + " N");
+    }
     if (c.tuning === "steady-swing") terms.push("steady-swing tuning");
     return terms;
   }
@@ -204,7 +241,8 @@
         ticks = ticks.concat(session.ticks);
         if (session.state.status & Physics.STATUS_DIVERGED) break;
       }
-      clicks.play(ticks, before, speed, session.state.n, session.state.phi);
+      const onBoard = session.settings.platform === "board";
+      clicks.play(ticks, before, speed, session.state.n, onBoard ? null : session.state.phi);
       achievedSim += session.t - before;
       achievedWall += wall;
       if (achievedWall >= 0.5) {
@@ -214,7 +252,8 @@
     }
     for (const g of Object.values(graphics)) fit(g.canvas);
     const o = Physics.order(session.state, session.system, phases);
-    View.disk(graphics.disk, session, phases, session.settings.hold);
+    const platformView = session.settings.platform === "board" ? View.board : View.disk;
+    platformView(graphics.disk, session, phases, session.settings.hold);
     View.wheel(graphics.wheel, phases, session.state.n, o.r, o.psi);
     View.side(graphics.side, session, phases, 4);
     const speed = Number($("speed").value);

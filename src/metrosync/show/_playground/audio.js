@@ -57,7 +57,10 @@ class Clicks {
       let node = level;
       if (ctx.createStereoPanner) {
         const pan = ctx.createStereoPanner();
-        pan.pan.value = Math.cos(2 * Math.PI * i / n + phi);
+        // Where the metronome stands: round the disk, or (phi null) left to right
+        // along the board.
+        pan.pan.value = phi === null ? (n > 1 ? 2 * i / (n - 1) - 1 : 0)
+          : Math.cos(2 * Math.PI * i / n + phi);
         level.connect(pan);
         node = pan;
       }

@@ -7,8 +7,11 @@
 // the steady-swing tuning (theory/tuning.py) the same inversion of BPM/ρ(L2), iterated,
 // with the per-design spline ρ(L2) that the package sends.
 // Equations (equations.py): the solved form (eqm1)-(eqm2) with the sums A, B, C, D,
-// the disk's torque −c_φ φ̇ − r Σ𝕄 + A sin(Ω t) (r = 1 with the escapement's reaction
-// on the disk, 0 without) and its dry friction F_d (at most T).
+// the platform's force −c_φ φ̇ − r Σ𝕄 + A sin(Ω t) (r = 1 with the escapement's
+// reaction on the disk, 0 without and always on the board) and its dry friction F_d
+// (at most T). The disk and the board (Pantaleone 2002) are one coordinate φ with the
+// same equations, written with the lever ℓ (R, or 1 m) and J_p (platformTerms): the
+// R below is ℓ, J is J_p.
 // Scheme (integrators/verlet.py), per step of length dt:
 //   1. θ' = θ + θ̇ dt + a dt²/2
 //   2. kick 𝕄_i = +M/dt if θ_i < δ < θ_i', −M/dt if θ_i > δ > θ_i', else 0
@@ -82,21 +85,40 @@ const Physics = (function () {
     return 2.0 * drive / (Math.PI * cTheta);
   }
 
-  // Per-metronome and disk constants (ensemble.build_ensemble, one run).
+  // The platform's constants (model/platform.py, Platform.terms): the lever ℓ (the
+  // disk's R, or 1 m for the board), its own inertia J_p (the disk's J(N) law or fixed
+  // J, kg m²; the board's mass with the rollers' and the N cases', kg), its damping and
+  // dry friction, and whether the escapement's reaction acts on it (never on the
+  // board). Everything after this reads only these, so the board runs the disk's step.
+  function platformTerms(c, n) {
+    if (c.platform === "board") {
+      return {
+        lever: 1.0, own: c.board_mass + c.roller_mass + n * c.box_mass,
+        damping: c.board_damping, dryFriction: c.board_dry_friction, reaction: 0.0,
+      };
+    }
+    return {
+      lever: c.radius, own: c.inertia === null ? c.j0 + n * c.j_per_metronome : c.inertia,
+      damping: c.c_phi, dryFriction: c.disk_dry_friction,
+      reaction: c.escapement_reaction ? 1.0 : 0.0,
+    };
+  }
+
+  // Per-metronome and platform constants (model/system.py's system_arrays, one run).
   // c: the model's constants (metronome design and platform fields by name);
-  // freqs: natural frequencies, BPM; hold: pin the disk (J = ∞).
+  // freqs: natural frequencies, BPM; hold: pin the platform (J_p = ∞).
   function buildSystem(c, freqs, hold) {
-    const n = freqs.length;
+    const n = freqs.length, terms = platformTerms(c, n);
     const sys = {
       n, l2: new Float64Array(n), mh: new Float64Array(n), mgh: new Float64Array(n),
       inertia: new Float64Array(n), cTheta: new Float64Array(n), drive: new Float64Array(n),
-      omega: new Float64Array(n), offset: new Float64Array(n), radius: c.radius, cPhi: c.c_phi,
-      totalInertia: 0.0, diskInertia: 0.0,
+      omega: new Float64Array(n), offset: new Float64Array(n), lever: terms.lever,
+      cPhi: terms.damping, totalInertia: 0.0, ownInertia: terms.own,
       forcingAmplitude: c.forcing_amplitude, forcingOmega: Math.PI * c.forcing_bpm / 60.0,
-      reaction: c.escapement_reaction ? 1.0 : 0.0, dryFriction: c.disk_dry_friction,
+      reaction: terms.reaction, dryFriction: terms.dryFriction,
     };
     const mass = c.w1 + c.w2;
-    let massSum = 0.0;
+    let massSum = 0.0, hanging = 0.0;
     for (let i = 0; i < n; i++) {
       const l2 = l2ForBpm(c, freqs[i]);
       const h = (c.w1 * c.l1 - c.w2 * l2) / mass;
@@ -110,9 +132,13 @@ const Physics = (function () {
       sys.drive[i] = c.drive;
       sys.offset[i] = c.escapement_offset;
       massSum += mass;
+      hanging += sys.mh[i] * sys.mh[i] / sys.inertia[i];
     }
-    sys.diskInertia = c.inertia === null ? c.j0 + n * c.j_per_metronome : c.inertia;
-    sys.totalInertia = hold ? Infinity : sys.diskInertia + (c.radius * c.radius) * massSum;
+    sys.totalInertia = hold ? Infinity : sys.ownInertia + (terms.lever * terms.lever) * massSum;
+    // The damping rate c/D₀ (D₀: eq. (eqm1)'s denominator, pendulums hanging), which the
+    // step must resolve (playground.damping_rate); 0 for a held platform.
+    sys.dampingRate = hold ? 0.0
+      : sys.cPhi / (sys.totalInertia - (terms.lever * terms.lever) * hanging);
     return sys;
   }
 
@@ -133,23 +159,23 @@ const Physics = (function () {
   // Numerator without dry friction and denominator D of eq. (eqm1) (equations.
   // _disk_equation); cos θ and sin θ are left in cosOut and sinOut.
   function diskEquation(sys, th, thd, phd, kick, t, cosOut, sinOut) {
-    const n = sys.n, radius = sys.radius;
+    const n = sys.n, lever = sys.lever;
     let sum1 = 0.0, sumKick = 0.0, sumAbc = 0.0, sumD = 0.0;
     for (let i = 0; i < n; i++) {
       const s = Math.sin(th[i]), co = Math.cos(th[i]);
       cosOut[i] = co;
       sinOut[i] = s;
       const mhOverI = sys.mh[i] / sys.inertia[i];
-      const a = radius * mhOverI * sys.mgh[i] * s * co;
-      const b = radius * mhOverI * sys.cTheta[i] * thd[i] * co;
-      const cc = radius * mhOverI * kick[i] * co;
-      const rm = radius * sys.mh[i];
+      const a = lever * mhOverI * sys.mgh[i] * s * co;
+      const b = lever * mhOverI * sys.cTheta[i] * thd[i] * co;
+      const cc = lever * mhOverI * kick[i] * co;
+      const rm = lever * sys.mh[i];
       sumD += rm * rm / sys.inertia[i] * (co * co);
       sum1 += sys.mh[i] * (thd[i] * thd[i]) * s;
       sumKick += kick[i];
       sumAbc += a + b - cc;
     }
-    const numerator = radius * sum1 + diskTorque(sys, phd, sumKick, t) + sumAbc;
+    const numerator = lever * sum1 + diskTorque(sys, phd, sumKick, t) + sumAbc;
     return { numerator, denominator: sys.totalInertia - sumD, sumKick };
   }
 
@@ -158,7 +184,7 @@ const Physics = (function () {
   function solve(sys, eq, friction, thd, kick, thdd, cos, sin) {
     const phdd = (eq.numerator + friction) / eq.denominator;
     for (let i = 0; i < sys.n; i++) {
-      thdd[i] = (kick[i] - sys.radius * sys.mh[i] * phdd * cos[i] - sys.mgh[i] * sin[i]
+      thdd[i] = (kick[i] - sys.lever * sys.mh[i] * phdd * cos[i] - sys.mgh[i] * sin[i]
         - sys.cTheta[i] * thd[i]) / sys.inertia[i];
     }
     return phdd;
@@ -176,7 +202,7 @@ const Physics = (function () {
     if (sys.totalInertia === Infinity) return 0.0;
     let coupling = 0.0;
     for (let i = 0; i < sys.n; i++) coupling += sys.mh[i] * Math.cos(th[i]) * thd[i];
-    return sys.totalInertia * phd + sys.radius * coupling;
+    return sys.totalInertia * phd + sys.lever * coupling;
   }
 
   // A state from positions and velocities (StepState.start): the derived quantities
@@ -211,7 +237,7 @@ const Physics = (function () {
       out[i] = st.thetaDot[i] + 0.5 * (st.accTheta[i] + thdd[i]) * dt;
       coupling += sys.mh[i] * st.cos[i] * out[i];
     }
-    return sys.radius * coupling;
+    return sys.lever * coupling;
   }
 
   // Advance `st` by one step of length dt. onTick(i, t, up), if given, hears of every
@@ -298,6 +324,6 @@ const Physics = (function () {
 
   return {
     STATUS_OVERTURNED, STATUS_DIVERGED, smallAmplitudeL2, l2ForBpm, steadyAmplitude,
-    buildSystem, accelerations, momentum, startState, step, order,
+    platformTerms, buildSystem, accelerations, momentum, startState, step, order,
   };
 })();

@@ -31,6 +31,7 @@ class Session {
     this.settings = {
       preset: s.preset, n: s.n, bpm: s.bpm, sigma: s.sigma_bpm, groups: 1, offset: 0.0,
       hold: Boolean(s.hold), jLaw: true, j: null, cPhi: null, drive: null,
+      platform: "disk", boardMass: null, boardDamping: null,
     };
     this.seed = s.seed;
     this.z = [];           // each metronome's standard-normal draw: f_i = bpm + σ z_i
@@ -43,6 +44,7 @@ class Session {
     this.ratePeriods = 4;  // tick rates average over this many periods
     this.ticks = [];       // crossings of the last advance: [i, t]
     this.tickCount = 0;    // crossings since the page opened
+    this.boardCentre = null;  // {x, t}: the board's mean position, for View.board
     this.usePreset(s.preset, false);
     this.restart(this.seed);
   }
@@ -51,6 +53,13 @@ class Session {
     const base = this.config.presets[this.settings.preset].constants;
     const c = Object.assign({}, base);
     if (this.settings.drive !== null) c.drive = this.settings.drive;
+    c.platform = this.settings.platform;
+    if (c.platform === "board") {
+      // The disk's fields stay the preset's: the board reads none of them.
+      c.board_mass = this.settings.boardMass;
+      c.board_damping = this.settings.boardDamping;
+      return c;
+    }
     if (this.settings.cPhi !== null) c.c_phi = this.settings.cPhi;
     if (!this.settings.jLaw) c.inertia = this.settings.j;
     return c;
@@ -63,6 +72,9 @@ class Session {
     const c = this.preset.constants;
     this.settings.drive = c.drive;
     this.settings.cPhi = c.c_phi;
+    this.settings.platform = c.platform;
+    this.settings.boardMass = c.board_mass;
+    this.settings.boardDamping = c.board_damping;
     this.settings.jLaw = c.inertia === null;
     if (this.preset.held) this.settings.hold = true;
     this.settings.j = c.inertia === null ? c.j0 + this.settings.n * c.j_per_metronome : c.inertia;
@@ -105,6 +117,8 @@ class Session {
       thetaDot.push(-amp * this.system.omega[i] * Math.sin(p));
     }
     this.state = Physics.startState(this.system, theta, thetaDot, 0.0, 0.0);
+    this.builtPlatform = this.settings.platform;
+    this.boardCentre = null;
     this.t = 0.0;
     this.history = [];
     this.markers = [];
@@ -135,8 +149,13 @@ class Session {
     }
     while (this.lastUp.length < n) this.lastUp.push([]);
     this.lastUp.length = n;
-    const st = Physics.startState(this.system, theta, thetaDot, old.phi, old.phiDot,
-      old.step * this.dt);
+    // Another platform starts at rest: φ (rad on the disk, m on the board) and its
+    // velocity mean nothing on the other.
+    const same = this.builtPlatform === this.settings.platform;
+    this.builtPlatform = this.settings.platform;
+    if (!same) this.boardCentre = null;
+    const st = Physics.startState(this.system, theta, thetaDot, same ? old.phi : 0.0,
+      same ? old.phiDot : 0.0, old.step * this.dt);
     st.step = old.step;
     st.status = old.status & Physics.STATUS_OVERTURNED;
     this.state = st;
@@ -192,8 +211,8 @@ class Session {
 
 // The physics as a pure function, for tests and for anyone who wants numbers:
 // run(params, steps) -> trajectories, recorded every `record_every` steps (default 1).
-// params: preset (name, default the page's), changes ({drive, c_phi, inertia, ...} by
-// the package's names), hold (pin the disk), frequencies_bpm, theta0, theta_dot0
+// params: preset (name, default the page's), changes ({drive, c_phi, inertia, platform,
+// board_mass, ...} by the package's names), hold (pin the platform), frequencies_bpm, theta0, theta_dot0
 // (default 0), phi_dot0 (default 0), dt (default the page's).
 function runTrajectories(config, params, steps) {
   const preset = config.presets[params.preset || config.start.preset];

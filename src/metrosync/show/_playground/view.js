@@ -1,4 +1,4 @@
-// Drawing: the disk from above, a side view of a few pendulums, r(t) scrolling and the
+// Drawing: the disk from above or the board from the side, a side view of a few pendulums, r(t) scrolling and the
 // phase wheel. Colours: a bob's hue is its phase, as on the playback page.
 "use strict";
 
@@ -46,6 +46,84 @@ const View = (function () {
     g.setTransform(1, 0, 0, 1, 0, 0);
     g.fillStyle = "#222";
     g.fillText(held ? "disk held" : "disk free", 8, 16);
+  }
+
+  // The board from the side, resting on two rollers (cans), every metronome standing
+  // on it with its pendulum swinging along it. The board is drawn about its mean
+  // position (session.boardCentre, which follows φ over a few seconds of simulated
+  // time): without damping the start's momentum carries the board away at a steady
+  // drift, which would take it out of view. The rollers, rolling without slipping,
+  // move half as far and turn by x/(2a). World units are metres.
+  function board(g, session, phases, held) {
+    const w = g.canvas.width, h = g.canvas.height, st = session.state, n = st.n;
+    const c = session.constants, l2 = session.system.l2;
+    const top = 1.15 * Math.max(...Array.from(l2), c.l1) + 0.01;  // rod above the pivot
+    const tall = 0.9 * (top + c.l1), cell = Math.max(0.6 * tall, 0.04);
+    // A 12 fl. oz can lying on its side (radius 3.3 cm); the board at least long
+    // enough to rest on two of them apart.
+    const can = 0.033, thick = 0.012, length = Math.max((n + 0.5) * cell, 10 * can);
+    const spacing = length / (n + 0.5);  // spread along the board
+    const scale = Math.min(0.92 * w / (length * 1.35), 0.8 * h / (2 * can + thick + top + c.l1));
+    const tau = 3.0;  // s of simulated time over which the drawing follows the drift
+    const mean = session.boardCentre;
+    if (mean === null || session.t < mean.t) {
+      session.boardCentre = { x: st.phi, t: session.t };
+    } else {
+      mean.x += (st.phi - mean.x) * (1 - Math.exp(-(session.t - mean.t) / tau));
+      mean.t = session.t;
+    }
+    // Kept within a quarter of the board of the middle, whatever the drift.
+    const x = Math.min(0.25 * length, Math.max(-0.25 * length, st.phi - session.boardCentre.x));
+    clear(g);
+    g.translate(w / 2, h - 0.1 * h);  // the table's line, x = 0 in the middle
+    g.scale(scale, scale);
+    g.lineWidth = 1 / scale;
+    g.strokeStyle = "#999";
+    g.beginPath(); g.moveTo(-w / scale, 0); g.lineTo(w / scale, 0); g.stroke();
+    for (const side of [-1, 1]) {
+      const cx = side * 0.3 * length + x / 2, turn = x / (2 * can);
+      g.fillStyle = "#d9dde3"; g.strokeStyle = "#777";
+      g.beginPath(); g.arc(cx, -can, can, 0, 2 * Math.PI); g.fill(); g.stroke();
+      g.strokeStyle = "#999";
+      g.beginPath();
+      g.moveTo(cx - can * Math.cos(turn), -can - can * Math.sin(turn));
+      g.lineTo(cx + can * Math.cos(turn), -can + can * Math.sin(turn));
+      g.stroke();
+    }
+    const deck = -2 * can - thick;
+    g.fillStyle = held ? "#e4e9f2" : "#e8d9bf";
+    g.strokeStyle = held ? "#3b5b92" : "#9a8a70";
+    g.lineWidth = (held ? 3 : 1) / scale;
+    g.fillRect(x - length / 2, deck, length, thick);
+    g.strokeRect(x - length / 2, deck, length, thick);
+    g.lineWidth = 1 / scale;
+    for (let i = 0; i < n; i++) {
+      const x0 = x + (i - (n - 1) / 2) * spacing, y0 = deck - c.l1;
+      const th = st.theta[i], dx = Math.sin(th), dy = Math.cos(th);  // y grows downwards
+      g.fillStyle = "#efe6d8"; g.strokeStyle = "#9a8a70";
+      g.beginPath();
+      g.moveTo(x0 - 0.4 * cell, deck); g.lineTo(x0 + 0.4 * cell, deck);
+      g.lineTo(x0 + 0.12 * cell, deck - tall); g.lineTo(x0 - 0.12 * cell, deck - tall);
+      g.closePath(); g.fill(); g.stroke();
+      // θ > 0 carries the pendulum's centre of mass (below the pivot) along +x, the
+      // way the board moves for φ > 0.
+      g.strokeStyle = "#333"; g.lineWidth = 2 / scale;
+      g.beginPath();
+      g.moveTo(x0 + c.l1 * dx, y0 + c.l1 * dy);
+      g.lineTo(x0 - top * dx, y0 - top * dy);
+      g.stroke();
+      g.lineWidth = 1 / scale;
+      const size = Math.min(0.3 * cell, 0.012);
+      g.fillStyle = hue(phases[i]); g.strokeStyle = "#222";
+      g.fillRect(x0 - l2[i] * dx - size, y0 - l2[i] * dy - size / 2, 2 * size, size);
+      g.strokeRect(x0 - l2[i] * dx - size, y0 - l2[i] * dy - size / 2, 2 * size, size);
+      g.fillStyle = "#555";
+      g.beginPath(); g.arc(x0 + c.l1 * dx, y0 + c.l1 * dy, 0.6 * size, 0, 2 * Math.PI); g.fill();
+    }
+    g.setTransform(1, 0, 0, 1, 0, 0);
+    g.fillStyle = "#222";
+    g.fillText((held ? "board held" : "board free") + "   x − mean = "
+      + (100 * (st.phi - session.boardCentre.x)).toFixed(2) + " cm", 8, 16);
   }
 
   // A few metronomes from the front: the rod turns about its pivot by θ, the fixed
@@ -145,5 +223,5 @@ const View = (function () {
     g.fillText("r = " + r.toFixed(2), 8, 16);
   }
 
-  return { hue, disk, side, order, wheel };
+  return { hue, disk, board, side, order, wheel };
 })();
