@@ -287,16 +287,22 @@ def check_time_step(dt: float, ensemble: Ensemble) -> None:
 MAX_DAMPING_PER_STEP = 1.0
 
 
+def damping_rate(system) -> float:
+    """The fastest viscous damping rate c/D₀ of a platform in ``system`` (`SystemArrays`),
+    1/s, D₀ the coefficient of φ̈ in eq. (eqm1) with the pendulums hanging; 0 when
+    every platform is held."""
+    free = ~np.isinf(system.total_inertia)
+    if not free.any():
+        return 0.0
+    d0 = system.total_inertia - system.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
+    return float(np.max(system.c_phi[free] / d0[free]))
+
+
 def check_damping_step(dt: float, ensemble: Ensemble) -> None:
     """Reject a fixed step too long for the platform's viscous damping rate c/D₀ (D₀
     the effective inertia of eq. (eqm1) with the pendulums hanging), which a fixed-step
     scheme would turn into a divergence."""
-    sys = ensemble.system
-    free = ~np.isinf(sys.total_inertia)
-    if not free.any():
-        return
-    d0 = sys.total_inertia - sys.lever**2 * np.sum(sys.mh**2 / sys.inertia, axis=-1)
-    rate = float(np.max(sys.c_phi[free] / d0[free]))
+    rate = damping_rate(ensemble.system)
     if rate * dt > MAX_DAMPING_PER_STEP:
         board = ensemble.params.platform.platform == "board"
         name = "board_damping" if board else "c_phi"

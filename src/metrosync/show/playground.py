@@ -32,6 +32,7 @@ from pathlib import Path
 from .._files import write_text
 from .._version import __version__
 from ..capabilities import require
+from ..ensemble import MAX_DAMPING_PER_STEP
 from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
 
@@ -63,10 +64,6 @@ MIN_DT = 1e-3
 MIN_STEPS_PER_PERIOD = 10
 #: |θ| beyond which the page reports an overturned pendulum, rad (as `simulate`).
 OVERTURN_ANGLE = math.pi / 2
-#: The most a step may be of the platform's damping time, rate × dt: the step takes
-#: the damping force explicitly and diverges beyond about 1.2 (a wet table's board,
-#: 100 kg/s, needs dt = 0.001 s).
-MAX_DAMPING_PER_STEP = 1.0
 
 
 def preset_data(params: ModelParameters) -> dict:
@@ -236,16 +233,13 @@ def damping_rate(params: ModelParameters, n: int, bpm: float) -> float:
     held disk. The page computes the same (`Physics.buildSystem`'s ``dampingRate``)."""
     import numpy as np
 
+    from ..ensemble import damping_rate as rate_of
     from ..model.system import system_arrays
     from ..model.tuning import l2_for_bpm
 
-    if params.platform.rigid:
-        return 0.0
     design = params.metronome
     l2 = np.full((1, n), l2_for_bpm(design, bpm, tuning=design.tuning))
-    system, _ = system_arrays(params, l2)
-    d0 = system.total_inertia - system.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
-    return float(system.c_phi[0] / d0[0])
+    return rate_of(system_arrays(params, l2)[0])
 
 
 def _check_damping_step(params: ModelParameters, n: int, bpm: float, dt: float) -> None:
