@@ -8,9 +8,10 @@ metronome's ring timed again, and how much each tick sounds like its train's sou
 
 A sound. The waveform the detector times (the channels' mix, band-passed forwards and
 backwards: no delay) from `BEFORE` before each onset to `AFTER` after it, averaged
-over the train's ticks that no other train's tick overlaps (none began in the
-`AFTER` before, nor in the `AFTER` after), apart for the ticks and the tocks (a
-tock can sound different); both together where one kind has fewer than `MIN_CLEAR`.
+over the first `MAX_LEARNED` of the train's ticks that no other train's tick
+overlaps (none began in the `AFTER` before, nor in the `AFTER` after), apart for the
+ticks and the tocks (a tock can sound different); both together where one kind has
+fewer than `MIN_CLEAR`.
 It holds the tick's later impacts and the loudest of its ring.
 
 Timing in a ring. A tick that begins within `AFTER` after another train's tick has its
@@ -33,6 +34,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 from scipy import signal
 
 from .detection import _segments
@@ -44,6 +46,8 @@ BEFORE = 8e-3
 AFTER = 0.05
 #: Ticks of one kind that sound alone, at least, for a sound of that kind.
 MIN_CLEAR = 4
+#: Ticks of one kind averaged, at most.
+MAX_LEARNED = 64
 #: Fit window around a tick's detected onset, s.
 FIT_BEFORE = 3e-3
 FIT_AFTER = 5e-3
@@ -109,6 +113,8 @@ def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound
         prev = np.where(j > 0, t - held[np.maximum(j - 1, 0)], np.inf)
         nxt = np.where(j + 1 < held.size, held[np.minimum(j + 1, held.size - 1)] - t, np.inf)
         alone = (prev > AFTER) & (nxt > AFTER)
+        for kind in (0, 1):  # the first few of each kind: the mean has settled by then
+            alone[np.flatnonzero(alone & (parity == kind))[MAX_LEARNED:]] = False
         if alone.sum() < MIN_CLEAR:
             out.append(None)
             continue
@@ -133,36 +139,55 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     rate = recording.sample_rate
     fit_before, fit_after = round(FIT_BEFORE * rate), round(FIT_AFTER * rate)
     onset = round(BEFORE * rate)
-    shifts = np.arange(-round(SEARCH * rate), round(SEARCH * rate) + 1)
-    cols = np.arange(fit_before + fit_after)
+    search = round(SEARCH * rate)
+    width = fit_before + fit_after
+    cols = np.arange(width)
     centre = np.round(np.asarray(at) * rate).astype(np.int64)
-    segments = _filtered(recording, scan, centre - fit_before, cols.size)
-    times = np.asarray(at, dtype=float).copy()
-    likeness = np.zeros(times.size)
-    for row, wave in enumerate(own):
-        # the own wave at onset centre + shift, read over the window: (shifts, window)
-        pos = onset - fit_before - shifts[:, None] + cols[None, :]
-        shifted = np.where(pos < wave.size, wave[np.clip(pos, 0, wave.size - 1)], 0.0)
+    segments = _filtered(recording, scan, centre - fit_before, width)
+    times = np.asarray(at, dtype=float)
+    # the own wave at every onset within the search, read over the window: the span of
+    # it that the window can see, slid along it
+    lo = onset - fit_before - search
+    explained = np.empty((times.size, 2 * search + 1))
+    energy = np.einsum("nw,nw->n", segments, segments)
+    alone = np.array([not c for c in context], dtype=bool)
+    # the ticks no other overlaps, a whole sound at a time: one matrix product each
+    where = np.array([w.ctypes.data for w in own])  # one sound's rows share their memory
+    for address in np.unique(where):
+        rows = np.flatnonzero(alone & (where == address))
+        wave = own[rows[0]] if rows.size else None
+        if rows.size:
+            shifted = sliding_window_view(wave[lo : lo + width + 2 * search], width)
+            norm = np.einsum("kw,kw->k", shifted, shifted)
+            explained[rows] = (segments[rows] @ shifted.T) ** 2 / np.maximum(norm, 1e-30)
+    for row in np.flatnonzero(~alone):
+        span = own[row][lo : lo + width + 2 * search]
+        cumulative = np.concatenate([[0.0], np.cumsum(span * span)])
+        norm = cumulative[width:] - cumulative[:-width]
         columns = []
         for other, when in context[row]:
             p = centre[row] - fit_before + cols - (round(when * rate) - onset)
             inside = (p >= 0) & (p < other.size)
             columns.append(np.where(inside, other[np.clip(p, 0, other.size - 1)], 0.0))
-        y = segments[row]
-        if columns:
-            q, _ = np.linalg.qr(np.array(columns).T)
-            y = y - q @ (q.T @ y)
-            shifted = shifted - (shifted @ q) @ q.T
-        norm = np.einsum("sw,sw->s", shifted, shifted)
-        explained = (shifted @ y) ** 2 / np.maximum(norm, 1e-30)
-        b = int(np.argmax(explained))
-        frac = 0.0
-        if 0 < b < shifts.size - 1:
-            e0, e1, e2 = explained[b - 1 : b + 2]
-            denom = e0 - 2 * e1 + e2
-            frac = 0.5 * (e0 - e2) / denom if denom < 0 else 0.0
-        times[row] = (centre[row] + shifts[b] + frac) / rate
-        likeness[row] = explained[b] / max(float(y @ y), 1e-30)
+        q, _ = np.linalg.qr(np.array(columns).T)
+        y = segments[row] - q @ (q.T @ segments[row])
+        energy[row] = y @ y
+        # what of the own wave the context could explain is not the tick's
+        for j in range(q.shape[1]):
+            norm = norm - np.correlate(span, q[:, j], "valid") ** 2
+        explained[row] = np.correlate(span, y, "valid") ** 2 / np.maximum(norm, 1e-30)
+    # index k: the onset `search` − k samples after the window's centre; refined on a
+    # parabola through the best and its neighbours
+    best = np.argmax(explained, axis=1)
+    rows = np.arange(times.size)
+    e1 = explained[rows, best]
+    e0 = explained[rows, np.maximum(best - 1, 0)]
+    e2 = explained[rows, np.minimum(best + 1, explained.shape[1] - 1)]
+    denom = e0 - 2 * e1 + e2
+    inner = (best > 0) & (best < explained.shape[1] - 1) & (denom < 0)
+    frac = np.where(inner, 0.5 * (e0 - e2) / np.where(inner, denom, -1.0), 0.0)
+    times = (centre + search - best - frac) / rate
+    likeness = e1 / np.maximum(energy, 1e-30)
     return times, likeness
 
 
