@@ -193,7 +193,7 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     sounds = tp.learn(recording, scan, ticks.time, trains)
     rate = recording.sample_rate
     lo, hi = tp.BEFORE + tp.MARGIN, recording.frames / rate - tp.AFTER - tp.MARGIN
-    owner, parity = tp._others(ticks.time, trains)
+    owner = tp.owners(ticks.time, trains)
     held = np.flatnonzero(owner >= 0)
     held = held[[sounds[owner[i]] is not None for i in held]]
     want_m, want_n, want_t = [], [], []
@@ -211,12 +211,12 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     want_m, want_n, want_t = np.array(want_m), np.concatenate(want_n), np.concatenate(want_t)
     order = np.argsort(want_t)
     want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
-    own = [sounds[m].waves[n % 2] for m, n in zip(want_m, want_n, strict=True)]
+    own = [sounds[m] for m in want_m]
     context = []
     for m, t in zip(want_m, want_t, strict=True):
         h = ticks.time[held]
         near = held[(h > t - tp.AFTER) & (h < t + tp.FIT_AFTER + tp.SEARCH) & (owner[held] != m)]
-        context.append([(sounds[owner[k]].waves[parity[k]], ticks.time[k]) for k in near])
+        context.append([(sounds[owner[k]], ticks.time[k]) for k in near])
     onset, likeness = tp.fit(recording, scan, want_t, own, context)
     j = np.clip(np.searchsorted(ticks.time, onset), 1, max(ticks.time.size - 1, 1))
     near = np.where(np.abs(ticks.time[j] - onset) < np.abs(ticks.time[j - 1] - onset), j, j - 1)

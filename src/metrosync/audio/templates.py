@@ -65,10 +65,13 @@ class Sound:
 
     waves : (2, L) the sound of its even and its odd beats (tick and tock).
     onset : index of the onset in each wave.
+    learned : whether each kind was heard often enough to be learned on its own (a
+        kind that was not is the mean of both, and its ticks' likeness is unknown).
     """
 
     waves: np.ndarray
     onset: int
+    learned: tuple[bool, bool] = (True, True)
 
 
 def _filtered(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
@@ -83,18 +86,15 @@ def _filtered(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
     return out
 
 
-def _others(times: np.ndarray, trains: list[Train]):
-    """(owner (K,), parity (K,)) of each tick held by one train: −1 for none."""
+def owners(times: np.ndarray, trains: list[Train]) -> np.ndarray:
+    """(K,) the train that alone holds each tick, −1 for none (or two)."""
     owner = np.full(times.size, -1, dtype=np.int64)
-    parity = np.zeros(times.size, dtype=np.int64)
     claims = np.zeros(times.size, dtype=np.int64)
     for t in trains:
         claims[t.index] += 1
     for m, t in enumerate(trains):
-        one = claims[t.index] == 1
-        owner[t.index[one]] = m
-        parity[t.index[one]] = t.beat[one] % 2
-    return owner, parity
+        owner[t.index[claims[t.index] == 1]] = m
+    return owner
 
 
 def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound | None]:
@@ -113,29 +113,38 @@ def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound
         prev = np.where(j > 0, t - held[np.maximum(j - 1, 0)], np.inf)
         nxt = np.where(j + 1 < held.size, held[np.minimum(j + 1, held.size - 1)] - t, np.inf)
         alone = (prev > AFTER) & (nxt > AFTER)
-        for kind in (0, 1):  # the first few of each kind: the mean has settled by then
-            alone[np.flatnonzero(alone & (parity == kind))[MAX_LEARNED:]] = False
-        if alone.sum() < MIN_CLEAR:
+        # a kind that is never alone (a tock that keeps falling just before another
+        # metronome's tick) is learned where none follows within the fit window: the
+        # start of its sound, which the fit reads, is its own
+        nearly = (prev > AFTER) & (nxt > FIT_AFTER + SEARCH)
+        use = np.zeros(t.size, dtype=bool)
+        for kind in (0, 1):
+            pick = alone if (alone & (parity == kind)).sum() >= MIN_CLEAR else nearly
+            # the first few of each kind: the mean has settled by then
+            use[np.flatnonzero(pick & (parity == kind))[:MAX_LEARNED]] = True
+        if use.sum() < MIN_CLEAR:
             out.append(None)
             continue
-        starts = np.round(t[alone] * rate).astype(np.int64) - before
+        starts = np.round(t[use] * rate).astype(np.int64) - before
         order = np.argsort(starts)
         waves = _filtered(recording, scan, starts[order], before + after)
-        kinds = parity[alone][order]
+        kinds = parity[use][order]
+        learned = tuple(bool((kinds == k).sum() >= MIN_CLEAR) for k in (0, 1))
         both = waves.mean(axis=0)
-        two = [waves[kinds == k].mean(axis=0) if (kinds == k).sum() >= MIN_CLEAR else both
-               for k in (0, 1)]  # fmt: skip
-        out.append(Sound(np.array(two), before))
+        two = [waves[kinds == k].mean(axis=0) if learned[k] else both for k in (0, 1)]
+        out.append(Sound(np.array(two), before, learned))
     return out
 
 
 def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     """(onsets (n,) s, likeness (n,)) of the ticks near ``at`` (n,) s, sorted: each
-    fitted as its own wave (``own[i]``: a wave of a `Sound`, its onset at `BEFORE`)
-    at the onset within `SEARCH` of at[i] that explains most of the window, plus the
-    waves ``context[i]`` ((wave, onset s) pairs: the other ticks that sound there)
-    at their onsets. Likeness: the share of the window's energy, less what the
-    context explains, that the tick's own wave explains (1: it sounds just like it)."""
+    fitted as the sound ``own[i]`` (a `Sound`: whichever of its two kinds fits better,
+    so that a train's beats counted one off after a gap do not matter) at the onset
+    within `SEARCH` of at[i] that explains most of the window, plus the sounds
+    ``context[i]`` ((Sound, onset s) pairs: the other ticks that sound there, each as
+    any mix of its two kinds) at their onsets. Likeness: the share of the window's
+    energy, less what the context explains, that the tick's own sound explains (1: it
+    sounds just like it)."""
     rate = recording.sample_rate
     fit_before, fit_after = round(FIT_BEFORE * rate), round(FIT_AFTER * rate)
     onset = round(BEFORE * rate)
@@ -144,42 +153,47 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     cols = np.arange(width)
     centre = np.round(np.asarray(at) * rate).astype(np.int64)
     segments = _filtered(recording, scan, centre - fit_before, width)
-    times = np.asarray(at, dtype=float)
-    # the own wave at every onset within the search, read over the window: the span of
+    # each sound at every onset within the search, read over the window: the span of
     # it that the window can see, slid along it
     lo = onset - fit_before - search
-    explained = np.empty((times.size, 2 * search + 1))
+    explained = np.empty((centre.size, 2 * search + 1))
     energy = np.einsum("nw,nw->n", segments, segments)
     alone = np.array([not c for c in context], dtype=bool)
     # the ticks no other overlaps, a whole sound at a time: one matrix product each
-    where = np.array([w.ctypes.data for w in own])  # one sound's rows share their memory
-    for address in np.unique(where):
-        rows = np.flatnonzero(alone & (where == address))
-        wave = own[rows[0]] if rows.size else None
-        if rows.size:
+    which = np.array([id(sound) for sound in own])
+    for key in np.unique(which):
+        rows = np.flatnonzero(alone & (which == key))
+        if rows.size == 0:
+            continue
+        best = np.zeros((rows.size, explained.shape[1]))
+        for wave in own[rows[0]].waves:
             shifted = sliding_window_view(wave[lo : lo + width + 2 * search], width)
             norm = np.einsum("kw,kw->k", shifted, shifted)
-            explained[rows] = (segments[rows] @ shifted.T) ** 2 / np.maximum(norm, 1e-30)
+            best = np.maximum(best, (segments[rows] @ shifted.T) ** 2 / np.maximum(norm, 1e-30))
+        explained[rows] = best
     for row in np.flatnonzero(~alone):
-        span = own[row][lo : lo + width + 2 * search]
-        cumulative = np.concatenate([[0.0], np.cumsum(span * span)])
-        norm = cumulative[width:] - cumulative[:-width]
         columns = []
         for other, when in context[row]:
             p = centre[row] - fit_before + cols - (round(when * rate) - onset)
-            inside = (p >= 0) & (p < other.size)
-            columns.append(np.where(inside, other[np.clip(p, 0, other.size - 1)], 0.0))
+            inside = (p >= 0) & (p < other.waves.shape[1])
+            for wave in other.waves:
+                columns.append(np.where(inside, wave[np.clip(p, 0, wave.size - 1)], 0.0))
         q, _ = np.linalg.qr(np.array(columns).T)
         y = segments[row] - q @ (q.T @ segments[row])
         energy[row] = y @ y
-        # what of the own wave the context could explain is not the tick's
-        for j in range(q.shape[1]):
-            norm = norm - np.correlate(span, q[:, j], "valid") ** 2
-        explained[row] = np.correlate(span, y, "valid") ** 2 / np.maximum(norm, 1e-30)
+        explained[row] = 0.0
+        for wave in own[row].waves:
+            span = wave[lo : lo + width + 2 * search]
+            cumulative = np.concatenate([[0.0], np.cumsum(span * span)])
+            norm = cumulative[width:] - cumulative[:-width]
+            # what of the own sound the context could explain is not the tick's
+            norm = norm - np.sum([np.correlate(span, c, "valid") ** 2 for c in q.T], axis=0)
+            fitted = np.correlate(span, y, "valid") ** 2 / np.maximum(norm, 1e-30)
+            explained[row] = np.maximum(explained[row], fitted)
     # index k: the onset `search` − k samples after the window's centre; refined on a
     # parabola through the best and its neighbours
     best = np.argmax(explained, axis=1)
-    rows = np.arange(times.size)
+    rows = np.arange(centre.size)
     e1 = explained[rows, best]
     e0 = explained[rows, np.maximum(best - 1, 0)]
     e2 = explained[rows, np.minimum(best + 1, explained.shape[1] - 1)]
@@ -191,11 +205,11 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     return times, likeness
 
 
-def _context(times, owner, parity, sounds, i, held) -> list:
-    """(wave, onset) of the ticks of other trains that sound in tick i's fit window."""
+def _context(times, owner, sounds, i, held) -> list:
+    """(Sound, onset) of the ticks of other trains that sound in tick i's fit window."""
     h = times[held]
     near = held[(h > times[i] - AFTER) & (h < times[i] + FIT_AFTER + SEARCH)]
-    return [(sounds[owner[k]].waves[parity[k]], times[k]) for k in near
+    return [(sounds[owner[k]], times[k]) for k in near
             if owner[k] != owner[i] and sounds[owner[k]] is not None]  # fmt: skip
 
 
@@ -206,7 +220,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     times = np.asarray(times, dtype=float)
     out = times.copy()
     likeness = np.full(times.size, np.nan)
-    owner, parity = _others(times, trains)
+    owner = owners(times, trains)
     masked = np.zeros(times.size, dtype=bool)
     for t in trains:
         masked[t.index[t.masked]] = True
@@ -214,9 +228,10 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     held = held[[sounds[owner[i]] is not None for i in held]]
     if held.size == 0:
         return out, likeness
-    own = [sounds[owner[i]].waves[parity[i]] for i in held]
-    context = [_context(times, owner, parity, sounds, i, held) for i in held]
+    own = [sounds[owner[i]] for i in held]
+    context = [_context(times, owner, sounds, i, held) for i in held]
     fitted, likeness[held] = fit(recording, scan, times[held], own, context)
+    likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
     j = np.searchsorted(h, h)
     in_ring = np.where(j > 0, h - h[np.maximum(j - 1, 0)], np.inf) <= AFTER
