@@ -3,7 +3,8 @@
 Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file
 (or files recorded together, `together`) in blocks (`reader`), finds every impact
 (`detection`), groups them into ticks and tells the metronomes apart by sound and
-tempo (`separation`), finds ticks another hid (`recovery`), and measures: each
+tempo (`separation`), finds ticks another hid (`recovery`), times the ticks in
+another's ring on the metronomes' learned sounds (`templates`), and measures: each
 metronome's tempo, jitter and beat (`metronome`); its phases, r and frequency as the
 light gate's (`observables.crossings`); the phase of each in metronome 0's beat
 (`attribution`); and the acoustic order parameter and clusters of the ensemble,

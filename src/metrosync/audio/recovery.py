@@ -25,6 +25,14 @@ resolution (`detection.RESOLUTION`) of it. Up to `PASSES` passes: each predicts
 from the ticks the last one added, so that a long run of missed beats is filled from
 both ends inwards.
 
+Last, each beat still missed, and the `END_BEATS` beyond each end of a train (where
+the tracker gave up), is sought by the metronome's own sound (`templates.fit`, beside
+the other metronomes' sounds that overlap it) within `templates.SEARCH` of the
+prediction: a tick whose onset the detector timed too far off in another's ring, or
+never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`). The
+curve's highest point alone is not enough there: beyond a train's end it is as
+often the room's noise.
+
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
 tick lies nearer another train's beat than its own train's beat puts it, within the
 detector's resolution: two metronomes ticked together there and its onset may be
