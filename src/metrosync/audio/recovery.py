@@ -220,11 +220,11 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     order = np.argsort(want_t)
     want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
     own = [sounds[m] for m in want_m]
-    context = []
-    for m, t in zip(want_m, want_t, strict=True):
-        h = ticks.time[held]
-        near = held[(h > t - tp.AFTER) & (h < t + tp.FIT_AFTER + tp.SEARCH) & (owner[held] != m)]
-        context.append([(sounds[owner[k]], ticks.time[k]) for k in near])
+    h = ticks.time[held]
+    first = np.searchsorted(h, want_t - tp.AFTER, side="right")
+    stop = np.searchsorted(h, want_t + tp.FIT_AFTER + tp.SEARCH)
+    context = [[(sounds[owner[k]], ticks.time[k]) for k in held[a:b] if owner[k] != m]
+               for m, a, b in zip(want_m, first, stop, strict=True)]  # fmt: skip
     onset, likeness = tp.fit(recording, scan, want_t, own, context)
     j = np.clip(np.searchsorted(ticks.time, onset), 1, max(ticks.time.size - 1, 1))
     near = np.where(np.abs(ticks.time[j] - onset) < np.abs(ticks.time[j - 1] - onset), j, j - 1)
@@ -244,7 +244,8 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     # loudness and rise as the detector measures them; the time is the fitted onset
     hops = np.clip(np.round(onset[fresh] * rate / scan.hop).astype(np.int64), 0,
                    scan.curve.size - 1)  # fmt: skip
-    extra = {f: getattr(det.refine(recording, scan, hops), f) for f in fields}
+    measured = det.refine(recording, scan, hops)
+    extra = {f: getattr(measured, f) for f in fields}
     extra["time"] = onset[fresh]
     merged = {f: np.concatenate([time if f == "time" else getattr(ticks, f), extra[f]])
               for f in fields}  # fmt: skip

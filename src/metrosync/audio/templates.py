@@ -56,7 +56,7 @@ SEARCH = 3e-3
 #: A tick less like its train's sound than this is not its metronome's.
 MIN_LIKENESS = 0.35
 #: Filtered beyond each end of a segment, s: the band-pass settles there.
-MARGIN = 10e-3
+MARGIN = 3e-3
 
 
 @dataclass(frozen=True)
@@ -205,12 +205,14 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     return times, likeness
 
 
-def _context(times, owner, sounds, i, held) -> list:
-    """(Sound, onset) of the ticks of other trains that sound in tick i's fit window."""
+def _context(times, owner, sounds, held) -> list:
+    """For each of ``held`` (sorted indices of ticks with a sound), the (Sound, onset) of
+    the ticks of other trains that sound in its fit window."""
     h = times[held]
-    near = held[(h > times[i] - AFTER) & (h < times[i] + FIT_AFTER + SEARCH)]
-    return [(sounds[owner[k]], times[k]) for k in near
-            if owner[k] != owner[i] and sounds[owner[k]] is not None]  # fmt: skip
+    first = np.searchsorted(h, h - AFTER, side="right")
+    stop = np.searchsorted(h, h + FIT_AFTER + SEARCH)
+    return [[(sounds[owner[k]], times[k]) for k in held[a:b] if owner[k] != owner[i]]
+            for i, a, b in zip(held, first, stop, strict=True)]  # fmt: skip
 
 
 def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
@@ -229,7 +231,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     if held.size == 0:
         return out, likeness
     own = [sounds[owner[i]] for i in held]
-    context = [_context(times, owner, sounds, i, held) for i in held]
+    context = _context(times, owner, sounds, held)
     fitted, likeness[held] = fit(recording, scan, times[held], own, context)
     likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
