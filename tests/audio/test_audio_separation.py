@@ -100,16 +100,14 @@ def test_a_tick_of_several_impacts_is_one_tick(tmp_path, seed):
     assert "a tick counted once" in ds.attrs["summary"]
 
 
-@pytest.mark.slow
-def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
-    """Twenty-four phone recordings, one to four metronomes of different makes at tempi
-    drawn in 100-200 BPM, each slightly limping and speeding up. A recording where a
-    metronome's ticks are hidden behind another's more often than not (two at nearly
-    one tempo, ticking together all along) is beyond one microphone and not counted;
-    at least 22 of the 24 must be hearable."""
+def _corpus_scores(tmp_path, counts, seeds):
+    """(number right per hearable recording, per-metronome scores where right, how many
+    hearable): a recording where a metronome's ticks are hidden behind another's more
+    often than not (two at nearly one tempo, ticking together all along) is beyond one
+    microphone and not counted."""
     right, rows, hearable_ones = [], [], 0
-    for n in (1, 2, 3, 4):
-        for seed in range(6):
+    for n in counts:
+        for seed in seeds:
             ds, truth = recording(tmp_path, n, seed)
             if min(hearable(truth, k).mean() for k in range(n)) < 0.5:
                 continue
@@ -117,16 +115,39 @@ def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
             right.append(ds.attrs["metronomes"] == n)
             if right[-1]:
                 rows.append(scores(ds, truth))
-    assert hearable_ones >= 22
-    assert np.mean(right) >= 0.95
-    table = np.concatenate(rows)
+    return np.array(right), np.concatenate(rows), hearable_ones
+
+
+def _assert_each_metronome_meets_the_issue(table):
     recall, precision, timing, bpm = table.T
+    assert np.all(recall >= 0.99), recall
+    assert np.all(precision >= 0.99), precision
     assert np.all(timing <= 1e-3)
     assert np.all(bpm <= 0.1)
-    # most metronomes hear every tick no other hid; a few lose a tick or two where
-    # another's impacts and ring mask theirs, or one tick is given to the wrong one
-    assert np.all(recall >= 0.98) and np.mean(recall >= 0.99) >= 0.9
-    assert np.all(precision >= 0.97) and np.mean(precision >= 0.99) >= 0.8
+
+
+def test_three_and_four_metronomes_each_heard_tick_by_tick(tmp_path):
+    """The corpus's three and four metronomes of different makes on one phone: every
+    metronome's ticks that no other hid are found (recall), every tick given to it is
+    its own (precision), both >= 99 %, within 1 ms, its tempo within 0.1 BPM. Ticks in
+    another's ring are timed on the sum of the two sounds (`audio.templates`); beats
+    the tracker missed are sought by their metronome's sound. One recording (four
+    metronomes, seed 4: one of them faint, a third of its ticks unheard) is counted as
+    the wrong number of metronomes."""
+    right, table, hearable_ones = _corpus_scores(tmp_path, (3, 4), range(6))
+    assert hearable_ones >= 10 and right.sum() >= right.size - 1
+    _assert_each_metronome_meets_the_issue(table)
+
+
+@pytest.mark.slow
+def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
+    """Twenty-four phone recordings, one to four metronomes of different makes at tempi
+    drawn in 100-200 BPM, each slightly limping and speeding up; at least 22 of the 24
+    are hearable, the number of metronomes right in 95 % of those."""
+    right, table, hearable_ones = _corpus_scores(tmp_path, (1, 2, 3, 4), range(6))
+    assert hearable_ones >= 22
+    assert np.mean(right) >= 0.95
+    _assert_each_metronome_meets_the_issue(table)
 
 
 @pytest.mark.parametrize("same_voice", [False, True], ids=["two makes", "one make"])

@@ -3,7 +3,8 @@
 Contract: ``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file
 (or files recorded together, `together`) in blocks (`reader`), finds every impact
 (`detection`), groups them into ticks and tells the metronomes apart by sound and
-tempo (`separation`), finds ticks another hid (`recovery`), and measures: each
+tempo (`separation`), finds ticks another hid (`recovery`), times the ticks in
+another's ring on the metronomes' learned sounds (`templates`), and measures: each
 metronome's tempo, jitter and beat (`metronome`); its phases, r and frequency as the
 light gate's (`observables.crossings`); the phase of each in metronome 0's beat
 (`attribution`); and the acoustic order parameter and clusters of the ensemble,
@@ -47,6 +48,7 @@ from ..errors import AnalysisError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
 from . import detection as det
+from . import templates
 from .attribution import phase_difference
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
@@ -140,6 +142,7 @@ def analyze_audio(
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
+    ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
     if trains:
         # the median of the metronomes' tempi; where the trains may have gone wrong (a
         # very noisy recording), from all the ticks, as without trains
@@ -184,6 +187,7 @@ def analyze_audio(
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
     label = nearer_another(ticks.time, trains, _labels(k, trains))
+    label[likeness < templates.MIN_LIKENESS] = -1  # a bump on the beat, not a tick
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)
@@ -253,6 +257,22 @@ def analyze_audio(
     )
     ds.attrs["summary"] = summary_text(ds)
     return ds
+
+
+def _retimed(recording, scan, ticks, trains: list[Train]):
+    """(ticks, trains, likeness (K,)) with the ticks in another metronome's ring timed on
+    the sum of the metronomes' sounds (`templates`), kept in time order, and how much
+    each held tick sounds like its metronome (NaN where unknown)."""
+    sounds = templates.learn(recording, scan, ticks.time, trains)
+    times, likeness = templates.retime(recording, scan, ticks.time, trains, sounds)
+    order = np.argsort(times, kind="stable")
+    likeness = likeness[order]
+    fields = det.Ticks.__dataclass_fields__
+    ticks = det.Ticks(*(times[order] if f == "time" else getattr(ticks, f)[order]
+                        for f in fields))  # fmt: skip
+    where = np.empty(order.size, dtype=np.int64)
+    where[order] = np.arange(order.size)
+    return ticks, [replace(t, index=where[t.index]) for t in trains], likeness
 
 
 def _pendulum_phases(kept: list, dt: float) -> xr.Dataset:

@@ -25,6 +25,14 @@ resolution (`detection.RESOLUTION`) of it. Up to `PASSES` passes: each predicts
 from the ticks the last one added, so that a long run of missed beats is filled from
 both ends inwards.
 
+Last, each beat still missed, and the `END_BEATS` beyond each end of a train (where
+the tracker gave up), is sought by the metronome's own sound (`templates.fit`, beside
+the other metronomes' sounds that overlap it) within `templates.SEARCH` of the
+prediction: a tick whose onset the detector timed too far off in another's ring, or
+never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`). The
+curve's highest point alone is not enough there: beyond a train's end it is as
+often the room's noise.
+
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
 tick lies nearer another train's beat than its own train's beat puts it, within the
 detector's resolution: two metronomes ticked together there and its onset may be
@@ -36,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import detection as det
+from . import templates as tp
 from .trains import Train, off_the_beat
 
 WINDOW = 3e-3
@@ -49,22 +58,31 @@ PASSES = 3
 SIDE = 3
 #: How long after a tick its later impacts and ring can move another's onset, s.
 RING = 0.04
+#: Beats sought by their sound beyond each end of a train.
+END_BEATS = 2
+#: A beat sought by its sound is found where it sounds at least this much like it.
+FOUND_LIKENESS = 0.5
 #: A tick in another's ring this many robust spreads off its beat is unattributed.
 RING_OFF_BEAT = 1.0
 
 
-def _predictions(times: np.ndarray, train: Train) -> tuple[np.ndarray, np.ndarray]:
+def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(beats missed, their predicted times) of one train: from the nearest heard beats
     of the same kind (tick or tock) before and after (not a masked tick: the tick that
     hid it timed it), at most `REACH` beats away, on a line fitted to up to `SIDE` on
     each side (`_fit_between`); from one side only, on the beat of the two nearest
     heard beats of the kind there (within 5 % of the train's mean beat, else the
-    mean)."""
+    mean). With ``beyond``, only the ``beyond`` beats before the train's first tick
+    and as many after its last."""
     heard = ~train.masked  # a masked tick is timed by the tick that hid it
     beat, t = train.beat[heard], times[train.index[heard]]
     if beat.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
-    missing = np.setdiff1d(np.arange(train.beat[0], train.beat[-1] + 1), train.beat)
+    if beyond:
+        first, last = train.beat[0], train.beat[-1]
+        missing = np.r_[first - beyond : first, last + 1 : last + beyond + 1]
+    else:
+        missing = np.setdiff1d(np.arange(train.beat[0], train.beat[-1] + 1), train.beat)
     swing = 2 * train.period
     out_n, out_t = [], []
     for parity in (0, 1):
@@ -170,7 +188,84 @@ def recover(recording, scan, ticks, trains: list[Train]):
         recovered += added
         if added + taken == 0:
             break
-    return ticks, trains, recovered
+    ticks, trains, added = _by_sound(recording, scan, ticks, trains)
+    return ticks, trains, recovered + added
+
+
+def _by_sound(recording, scan, ticks, trains: list[Train]):
+    """(ticks, trains, ticks added): each beat still missed, and the `END_BEATS` beyond
+    each end of a train, sought by the train's own sound (`templates.fit`) within
+    `templates.SEARCH` of the prediction, beside the other trains' sounds: kept where
+    it sounds like the train (`FOUND_LIKENESS`) and no tick is within the detector's
+    resolution of it; a tick heard there that no train holds is the one found."""
+    sounds = tp.learn(recording, scan, ticks.time, trains)
+    rate = recording.sample_rate
+    lo, hi = tp.BEFORE + tp.MARGIN, recording.frames / rate - tp.AFTER - tp.MARGIN
+    owner = tp.owners(ticks.time, trains)
+    held = np.flatnonzero(owner >= 0)
+    held = held[[sounds[owner[i]] is not None for i in held]]
+    want_m, want_n, want_t = [], [], []
+    for m, train in enumerate(trains):
+        if sounds[m] is None:
+            continue
+        for beyond in (0, END_BEATS):
+            n, p = _predictions(ticks.time, train, beyond)
+            ok = (p > lo) & (p < hi)
+            want_m += [m] * int(ok.sum())
+            want_n.append(n[ok])
+            want_t.append(p[ok])
+    if not want_m:
+        return ticks, trains, 0
+    want_m, want_n, want_t = np.array(want_m), np.concatenate(want_n), np.concatenate(want_t)
+    order = np.argsort(want_t)
+    want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
+    own = [sounds[m] for m in want_m]
+    h = ticks.time[held]
+    first = np.searchsorted(h, want_t - tp.AFTER, side="right")
+    stop = np.searchsorted(h, want_t + tp.FIT_AFTER + tp.SEARCH)
+    context = [[(sounds[owner[k]], ticks.time[k]) for k in held[a:b] if owner[k] != m]
+               for m, a, b in zip(want_m, first, stop, strict=True)]  # fmt: skip
+    onset, likeness = tp.fit(recording, scan, want_t, own, context)
+    j = np.clip(np.searchsorted(ticks.time, onset), 1, max(ticks.time.size - 1, 1))
+    near = np.where(np.abs(ticks.time[j] - onset) < np.abs(ticks.time[j - 1] - onset), j, j - 1)
+    close = np.abs(ticks.time[near] - onset) <= det.RESOLUTION
+    keep = (likeness >= FOUND_LIKENESS) & (~close | (owner[near] < 0))
+    # one found tick per beat and per sound: two beats that found one onset are neither's
+    _, first, counts = np.unique(np.round(onset[keep] * rate), return_index=True,
+                                 return_counts=True)  # fmt: skip
+    chosen = np.flatnonzero(keep)[first[counts == 1]]
+    if chosen.size == 0:
+        return ticks, trains, 0
+    reuse = chosen[close[chosen]]
+    time = ticks.time.copy()
+    time[near[reuse]] = onset[reuse]  # heard, but timed on the other's ring
+    fresh = chosen[~close[chosen]]
+    fields = det.Ticks.__dataclass_fields__
+    # loudness and rise as the detector measures them; the time is the fitted onset
+    hops = np.clip(np.round(onset[fresh] * rate / scan.hop).astype(np.int64), 0,
+                   scan.curve.size - 1)  # fmt: skip
+    measured = det.refine(recording, scan, hops)
+    extra = {f: getattr(measured, f) for f in fields}
+    extra["time"] = onset[fresh]
+    merged = {f: np.concatenate([time if f == "time" else getattr(ticks, f), extra[f]])
+              for f in fields}  # fmt: skip
+    index_of = np.empty(chosen.size, dtype=np.int64)
+    index_of[close[chosen]] = near[reuse]
+    index_of[~close[chosen]] = ticks.time.size + np.arange(fresh.size)
+    order = np.argsort(merged["time"], kind="stable")
+    new_ticks = det.Ticks(*(merged[f][order] for f in fields))
+    where = np.empty(order.size, dtype=np.int64)
+    where[order] = np.arange(order.size)
+    out = []
+    for m, train in enumerate(trains):
+        mine = want_m[chosen] == m
+        index = np.concatenate([train.index, index_of[mine]])
+        number = np.concatenate([train.beat, want_n[chosen][mine]])
+        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
+        k = np.argsort(number, kind="stable")
+        # a beat found before the first counts from 0 again
+        out.append(Train(where[index[k]], number[k] - number[k[0]], train.period, masked[k]))
+    return new_ticks, out, int(fresh.size)
 
 
 def _pass(recording, scan, ticks, trains: list[Train]):

@@ -1,0 +1,243 @@
+"""Each metronome's tick as this recording hears it, and ticks timed against it where
+another metronome's impacts and ring overlap them.
+
+Contract: `learn(recording, scan, times, trains)` returns one `Sound` per train (or
+None where too few of its ticks sound alone); `retime(recording, scan, times,
+trains, sounds)` returns the tick times (K,) with each tick that sounds in another
+metronome's ring timed again, and how much each tick sounds like its train's sound.
+
+A sound. The waveform the detector times (the channels' mix, band-passed forwards and
+backwards: no delay) from `BEFORE` before each onset to `AFTER` after it, averaged
+over the first `MAX_LEARNED` of the train's ticks that no other train's tick
+overlaps (none began in the `AFTER` before, nor in the `AFTER` after), apart for the
+ticks and the tocks (a tock can sound different); both together where one kind has
+fewer than `MIN_CLEAR`.
+It holds the tick's later impacts and the loudest of its ring.
+
+Timing in a ring. A tick that begins within `AFTER` after another train's tick has its
+onset timed on a sum of the two: the detector's onset rule reads the other's ring as
+its background and times the tick late by a millisecond or two. Over `FIT_BEFORE`
+before to `FIT_AFTER` after the detected onset, the waveform is fitted by least
+squares as a·(own sound at τ) + Σ b_j·(sound j at its onset t_j), for every τ within
+`SEARCH` of the detected onset, whole samples apart; the τ of the smallest residual
+(refined on a parabola) is the onset. The other ticks keep their times: their onsets
+are the first thing heard, where the detector is exact.
+
+Likeness. The share of the window's energy (less what the other ticks explain) that
+the tick's own sound explains at its best onset: above 0.4 for the corpus's ticks,
+under 0.1 for a handling bump on a metronome's beat. A tick held by a train that
+sounds less like it than `MIN_LIKENESS` is not that metronome's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy import signal
+
+from .detection import _segments
+from .trains import Train
+
+#: Sound kept before each onset, s (room for the search below).
+BEFORE = 8e-3
+#: Sound kept after each onset, s: its later impacts and the loudest of its ring.
+AFTER = 0.05
+#: Ticks of one kind that sound alone, at least, for a sound of that kind.
+MIN_CLEAR = 4
+#: Ticks of one kind averaged, at most.
+MAX_LEARNED = 64
+#: Fit window around a tick's detected onset, s.
+FIT_BEFORE = 3e-3
+FIT_AFTER = 5e-3
+#: Farthest a tick is moved, s.
+SEARCH = 3e-3
+#: A tick less like its train's sound than this is not its metronome's.
+MIN_LIKENESS = 0.35
+#: Filtered beyond each end of a segment, s: the band-pass settles there.
+MARGIN = 3e-3
+
+
+@dataclass(frozen=True)
+class Sound:
+    """One train's tick, sampled at the recording's rate from −`BEFORE` to `AFTER`.
+
+    waves : (2, L) the sound of its even and its odd beats (tick and tock).
+    onset : index of the onset in each wave.
+    learned : whether each kind was heard often enough to be learned on its own (a
+        kind that was not is the mean of both, and its ticks' likeness is unknown).
+    """
+
+    waves: np.ndarray
+    onset: int
+    learned: tuple[bool, bool] = (True, True)
+
+
+def _filtered(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
+    """(n, length) the band-passed channel mix from each of ``starts`` (samples, sorted)."""
+    margin = round(MARGIN * recording.sample_rate)
+    out = np.empty((starts.size, length))
+    for first, seg in _segments(recording, starts - margin, length + 2 * margin, 2048):
+        mix = seg.mean(axis=2)
+        out[first : first + mix.shape[0]] = signal.sosfiltfilt(scan.sos, mix, axis=1)[
+            :, margin : margin + length
+        ]
+    return out
+
+
+def owners(times: np.ndarray, trains: list[Train]) -> np.ndarray:
+    """(K,) the train that alone holds each tick, −1 for none (or two)."""
+    owner = np.full(times.size, -1, dtype=np.int64)
+    claims = np.zeros(times.size, dtype=np.int64)
+    for t in trains:
+        claims[t.index] += 1
+    for m, t in enumerate(trains):
+        owner[t.index[claims[t.index] == 1]] = m
+    return owner
+
+
+def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound | None]:
+    """One `Sound` per train (see the module docstring)."""
+    rate = recording.sample_rate
+    before, after = round(BEFORE * rate), round(AFTER * rate)
+    held = np.sort(np.concatenate([times[t.index] for t in trains])) if trains else times
+    out: list[Sound | None] = []
+    for train in trains:
+        heard = ~train.masked
+        index, parity = train.index[heard], train.beat[heard] % 2
+        t = times[index]
+        # alone: no tick of another train in the AFTER before or after (its own is held
+        # too, but never that close)
+        j = np.searchsorted(held, t)
+        prev = np.where(j > 0, t - held[np.maximum(j - 1, 0)], np.inf)
+        nxt = np.where(j + 1 < held.size, held[np.minimum(j + 1, held.size - 1)] - t, np.inf)
+        alone = (prev > AFTER) & (nxt > AFTER)
+        # a kind that is never alone (a tock that keeps falling just before another
+        # metronome's tick) is learned where none follows within the fit window: the
+        # start of its sound, which the fit reads, is its own
+        nearly = (prev > AFTER) & (nxt > FIT_AFTER + SEARCH)
+        use = np.zeros(t.size, dtype=bool)
+        for kind in (0, 1):
+            pick = alone if (alone & (parity == kind)).sum() >= MIN_CLEAR else nearly
+            # the first few of each kind: the mean has settled by then
+            use[np.flatnonzero(pick & (parity == kind))[:MAX_LEARNED]] = True
+        if use.sum() < MIN_CLEAR:
+            out.append(None)
+            continue
+        starts = np.round(t[use] * rate).astype(np.int64) - before
+        order = np.argsort(starts)
+        waves = _filtered(recording, scan, starts[order], before + after)
+        kinds = parity[use][order]
+        learned = tuple(bool((kinds == k).sum() >= MIN_CLEAR) for k in (0, 1))
+        both = waves.mean(axis=0)
+        two = [waves[kinds == k].mean(axis=0) if learned[k] else both for k in (0, 1)]
+        out.append(Sound(np.array(two), before, learned))
+    return out
+
+
+def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
+    """(onsets (n,) s, likeness (n,)) of the ticks near ``at`` (n,) s, sorted: each
+    fitted as the sound ``own[i]`` (a `Sound`: whichever of its two kinds fits better,
+    so that a train's beats counted one off after a gap do not matter) at the onset
+    within `SEARCH` of at[i] that explains most of the window, plus the sounds
+    ``context[i]`` ((Sound, onset s) pairs: the other ticks that sound there, each as
+    any mix of its two kinds) at their onsets. Likeness: the share of the window's
+    energy, less what the context explains, that the tick's own sound explains (1: it
+    sounds just like it)."""
+    rate = recording.sample_rate
+    fit_before, fit_after = round(FIT_BEFORE * rate), round(FIT_AFTER * rate)
+    onset = round(BEFORE * rate)
+    search = round(SEARCH * rate)
+    width = fit_before + fit_after
+    cols = np.arange(width)
+    centre = np.round(np.asarray(at) * rate).astype(np.int64)
+    segments = _filtered(recording, scan, centre - fit_before, width)
+    # each sound at every onset within the search, read over the window: the span of
+    # it that the window can see, slid along it
+    lo = onset - fit_before - search
+    explained = np.empty((centre.size, 2 * search + 1))
+    energy = np.einsum("nw,nw->n", segments, segments)
+    alone = np.array([not c for c in context], dtype=bool)
+    # the ticks no other overlaps, a whole sound at a time: one matrix product each
+    which = np.array([id(sound) for sound in own])
+    for key in np.unique(which):
+        rows = np.flatnonzero(alone & (which == key))
+        if rows.size == 0:
+            continue
+        best = np.zeros((rows.size, explained.shape[1]))
+        for wave in own[rows[0]].waves:
+            shifted = sliding_window_view(wave[lo : lo + width + 2 * search], width)
+            norm = np.einsum("kw,kw->k", shifted, shifted)
+            best = np.maximum(best, (segments[rows] @ shifted.T) ** 2 / np.maximum(norm, 1e-30))
+        explained[rows] = best
+    for row in np.flatnonzero(~alone):
+        columns = []
+        for other, when in context[row]:
+            p = centre[row] - fit_before + cols - (round(when * rate) - onset)
+            inside = (p >= 0) & (p < other.waves.shape[1])
+            for wave in other.waves:
+                columns.append(np.where(inside, wave[np.clip(p, 0, wave.size - 1)], 0.0))
+        q, _ = np.linalg.qr(np.array(columns).T)
+        y = segments[row] - q @ (q.T @ segments[row])
+        energy[row] = y @ y
+        explained[row] = 0.0
+        for wave in own[row].waves:
+            span = wave[lo : lo + width + 2 * search]
+            cumulative = np.concatenate([[0.0], np.cumsum(span * span)])
+            norm = cumulative[width:] - cumulative[:-width]
+            # what of the own sound the context could explain is not the tick's
+            norm = norm - np.sum([np.correlate(span, c, "valid") ** 2 for c in q.T], axis=0)
+            fitted = np.correlate(span, y, "valid") ** 2 / np.maximum(norm, 1e-30)
+            explained[row] = np.maximum(explained[row], fitted)
+    # index k: the onset `search` − k samples after the window's centre; refined on a
+    # parabola through the best and its neighbours
+    best = np.argmax(explained, axis=1)
+    rows = np.arange(centre.size)
+    e1 = explained[rows, best]
+    e0 = explained[rows, np.maximum(best - 1, 0)]
+    e2 = explained[rows, np.minimum(best + 1, explained.shape[1] - 1)]
+    denom = e0 - 2 * e1 + e2
+    inner = (best > 0) & (best < explained.shape[1] - 1) & (denom < 0)
+    frac = np.where(inner, 0.5 * (e0 - e2) / np.where(inner, denom, -1.0), 0.0)
+    times = (centre + search - best - frac) / rate
+    likeness = e1 / np.maximum(energy, 1e-30)
+    return times, likeness
+
+
+def _context(times, owner, sounds, held) -> list:
+    """For each of ``held`` (sorted indices of ticks with a sound), the (Sound, onset) of
+    the ticks of other trains that sound in its fit window."""
+    h = times[held]
+    first = np.searchsorted(h, h - AFTER, side="right")
+    stop = np.searchsorted(h, h + FIT_AFTER + SEARCH)
+    return [[(sounds[owner[k]], times[k]) for k in held[a:b] if owner[k] != owner[i]]
+            for i, a, b in zip(held, first, stop, strict=True)]  # fmt: skip
+
+
+def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
+    """((K,) ``times`` with each tick that sounds in another train's ring timed again on
+    the sum of the sounds, (K,) each held tick's likeness to its train's sound (NaN
+    for the others)); see the module docstring."""
+    times = np.asarray(times, dtype=float)
+    out = times.copy()
+    likeness = np.full(times.size, np.nan)
+    owner = owners(times, trains)
+    masked = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        masked[t.index[t.masked]] = True
+    held = np.flatnonzero(owner >= 0)
+    held = held[[sounds[owner[i]] is not None for i in held]]
+    if held.size == 0:
+        return out, likeness
+    own = [sounds[owner[i]] for i in held]
+    context = _context(times, owner, sounds, held)
+    fitted, likeness[held] = fit(recording, scan, times[held], own, context)
+    likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
+    h = times[held]
+    j = np.searchsorted(h, h)
+    in_ring = np.where(j > 0, h - h[np.maximum(j - 1, 0)], np.inf) <= AFTER
+    # a masked tick is the onset of the tick that hid it: it keeps that time
+    moved = in_ring & ~masked[held]
+    out[held[moved]] = fitted[moved]
+    return out, likeness

@@ -1,0 +1,74 @@
+"""Each metronome's learned sound: a tick in another's ring timed on the sum of the two,
+and how much a sound is like a metronome's tick."""
+
+from __future__ import annotations
+
+import corpus
+import numpy as np
+import pytest
+
+from metrosync.audio import detection as det
+from metrosync.audio import templates as tp
+from metrosync.audio.reader import open_recording
+from metrosync.audio.trains import Train
+from metrosync.show.ticks import voices
+
+
+@pytest.fixture(scope="module")
+def overlapping(tmp_path_factory):
+    """Two metronomes of different makes through a phone, 100 and 101 BPM: over the
+    minute the second's ticks sweep through the first's ring. Returns the recording,
+    its scan, the true onsets (sorted), the trains over them and the truth per train."""
+    v = voices(2, 3)
+    trains = [corpus.steady_train(100.0, 60.0, phase=0.0, voice=v[0], seed=1),
+              corpus.steady_train(101.0, 60.0, phase=0.02, voice=v[1], seed=2)]  # fmt: skip
+    rec = corpus.make_recording(trains, impairments=corpus.Impairments.phone(), seed=3)
+    path = rec.write(tmp_path_factory.mktemp("templates") / "two.wav")
+    recording = open_recording(path)
+    scan = det.scan(recording)
+    truth = [t.times for t in rec.truth]
+    times = np.concatenate(truth)
+    order = np.argsort(times, kind="stable")
+    where = np.empty(order.size, dtype=np.int64)
+    where[order] = np.arange(order.size)
+    index = [where[: truth[0].size], where[truth[0].size :]]
+    built = [Train(i, np.arange(i.size), 0.6, np.zeros(i.size, dtype=bool)) for i in index]
+    return recording, scan, times[order], built, index
+
+
+def _since_another(times, index):
+    """(K,) time since the last tick of the other train, s (inf for none)."""
+    out = np.full(times.size, np.inf)
+    for mine, other in ((index[0], index[1]), (index[1], index[0])):
+        j = np.searchsorted(times[other], times[mine]) - 1
+        out[mine] = np.where(j >= 0, times[mine] - times[other][np.maximum(j, 0)], np.inf)
+    return out
+
+
+def test_a_tick_in_another_metronomes_ring_is_timed_on_the_sum_of_the_sounds(overlapping):
+    recording, scan, truth, trains, index = overlapping
+    since = _since_another(truth, index)
+    ring = np.flatnonzero((since > det.RESOLUTION) & (since <= tp.AFTER))
+    assert ring.size >= 8
+    sounds = tp.learn(recording, scan, truth, trains)
+    assert all(s is not None and all(s.learned) for s in sounds)
+    # as the detector's onset rule times them: late by a millisecond or two
+    heard = truth.copy()
+    heard[ring] += np.linspace(1e-3, 2.5e-3, ring.size)
+    timed, likeness = tp.retime(recording, scan, heard, trains, sounds)
+    assert np.abs(timed[ring] - truth[ring]).max() < 0.3e-3
+    alone = since > tp.AFTER
+    np.testing.assert_array_equal(timed[alone], heard[alone])  # only those in a ring move
+    assert np.nanmin(likeness) > 0.5
+
+
+def test_a_sound_between_the_ticks_is_unlike_any_metronome(overlapping):
+    recording, scan, truth, trains, index = overlapping
+    sounds = tp.learn(recording, scan, truth, trains)
+    # halfway between two beats of the first metronome: the room's noise and ring
+    between = 0.5 * (truth[index[0][10:20]] + truth[index[0][11:21]])
+    between = between[np.min(np.abs(between[:, None] - truth[None, :]), axis=1) > 0.1]
+    assert between.size >= 3
+    _, likeness = tp.fit(recording, scan, between, [sounds[0]] * between.size,
+                         [[] for _ in between])  # fmt: skip
+    assert np.all(likeness < tp.MIN_LIKENESS)
