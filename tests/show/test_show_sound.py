@@ -108,6 +108,16 @@ def test_pan_follows_the_place_on_the_disk(pair_ds):
     assert l0 < 0.05 * r0
 
 
+def test_on_a_board_the_row_goes_from_left_to_right(board_ds):
+    run = RecordedRun.from_dataset(board_ds)
+    times = np.linspace(0.0, 10.0, 5)
+    np.testing.assert_array_equal(run.stereo_position(0, times), -1.0)
+    np.testing.assert_array_equal(run.stereo_position(1, times), 1.0)
+    alone = click_track(RecordedRun.from_dataset(board_ds.isel(metronome=[0])), end=3.0)
+    left, right = np.abs(alone.samples).sum(axis=0)
+    assert left > 0 and left == pytest.approx(right)  # one metronome alone: in the middle
+
+
 @pytest.mark.parametrize(
     ("options", "name"),
     [

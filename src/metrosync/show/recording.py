@@ -145,6 +145,16 @@ class RecordedRun:
         """(N,) angle α_i of each metronome on the disk at φ = 0, rad."""
         return 2 * np.pi * np.arange(self.n) / self.n
 
+    def stereo_position(self, i: int, times) -> np.ndarray:
+        """Where metronome ``i`` sits from left (−1) to right (1) at ``times``, for a
+        listener in front: on the disk its x, cos(α_i + φ), seen from above; on the
+        board its place in the row (the board's millimetres of motion are not heard)."""
+        times = np.asarray(times, dtype=float)
+        if self.platform == "board":
+            place = 2.0 * i / (self.n - 1) - 1.0 if self.n > 1 else 0.0
+            return np.full(times.shape, place)
+        return np.cos(self.rim_angles[i] + self.phi_at(times))
+
     def window(self, start: float | None = None, end: float | None = None) -> tuple[float, float]:
         """Check and complete a time window [start, end] inside the recording, s."""
         return check_window(start, end, float(self.time[0]), float(self.time[-1]))

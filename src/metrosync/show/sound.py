@@ -14,7 +14,8 @@ records the crossing is the root of the cubic Hermite interpolant built from θ 
 
 Each click starts at sample round(τ·rate), τ = (t − start)/speedup being its time in
 the audio, so it is within half a sample of the crossing. Metronome i is panned by
-its x position R cos(α_i + φ) on the disk seen from above (constant-power pan), and
+its x position R cos(α_i + φ) on the disk seen from above, or by its place in the row
+on a board, left to right (constant-power pan, `RecordedRun.stereo_position`), and
 has a pitch of its own so that the ear can tell them apart. Each click has the gain
 0.9/N, so the file never clips and a synchronized ensemble sounds louder, as it does
 in the room.
@@ -249,7 +250,7 @@ def click_track(
         tau = (times - start) / speedup
         audio_times.append(tau)
         onsets.append(np.round(tau * sample_rate).astype(np.int64))
-        left, right = pan_gains(np.cos(run.rim_angles[i] + run.phi_at(times)))
+        left, right = pan_gains(run.stereo_position(i, times))
         gains.append(gain * np.column_stack([left, right]))
         waveforms.append(click_waveform(pitches[i], sample_rate))
         if tick_sound == "realistic":
