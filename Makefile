@@ -11,16 +11,11 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
+# The package with what the tests and the documentation site need (the test and docs
+# extras): `make test` builds the site in a test, `make docs` builds it for reading.
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
-	touch $(STAMP)
-
-# The documentation tools (the `docs` extra), installed beside the package.
-DOCS_STAMP := $(VENV)/.installed-docs
-
-$(DOCS_STAMP): pyproject.toml $(STAMP)
 	$(BIN)/python -m pip install --quiet -e ".[test,docs]"
-	touch $(DOCS_STAMP)
+	touch $(STAMP)
 
 run: $(STAMP)
 	$(BIN)/metrosync reproduce --quick --out results
@@ -48,7 +43,7 @@ lint: $(STAMP)
 
 # The documentation site, into docs/_build/html, every gallery example run; any warning
 # is an error. Offline: MathJax comes from a package, the theme bundles its assets.
-docs: $(DOCS_STAMP)
+docs: $(STAMP)
 	$(BIN)/python -m sphinx -W --keep-going -q -b html docs docs/_build/html
 	@echo "open docs/_build/html/index.html"
 

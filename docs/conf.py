@@ -11,7 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
+if (ROOT / "src" / "metrosync").is_dir():  # the checkout's sources, installed or not
+    sys.path.insert(0, str(ROOT / "src"))
 
 import metrosync  # noqa: E402
 
@@ -69,6 +70,8 @@ sphinx_gallery_conf = {
     "min_reported_time": 0,
     "show_memory": False,
     "show_signature": False,
+    # Its computation-times page loads scripts from the web; each example shows its own time.
+    "write_computation_times": False,
 }
 
 # -- HTML -------------------------------------------------------------------------
@@ -82,6 +85,8 @@ html_theme_options = {
     "footer_start": ["copyright"],
     "footer_end": ["sphinx-version"],
 }
+# A first visit has no stored colour mode: start from the system's, not from none.
+html_context = {"default_mode": "auto"}
 html_sidebars = {"**": ["sidebar-nav-bs"]}
 html_show_sourcelink = False
 html_copy_source = False
