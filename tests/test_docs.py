@@ -71,3 +71,16 @@ def test_the_model_page_quotes_the_code_s_numbers():
         value = platform.disk_inertia(n)
         assert f"J({n}) = {value:.3g}" in text, n
     assert f"N × {platform.j_per_metronome:.6f} kg m²" in text
+
+
+def test_the_citation_file_cites_the_software_and_the_paper():
+    import yaml  # dask's dependency
+
+    import metrosync
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["type"] == "software" and cff["version"] == metrosync.__version__
+    (paper,) = cff["references"]
+    assert paper["title"] == "The rhythm of coupled metronomes" and paper["year"] == 2013
+    assert [a["family-names"] for a in paper["authors"]] == ["Boda", "Néda", "Tyukodi", "Tunyagi"]
+    assert paper["identifiers"][0]["value"] == "arXiv:1210.3175"
