@@ -56,7 +56,9 @@ def site(tmp_path_factory):
 def test_the_site_builds_with_no_warning(site):
     built = site["result"]
     assert built.returncode == 0, built.stderr[-4000:]
-    assert built.stderr.strip() == "", built.stderr[-4000:]
+    # A cold kernel cache says that it compiles them, once: a notice, not a warning.
+    said = [line for line in built.stderr.splitlines() if line.strip()]
+    assert not [line for line in said if "compiling kernels, once" not in line], built.stderr
 
 
 def test_the_gallery_has_at_least_twelve_questions_each_run_with_its_figure(site):
@@ -70,8 +72,7 @@ def test_the_gallery_has_at_least_twelve_questions_each_run_with_its_figure(site
 
 
 def test_each_example_runs_in_under_30_s(site):
-    """The gallery's own timing of each script (compiling the kernels, once, when the
-    cache is cold, is in the first example's)."""
+    """The gallery's own timing of each script (docs/conf.py compiles the kernels first)."""
     seconds = {}
     for script in EXAMPLES:
         text = (site["src"] / "gallery" / f"{script.stem}.rst").read_text()
@@ -79,9 +80,7 @@ def test_each_example_runs_in_under_30_s(site):
             r"running time of the script:\*\* \((\d+) minutes ([\d.]+) seconds\)", text
         ).groups()
         seconds[script.stem] = 60 * int(minutes) + float(secs)
-    compiling = 120.0  # a cold numba cache: the kernels take 30-100 s on the 2-core machine
-    first = EXAMPLES[0].stem  # the gallery runs them in file-name order
-    slow = {k: v for k, v in seconds.items() if v > 30.0 + (compiling if k == first else 0.0)}
+    slow = {name: s for name, s in seconds.items() if s > 30.0}
     assert not slow, slow
     assert sum(seconds.values()) > 5.0, seconds  # they did run
 
