@@ -81,6 +81,7 @@ def run_block(block: str, where: str) -> int:
 def test_the_pages_have_the_blocks_this_file_expects():
     assert len(BLOCKS) >= 4, "the pattern for ```python blocks found too few"
     assert any(where.startswith("docs/") for where in LOCATED.values())
+    assert any(where.startswith("README.md") for where in LOCATED.values())
     assert sum(quoted(line) is not None for b in BLOCKS for line in b.splitlines()) >= 3
 
 
