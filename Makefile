@@ -5,14 +5,16 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test lint bench clean system-deps firmware flash
+.PHONY: run test lint docs bench clean system-deps firmware flash
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
+# The package with what the tests and the documentation site need (the test and docs
+# extras): `make test` builds the site in a test, `make docs` builds it for reading.
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m pip install --quiet -e ".[test,docs]"
 	touch $(STAMP)
 
 run: $(STAMP)
@@ -36,10 +38,18 @@ flash:
 	$(MAKE) -C firmware/gate-logger flash
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
+	$(BIN)/mypy
+
+# The documentation site, into docs/_build/html, every gallery example run; any warning
+# is an error. Offline: MathJax comes from a package, the theme bundles its assets.
+docs: $(STAMP)
+	$(BIN)/python -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/kernel.py
 
 clean:
-	rm -rf $(VENV) results build *.egg-info firmware/gate-logger/build
+	rm -rf $(VENV) results build dist *.egg-info firmware/gate-logger/build \
+		docs/_build docs/gallery docs/sg_execution_times.rst

@@ -1,4 +1,5 @@
-"""The README and docs/model.md: links resolve, and the model page's numbers are the code's."""
+"""The README and the site's pages (docs/*.md): links resolve, every public name has its
+entry in the API reference, and the model page's numbers are the code's."""
 
 import re
 from pathlib import Path
@@ -8,7 +9,7 @@ from metrosync.paper import paper_sigma_to_bpm
 
 ROOT = Path(__file__).resolve().parents[1]
 MODEL = ROOT / "docs" / "model.md"
-DOCS = [ROOT / "README.md", MODEL]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def test_every_relative_link_resolves():
@@ -20,6 +21,22 @@ def test_every_relative_link_resolves():
     ]
     assert len(local) > 5, "hardly any relative links found: the pattern is wrong"
     assert not [link for page, link in local if not (page.parent / link).exists()]
+
+
+def test_the_api_page_names_every_public_name():
+    import metrosync
+
+    text = (ROOT / "docs" / "api.md").read_text()
+    documented = set(
+        re.findall(r"^\.\. (?:autofunction|autoclass|autoexception|py:data):: (\w+)", text, re.M)
+    )
+    assert set(metrosync.__all__) <= documented, set(metrosync.__all__) - documented
+
+
+def test_every_page_is_in_the_site_s_table_of_contents():
+    index = (ROOT / "docs" / "index.md").read_text()
+    pages = {p.stem for p in (ROOT / "docs").glob("*.md")} - {"index"}
+    assert not [page for page in pages if f"\n{page}\n" not in index]
 
 
 def test_the_readme_links_the_model_page_and_no_missing_notes():
@@ -54,3 +71,16 @@ def test_the_model_page_quotes_the_code_s_numbers():
         value = platform.disk_inertia(n)
         assert f"J({n}) = {value:.3g}" in text, n
     assert f"N × {platform.j_per_metronome:.6f} kg m²" in text
+
+
+def test_the_citation_file_cites_the_software_and_the_paper():
+    import yaml  # dask's dependency
+
+    import metrosync
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["type"] == "software" and cff["version"] == metrosync.__version__
+    (paper,) = cff["references"]
+    assert paper["title"] == "The rhythm of coupled metronomes" and paper["year"] == 2013
+    assert [a["family-names"] for a in paper["authors"]] == ["Boda", "Néda", "Tyukodi", "Tunyagi"]
+    assert paper["identifiers"][0]["value"] == "arXiv:1210.3175"

@@ -1,11 +1,14 @@
-"""Every Python block of the README runs on its own, as a reader pastes it into a fresh
-interpreter, and gives the values its comments quote.
+"""Every Python block of the README and of the documentation site's pages (docs/*.md)
+runs on its own, as a reader pastes it into a fresh interpreter, and gives the values
+its comments quote. (The gallery's scripts, examples/, run at every `make docs` and in
+tests/test_docs_site.py.)
 
 A block is run statement by statement in an empty namespace, in an empty folder.
 An expression statement whose comment quotes a result (``# ≈ 0.92, 0.99`` or
 ``# True: ...``) is evaluated and compared with it: numbers to the quoted decimals
 (one unit of the last digit either way), booleans exactly. The blocks run at the
-sizes printed; all of them together simulate about 3×10⁷ oscillator-steps.
+sizes printed; all of them together simulate about 3×10⁷ oscillator-steps. A block
+that appears on several pages runs once.
 """
 
 import ast
@@ -17,15 +20,21 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text()
-BLOCKS = re.findall(r"^```python\n(.*?)^```", README, flags=re.S | re.M)
+PAGES = [*sorted((ROOT / "docs").glob("*.md")), ROOT / "README.md"]
+PYTHON_BLOCK = re.compile(r"^```python\n(.*?)^```", flags=re.S | re.M)
+LOCATED: dict[str, str] = {}  # block -> "page:line" of its first appearance
+for _page in PAGES:
+    _text = _page.read_text()
+    for _match in PYTHON_BLOCK.finditer(_text):
+        _where = f"{_page.relative_to(ROOT)}:{_text[: _match.start()].count(chr(10)) + 2}"
+        LOCATED.setdefault(_match.group(1), _where)
+BLOCKS = list(LOCATED)
 QUOTED_NUMBERS = re.compile(r"#.*?≈\s*((?:-?\d+\.\d+(?:,\s*)?)+)")
 QUOTED_BOOL = re.compile(r"#\s*(True|False)\b")
 
 
 def block_id(block: str) -> str:
-    line = README[: README.index(block)].count("\n") + 1
-    return f"README.md:{line}"
+    return LOCATED[block]
 
 
 def quoted(source: str):
@@ -40,13 +49,13 @@ def quoted(source: str):
 
 def check_quote(value, quote, where: str) -> None:
     if isinstance(quote, bool):
-        assert bool(value) is quote, f"{where}: got {value!r}, the README says {quote}"
+        assert bool(value) is quote, f"{where}: got {value!r}, the page says {quote}"
         return
     got = np.ravel(np.asarray(value, dtype=float))
-    assert got.size == len(quote), f"{where}: got {got}, the README quotes {quote}"
+    assert got.size == len(quote), f"{where}: got {got}, the page quotes {quote}"
     for x, text in zip(got, quote, strict=True):
         decimals = len(text.split(".")[1])
-        assert abs(x - float(text)) <= 10.0**-decimals, f"{where}: got {got}, README: {quote}"
+        assert abs(x - float(text)) <= 10.0**-decimals, f"{where}: got {got}, the page: {quote}"
 
 
 def run_block(block: str, where: str) -> int:
@@ -59,7 +68,7 @@ def run_block(block: str, where: str) -> int:
         quote = quoted(source)
         if isinstance(statement, ast.Expr):
             code = compile(ast.Expression(statement.value), where, "eval")
-            value = eval(code, namespace)  # noqa: S307 - the README's own code
+            value = eval(code, namespace)  # noqa: S307 - the page's own code
             if quote is not None:
                 check_quote(value, quote, f"{where}+{statement.lineno - 1}")
                 checked += 1
@@ -69,8 +78,10 @@ def run_block(block: str, where: str) -> int:
     return checked
 
 
-def test_the_readme_has_the_blocks_this_file_expects():
+def test_the_pages_have_the_blocks_this_file_expects():
     assert len(BLOCKS) >= 4, "the pattern for ```python blocks found too few"
+    assert any(where.startswith("docs/") for where in LOCATED.values())
+    assert any(where.startswith("README.md") for where in LOCATED.values())
     assert sum(quoted(line) is not None for b in BLOCKS for line in b.splitlines()) >= 3
 
 
@@ -87,9 +98,9 @@ def test_each_python_block_runs_on_its_own(block, tmp_path, monkeypatch):
 
 
 def test_a_wrong_quote_is_caught():
-    with pytest.raises(AssertionError, match="README"):
+    with pytest.raises(AssertionError, match="the page"):
         run_block("x = 0.5\nx + 0.1   # ≈ 0.50\n", "example")
-    with pytest.raises(AssertionError, match="README says True"):
+    with pytest.raises(AssertionError, match="the page says True"):
         run_block("1 > 2   # True: of course not\n", "example")
     with pytest.raises(NameError):
         run_block("ms.simulate\n", "example")  # a name only an earlier block defines

@@ -85,7 +85,8 @@ def simulate(
     trajectories : also keep θ, θ̇, φ, φ̇ at each record.
     equilibrium_window : length (s) of the final window averaged for r_eq;
         default a quarter of ``duration``.
-    overturn_angle : |θ| beyond which a run is flagged overturned, rad.
+    overturn_angle : the angle (rad) beyond which a run is flagged overturned: a
+        metronome with ``abs(theta)`` above it.
     progress : show a progress bar; default when stderr is a terminal.
 
     Returns

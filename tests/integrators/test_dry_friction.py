@@ -235,14 +235,14 @@ def test_disk_at_rest_is_the_fraction_of_the_final_window_the_disk_is_held(integ
 
 
 @pytest.mark.slow
-def test_the_readme_table_of_dry_friction_is_what_its_command_gives():
-    """The README's row for T = 0.03 N m, re-run with its command's settings (seconds)."""
+def test_the_docs_table_of_dry_friction_is_what_its_command_gives():
+    """The docs' row for T = 0.03 N m, re-run with its command's settings (seconds)."""
     import re
     from pathlib import Path
 
-    readme = (Path(__file__).parents[2] / "README.md").read_text()
+    readme = (Path(__file__).parents[2] / "docs" / "beyond.md").read_text()
     row = re.search(r"^\| 0\.03 \| (\d+) % \| (0\.\d\d) ± (0\.\d\d) \|$", readme, re.MULTILINE)
-    assert row, "the README's dry-friction table has no row for T = 0.03"
+    assert row, "docs/beyond.md's dry-friction table has no row for T = 0.03"
     command = "--runs 10 --duration 300 \\\n    --window 100 --seed 0 --set disk_dry_friction="
     assert command in readme
     ds = simulate(7, 184, sigma_bpm=0.75, runs=10, duration=300, equilibrium_window=100,

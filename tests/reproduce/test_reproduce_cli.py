@@ -67,20 +67,20 @@ def test_a_local_cluster_gives_the_in_process_numbers(tmp_path):
     assert there.cached_points == 0 and there.points == 6
 
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+DOCS = Path(__file__).resolve().parents[2] / "docs"
 
 
 def flat(text: str) -> str:
     return " ".join(text.split())
 
 
-def test_help_readme_and_report_quote_the_same_measured_cost(tiny, capsys):
+def test_help_docs_and_report_quote_the_same_measured_cost(tiny, capsys):
     from metrosync.paper.studies import MEASURED_COST
 
     with pytest.raises(SystemExit):
         main(["reproduce", "--help"])
     shown = flat(capsys.readouterr().out)
-    readme = flat(README.read_text())
+    readme = flat((DOCS / "reproducing.md").read_text())
     report = flat(tiny.report.read_text())
     for mode, cost in MEASURED_COST.items():
         assert flat(cost) in shown, mode
@@ -90,9 +90,9 @@ def test_help_readme_and_report_quote_the_same_measured_cost(tiny, capsys):
         assert stale not in shown
 
 
-def test_readme_names_the_sweep_store_that_is_written(tmp_path, capsys):
+def test_the_docs_name_the_sweep_store_that_is_written(tmp_path, capsys):
     out = tmp_path / "sw.nc"
     args = ["sweep", "--bpm", "185,190", "--runs", "1", "--duration", "5", "--no-progress"]
     assert main([*args, "--out", str(out)]) == 0
     assert len(list((tmp_path / "sw.points" / "points").glob("*.nc"))) == 2
-    assert "`sw.points/points/<hash>.nc`" in flat(README.read_text())
+    assert "`sw.points/points/<hash>.nc`" in flat((DOCS / "sweeps.md").read_text())

@@ -685,7 +685,7 @@ def test_every_asset_ships_in_the_wheel():
         assert any(fnmatch.fnmatch(name, g) for g in globs), name
 
 
-# -- what the README's "In the classroom" promises, in the model the page runs --------
+# -- what the classroom page's "In the classroom" promises, in the model the page runs --------
 
 
 def test_raising_sigma_breaks_the_synchrony():

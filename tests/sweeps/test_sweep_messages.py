@@ -81,8 +81,11 @@ def test_status_bits_are_documented_in_one_public_place():
 
     for bit, name in status.SWEEP_FLAG_MEANINGS.items():
         assert f"{bit}      {name}" in status.__doc__
-    readme = (__import__("pathlib").Path(__file__).parents[2] / "README.md").read_text()
-    assert "[`metrosync.status`](src/metrosync/status.py)" in readme
+    docs = __import__("pathlib").Path(__file__).parents[2] / "docs"
+    for page in ("getting-started.md", "sweeps.md"):  # the dataset's and the sweep's pages
+        assert "every bit" in (docs / page).read_text() and "`metrosync.status`" in (
+            docs / page
+        ).read_text()
 
 
 def test_a_value_just_past_the_tunable_range_reads_as_outside_it(tmp_path, capsys):

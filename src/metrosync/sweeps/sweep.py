@@ -117,9 +117,9 @@ def sweep(
 
     Parameters
     ----------
-    grid : a `Grid`, or its swept axes (name -> values, e.g. ``{"bpm": "150:220:2.5",
-        "n": [7, 16]}``), completed by ``fixed`` and ``grid_options`` (``seed``,
-        ``preset``, ``keep_r``, ... see `Grid`).
+    grid : a `Grid`, or its swept axes (name -> values)
+        For example ``{"bpm": "150:220:2.5", "n": [7, 16]}``, completed by ``fixed``
+        and ``grid_options`` (``seed``, ``preset``, ``keep_r``, ... see `Grid`).
     store : directory of finished points; reused across calls and across grids.
     out : also write the merged dataset to this NetCDF file (atomically).
     scheduler : None (in process), ``"local"`` (Dask LocalCluster on loopback) or
