@@ -204,19 +204,21 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     owner = tp.owners(ticks.time, trains)
     held = np.flatnonzero(owner >= 0)
     held = held[[sounds[owner[i]] is not None for i in held]]
-    want_m, want_n, want_t = [], [], []
+    metronomes: list[int] = []
+    beats: list[np.ndarray] = []
+    times: list[np.ndarray] = []
     for m, train in enumerate(trains):
         if sounds[m] is None:
             continue
         for beyond in (0, END_BEATS):
             n, p = _predictions(ticks.time, train, beyond)
             ok = (p > lo) & (p < hi)
-            want_m += [m] * int(ok.sum())
-            want_n.append(n[ok])
-            want_t.append(p[ok])
-    if not want_m:
+            metronomes += [m] * int(ok.sum())
+            beats.append(n[ok])
+            times.append(p[ok])
+    if not metronomes:
         return ticks, trains, 0
-    want_m, want_n, want_t = np.array(want_m), np.concatenate(want_n), np.concatenate(want_t)
+    want_m, want_n, want_t = np.array(metronomes), np.concatenate(beats), np.concatenate(times)
     order = np.argsort(want_t)
     want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
     own = [sounds[m] for m in want_m]

@@ -129,7 +129,7 @@ def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound
         order = np.argsort(starts)
         waves = _filtered(recording, scan, starts[order], before + after)
         kinds = parity[use][order]
-        learned = tuple(bool((kinds == k).sum() >= MIN_CLEAR) for k in (0, 1))
+        learned = (bool((kinds == 0).sum() >= MIN_CLEAR), bool((kinds == 1).sum() >= MIN_CLEAR))
         both = waves.mean(axis=0)
         two = [waves[kinds == k].mean(axis=0) if learned[k] else both for k in (0, 1)]
         out.append(Sound(np.array(two), before, learned))

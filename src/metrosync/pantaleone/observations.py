@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -103,6 +104,7 @@ def pair_starts(
     params = get_preset(PRESET, warn=False)
     if changes:
         params = params.with_changes(**changes)
+    pair: dict[str, Any]
     if metronome is None:
         pair = {"frequencies_bpm": [BPM, BPM]}
         amplitude, omega = steady_amplitude(params), float(bpm_to_omega(BPM))

@@ -309,11 +309,11 @@ class BoardView(DiskView):
         self.board.set_x(x - self.length / 2)
         marks, turn = [], x / (2 * self.CAN)
         for side, can in zip((-1, 1), self.cans, strict=True):
-            centre = np.array([side * 0.3 * self.length + x / 2, self.CAN])
+            centre = (float(side * 0.3 * self.length + x / 2), float(self.CAN))
             can.set_center(centre)
             # turning clockwise as it rolls to +x
             u = self.CAN * np.array([np.cos(-turn), np.sin(-turn)])
-            marks.append([centre - u, centre + u])
+            marks.append([np.subtract(centre, u), np.add(centre, u)])
         self.can_marks.set_segments(marks)
         n = self.run.n
         pivot = np.stack([x + (np.arange(n) - (n - 1) / 2) * self.spacing,
