@@ -105,6 +105,13 @@ def _offset(values) -> float:
     return float(flat[np.argmax(np.abs(flat))])
 
 
+def _platform_dry_friction(platform) -> Found | None:
+    """The platform's Coulomb friction, named by its own parameter, when it is on."""
+    name = platform.dry_friction_parameter
+    value = getattr(platform, name)
+    return (name, value, platform.units()[name]) if value > 0 else None
+
+
 FEATURES: dict[str, Feature] = {
     f.name: f
     for f in (
@@ -165,13 +172,7 @@ FEATURES: dict[str, Feature] = {
             summary="Coulomb (dry) friction on the platform: it sticks and slips",
             lacks="no dry friction on the platform",
             example={"disk_dry_friction": 5e-3},
-            from_params=lambda p: (
-                ("disk_dry_friction", p.platform.disk_dry_friction, "N m")
-                if p.platform.disk_dry_friction > 0
-                else ("board_dry_friction", p.platform.board_dry_friction, "N")
-                if p.platform.board_dry_friction > 0
-                else None
-            ),
+            from_params=lambda p: _platform_dry_friction(p.platform),
             from_system=lambda s: (
                 ("disk_dry_friction", _largest(s.dry_friction), "N m")
                 if np.any(s.dry_friction > 0)

@@ -304,14 +304,13 @@ def check_damping_step(dt: float, ensemble: Ensemble) -> None:
     scheme would turn into a divergence."""
     rate = damping_rate(ensemble.system)
     if rate * dt > MAX_DAMPING_PER_STEP:
-        board = ensemble.params.platform.platform == "board"
-        name = "board_damping" if board else "c_phi"
-        value = ensemble.params.platform.board_damping if board else ensemble.params.platform.c_phi
+        platform = ensemble.params.platform
+        name = platform.damping_parameter
         raise ParameterError(
-            f"`{name}` = {value!r} damps the {'board' if board else 'disk'} at {rate:.3g} /s, "
-            f"too fast for the step `dt` = {dt!r} s (a fixed-step scheme needs rate x dt <= "
-            f"{MAX_DAMPING_PER_STEP:g}): use dt <= {MAX_DAMPING_PER_STEP / rate:.3g} s, or "
-            f"integrator='exact'."
+            f"`{name}` = {getattr(platform, name)!r} damps the {platform.platform} at "
+            f"{rate:.3g} /s, too fast for the step `dt` = {dt!r} s (a fixed-step scheme needs "
+            f"rate x dt <= {MAX_DAMPING_PER_STEP:g}): use dt <= "
+            f"{MAX_DAMPING_PER_STEP / rate:.3g} s, or integrator='exact'."
         )
 
 

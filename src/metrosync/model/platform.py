@@ -200,6 +200,17 @@ class Platform:
         return self.radius if self.platform == "disk" else 1.0
 
     @property
+    def damping_parameter(self) -> str:
+        """The field that damps this platform viscously: ``c_phi`` or ``board_damping``."""
+        return "c_phi" if self.platform == "disk" else "board_damping"
+
+    @property
+    def dry_friction_parameter(self) -> str:
+        """The field of this platform's Coulomb friction: ``disk_dry_friction`` or
+        ``board_dry_friction``."""
+        return f"{self.platform}_dry_friction"
+
+    @property
     def inertia_per_metronome(self) -> float:
         """What each metronome's case adds to J_p: ``j_per_metronome`` (kg m²) on the
         disk's law, ``box_mass`` (kg) on the board."""
@@ -220,8 +231,8 @@ class Platform:
         return PlatformTerms(
             lever=self.lever,
             own_inertia=self.own_inertia(n),
-            damping=self.c_phi if disk else self.board_damping,
-            dry_friction=self.disk_dry_friction if disk else self.board_dry_friction,
+            damping=getattr(self, self.damping_parameter),
+            dry_friction=getattr(self, self.dry_friction_parameter),
             forcing_amplitude=self.forcing_amplitude,
             escapement_reaction=self.escapement_reaction if disk else False,
         )

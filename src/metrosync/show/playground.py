@@ -35,6 +35,7 @@ from ..capabilities import require
 from ..ensemble import MAX_DAMPING_PER_STEP
 from ..errors import ParameterError, describe, shown_range
 from ..model import PRESETS, ModelParameters, get_preset
+from ..model.quantity import declared
 
 #: The page's scripts, in the order they run (each uses those before it).
 SCRIPTS = ("physics.js", "session.js", "view.js", "audio.js", "app.js")
@@ -247,15 +248,15 @@ def _check_damping_step(params: ModelParameters, n: int, bpm: float, dt: float) 
     rate = damping_rate(params, n, bpm)
     if rate * dt <= MAX_DAMPING_PER_STEP:
         return
-    board = params.platform.platform == "board"
-    name, unit = ("board_damping", "kg/s") if board else ("c_phi", "kg m²/s")
-    value = getattr(params.platform, name)
+    platform = params.platform
+    name = platform.damping_parameter
+    unit, value = declared(platform, name), getattr(platform, name)
     fixes = f"lower it to at most {value * MAX_DAMPING_PER_STEP / (rate * dt):.3g} {unit}"
     finer = MAX_DAMPING_PER_STEP / rate
     if finer >= MIN_DT:
         fixes += f", or give `dt` <= {finer:.3g} s"
     raise ParameterError(
-        f"`{name}` = {value!r} {unit} damps the {'board' if board else 'disk'} at {rate:.3g} /s, "
+        f"`{name}` = {value!r} {unit} damps the {platform.platform} at {rate:.3g} /s, "
         f"too fast for the step `dt` = {dt:g} s (the page's step needs rate x dt <= "
         f"{MAX_DAMPING_PER_STEP:g}, or it diverges): {fixes}."
     )
