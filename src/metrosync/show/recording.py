@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -178,11 +179,12 @@ class RecordedRun:
         """(K, N) analytic phase atan2(−θ̇/ω, θ) at ``times``, rad in (−π, π]."""
         return np.arctan2(-self.theta_dot_at(times) / self.omega, self.theta_at(times))
 
-    @property
+    @cached_property
     def phi_trend(self) -> tuple[float, float]:
         """(a, b) of the straight line a + b t fitted to φ(t) over the recording: the
         board's mean motion. Without damping the board keeps the momentum its start
-        gave it and drifts at a steady speed; drawn about this line it stays in view."""
+        gave it and drifts at a steady speed; drawn about this line it stays in view.
+        Fitted once: an animation asks for it every frame."""
         if self.time.size < 2:
             return float(self.phi[0]), 0.0
         slope, intercept = np.polyfit(self.time - self.time[0], self.phi, 1)
