@@ -31,6 +31,7 @@ import numpy as np
 from ..model import Metronome, get_preset
 from ..model.metronome import bpm_to_omega
 from ..model.steady_swing import steady_swing
+from ..observables.entrainment import upward_crossings
 from ..simulate import simulate
 from ..theory._coupling_base import tuned_metronome
 
@@ -51,6 +52,12 @@ DT = 0.005
 def steady_amplitude(params=PRESET, bpm: float = BPM) -> float:
     """The swing of a free metronome of ``params`` marked ``bpm``, rad."""
     return steady_swing(tuned_metronome(bpm, get_preset(params, warn=False))[0]).amplitude
+
+
+def board(changes: dict | None = None):
+    """His board (`PRESET`), with ``changes`` (a heavier board, a damped one)."""
+    params = get_preset(PRESET, warn=False)
+    return params.with_changes(**changes) if changes else params
 
 
 @dataclass(frozen=True)
@@ -101,9 +108,7 @@ def pair_starts(
     """Two identical metronomes on the board from ``starts`` starts at the steady
     swing: at random phases, or within ±30° of anti-phase (``near_anti_phase``); marked
     `BPM`, or two copies of ``metronome`` when it is given."""
-    params = get_preset(PRESET, warn=False)
-    if changes:
-        params = params.with_changes(**changes)
+    params = board(changes)
     pair: dict[str, Any]
     if metronome is None:
         pair = {"frequencies_bpm": [BPM, BPM]}
@@ -131,11 +136,6 @@ def pair_starts(
     return PairStarts(np.array(times), np.array(finals), duration, np.array(lags))
 
 
-def _upward_crossings(theta: np.ndarray, time: np.ndarray) -> np.ndarray:
-    k = np.flatnonzero((theta[:-1] < 0) & (theta[1:] >= 0))
-    return time[k] - theta[k] * (time[k + 1] - time[k]) / (theta[k + 1] - theta[k])
-
-
 @dataclass(frozen=True)
 class Lag:
     """A detuned pair: ``detuning_bpm`` between their markings, whether they locked,
@@ -158,9 +158,7 @@ def pair_lag(
     """Two metronomes marked ``BPM ± detuning/2`` (the first the faster), started in
     phase, measured over the last ``window`` seconds."""
     frequencies = [BPM + detuning_bpm / 2, BPM - detuning_bpm / 2]
-    params = get_preset(PRESET, warn=False)
-    if changes:
-        params = params.with_changes(**changes)
+    params = board(changes)
     amplitude = steady_amplitude(params)
     ds = simulate(
         None, None, frequencies_bpm=frequencies, preset=params, integrator="located",
@@ -170,7 +168,7 @@ def pair_lag(
     time = ds.time.values
     keep = time >= time[-1] - window
     theta = ds.theta.values[keep, 0, :]
-    first, second = (_upward_crossings(theta[:, i], time[keep]) for i in range(2))
+    first, second = (upward_crossings(time[keep], theta[:, i]) for i in range(2))
     period = float(np.mean(np.diff(first)))
     if abs(len(first) - len(second)) > 1 or len(first) < 4:
         return Lag(detuning_bpm, False, math.nan, math.nan)

@@ -51,6 +51,7 @@ from ..errors import ParameterError
 from ..model import ModelParameters, get_preset
 from ..model.steady_swing import relaxation_rate, steady_swing
 from ..model.tuning import l2_for_bpm, with_tuning
+from ..observables.entrainment import upward_crossings
 from ..observables.order import crossing_phase
 from ..simulate import simulate
 from ._coupling_base import Coupling, disk_scale, tuned_metronome
@@ -86,14 +87,9 @@ def _free_omega(metronome, swing, params: ModelParameters, dt: float) -> float:
         record_every=max(1, int(round(2.5e-3 / dt))),
         progress=False,
     )
-    ticks = _upward_crossings(ds.theta.values[:, 0, 0], ds.time.values)
+    ticks = upward_crossings(ds.time.values, ds.theta.values[:, 0, 0])
     ticks = ticks[ticks > 20.0]
     return 2 * np.pi * (ticks.size - 1) / (ticks[-1] - ticks[0])
-
-
-def _upward_crossings(theta: np.ndarray, t: np.ndarray) -> np.ndarray:
-    i = np.nonzero((theta[:-1] < 0) & (theta[1:] >= 0))[0]
-    return t[i] + (t[i + 1] - t[i]) * (-theta[i]) / (theta[i + 1] - theta[i])
 
 
 def _line(x, y):
@@ -154,7 +150,7 @@ def measure_by_growth(
     )
     t, theta = ds.time.values, ds.theta.values[:, 0, :]
     grid = np.arange(t_min, t[-1] - 2.0, 0.05)
-    phases = np.stack([crossing_phase(_upward_crossings(theta[:, i], t), grid) for i in range(n)])
+    phases = np.stack([crossing_phase(upward_crossings(t, theta[:, i]), grid) for i in range(n)])
     z = np.mean(np.exp(1j * phases), axis=0)
     r = np.abs(z)
     past = np.nonzero(r > r_max)[0]
@@ -213,7 +209,7 @@ def _locked_pair(bpm, detune, params, dt, start_lag, duration=300.0):
         progress=False,
     )
     t = ds.time.values
-    first, second = (_upward_crossings(ds.theta.values[:, 0, i], t) for i in range(2))
+    first, second = (upward_crossings(t, ds.theta.values[:, 0, i]) for i in range(2))
     keep = first[(first > duration / 2) & (first > second[0]) & (first < second[-1])]
     k = np.searchsorted(second, keep) - 1
     lead = np.exp(2j * np.pi * (keep - second[k]) / (second[k + 1] - second[k]))
