@@ -254,19 +254,9 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     index_of = np.empty(chosen.size, dtype=np.int64)
     index_of[close[chosen]] = near[reuse]
     index_of[~close[chosen]] = ticks.time.size + np.arange(fresh.size)
-    order = np.argsort(merged["time"], kind="stable")
-    new_ticks = det.Ticks(*(merged[f][order] for f in fields))
-    where = np.empty(order.size, dtype=np.int64)
-    where[order] = np.arange(order.size)
-    out = []
-    for m, train in enumerate(trains):
-        mine = want_m[chosen] == m
-        index = np.concatenate([train.index, index_of[mine]])
-        number = np.concatenate([train.beat, want_n[chosen][mine]])
-        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
-        k = np.argsort(number, kind="stable")
-        # a beat found before the first counts from 0 again
-        out.append(Train(where[index[k]], number[k] - number[k[0]], train.period, masked[k]))
+    # a beat found before the first counts from 0 again
+    new_ticks, out = _merged(merged, trains, index_of, want_m[chosen], want_n[chosen],
+                             from_first=True)  # fmt: skip
     return new_ticks, out, int(fresh.size)
 
 
@@ -308,21 +298,31 @@ def _pass(recording, scan, ticks, trains: list[Train]):
         return ticks, trains, 0, taken
     fields = det.Ticks.__dataclass_fields__
     merged = {f: np.concatenate([getattr(ticks, f), getattr(found, f)[near]]) for f in fields}
+    added_index = ticks.time.size + np.arange(int(near.sum()))
+    new_ticks, new_trains = _merged(merged, trains, added_index, owner[near], beat[near],
+                                    from_first=False)  # fmt: skip
+    return new_ticks, new_trains, int(near.sum()), taken
+
+
+def _merged(merged: dict, trains: list[Train], index, owner, beat, *, from_first: bool):
+    """The ticks of ``merged`` (the detector's fields, the old ticks then the added)
+    sorted by time, and each train with the ticks ``index`` that ``owner`` gives it at
+    their ``beat``s, renumbered from its first beat when ``from_first``."""
+    fields = det.Ticks.__dataclass_fields__
     order = np.argsort(merged["time"], kind="stable")
     new_ticks = det.Ticks(*(merged[f][order] for f in fields))
     where = np.empty(order.size, dtype=np.int64)
     where[order] = np.arange(order.size)
-    base = ticks.time.size
-    added_index = base + np.arange(int(near.sum()))
-    new_trains = []
+    out = []
     for m, train in enumerate(trains):
-        mine = owner[near] == m
-        index = np.concatenate([train.index, added_index[mine]])
-        number = np.concatenate([train.beat, beat[near][mine]])
+        mine = owner == m
+        numbers = np.concatenate([train.beat, beat[mine]])
         masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
-        k = np.argsort(number, kind="stable")
-        new_trains.append(Train(where[index[k]], number[k], train.period, masked[k]))
-    return new_ticks, new_trains, int(near.sum()), taken
+        k = np.argsort(numbers, kind="stable")
+        first = numbers[k[0]] if from_first else 0
+        at = np.concatenate([train.index, index[mine]])[k]
+        out.append(Train(where[at], numbers[k] - first, train.period, masked[k]))
+    return new_ticks, out
 
 
 def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
