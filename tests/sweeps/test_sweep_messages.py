@@ -83,9 +83,8 @@ def test_status_bits_are_documented_in_one_public_place():
         assert f"{bit}      {name}" in status.__doc__
     docs = __import__("pathlib").Path(__file__).parents[2] / "docs"
     for page in ("getting-started.md", "sweeps.md"):  # the dataset's and the sweep's pages
-        assert "every bit" in (docs / page).read_text() and "`metrosync.status`" in (
-            docs / page
-        ).read_text()
+        text = (docs / page).read_text()
+        assert "every bit" in text and "`metrosync.status`" in text
 
 
 def test_a_value_just_past_the_tunable_range_reads_as_outside_it(tmp_path, capsys):
