@@ -18,7 +18,7 @@ def test_full_grids_sweep_the_large_sizes_around_the_onset(name, sigma):
     assert grid.integrator == "located"
     assert grid.axes["n"] == (64, 256, 1024, 4096)
     assert grid.fixed["sigma_bpm"] == sigma
-    assert grid.fixed["runs"] >= 200
+    assert grid.target_error <= 0.01 and grid.max_runs >= 336  # a spread of 0.18 near the onset
     assert grid.fixed["dt"] <= 0.02  # located at 0.04 loses the onset (REPORT.md)
     bpm = np.array(grid.axes["bpm"])
     assert bpm.size >= 7 and np.ptp(bpm) >= 20

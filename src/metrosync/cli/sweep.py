@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from .._words import plural
@@ -54,6 +55,22 @@ def register(subparsers) -> None:
                    metavar="N@BPM[:SIGMA]",
                    help="a group of N metronomes at BPM (repeat for several; replaces --n "
                    "and --bpm); sweep --group-offset-bpm to move the groups apart")  # fmt: skip
+    a = parser.add_argument_group("runs until the error is small enough")
+    a.add_argument(
+        "--target-error",
+        type=target_error,
+        default=None,
+        metavar="SE",
+        help="run each point in batches of --runs until the standard error of its "
+        "mean r_eq is at most SE (e.g. 0.01); 'none' turns a grid file's off",
+    )
+    a.add_argument(
+        "--max-runs",
+        type=int,
+        default=None,
+        metavar="RUNS",
+        help="most runs a point grows to with --target-error (default: 8 x --runs)",
+    )
     o = parser.add_argument_group("run")
     o.add_argument("--out", type=Path, required=True, help="merged result, FILE.nc")
     o.add_argument("--store", type=Path, default=None,
@@ -66,8 +83,25 @@ def register(subparsers) -> None:
     o.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_aliases(parser, sigma_bpm="--sigma", n_workers="--workers", scheduler="--scheduler",
                 groups="--group", n="--n", bpm="--bpm",
-                group_offset_bpm="--group-offset-bpm")  # fmt: skip
+                group_offset_bpm="--group-offset-bpm", target_error="--target-error",
+                max_runs="--max-runs")  # fmt: skip
     parser.set_defaults(func=run)
+
+
+#: ``--target-error none``: a grid file's target turned off (runs fixed by --runs).
+NO_TARGET = object()
+
+
+def target_error(text: str):
+    """``--target-error``: a standard error, or ``none``."""
+    if text.strip().lower() == "none":
+        return NO_TARGET
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"takes a standard error such as 0.01, or none; got {text!r}"
+        ) from None
 
 
 def grid_from_args(args):
@@ -101,6 +135,12 @@ def grid_from_args(args):
         options["preset"] = args.preset
     if args.groups:
         options["groups"] = args.groups
+    if args.target_error is NO_TARGET:  # a grid file's target and cap, both off
+        options.update(target_error=None, max_runs=args.max_runs)
+    elif args.target_error is not None:
+        options["target_error"] = args.target_error
+    if args.max_runs is not None:
+        options["max_runs"] = args.max_runs
     if args.grid is not None:
         return Grid.from_toml(args.grid, axes=axes, fixed=fixed, **options)
     if not axes:

@@ -36,6 +36,7 @@ from scipy.signal import savgol_filter
 from .. import interrupts
 from ..budget import Budget
 from ..errors import ParameterError
+from .resample import resample_runs
 
 METHODS = ("peak", "rise")
 #: Grid points in the local quadratic fit that gives the slope of r̄(ω₀).
@@ -115,18 +116,17 @@ def bootstrap(
     """Bootstrap replicas of both estimators: ``{"peak": (n_boot,), "rise": (n_boot,)}``.
 
     r_runs : (K, B) per-run r_eq at each of the K frequencies; runs are resampled
-    independently at each frequency (they are independent simulations).
+    independently at each frequency (they are independent simulations), each among
+    its own finite runs (`metrosync.sweeps.resample`).
     """
     r_runs = np.asarray(r_runs, dtype=float)
     rng = np.random.default_rng(seed)
-    runs = r_runs.shape[-1]
     # In batches, so that memory stays bounded for many runs and replicas.
     batch = max(1, BATCH_VALUES // r_runs.size)
     parts: dict[str, list[np.ndarray]] = {m: [] for m in METHODS}
     for start in range(0, n_boot, batch):
         interrupts.check()
-        idx = rng.integers(0, runs, size=(min(batch, n_boot - start), *r_runs.shape))
-        replicas = np.take_along_axis(np.broadcast_to(r_runs, idx.shape), idx, axis=-1)
+        replicas = resample_runs(r_runs, rng, (min(batch, n_boot - start), *r_runs.shape))
         for m, values in estimate(bpm, replicas).items():
             parts[m].append(values)
     return {m: np.concatenate(parts[m]) for m in METHODS}

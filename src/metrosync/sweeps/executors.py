@@ -67,6 +67,16 @@ class Execution:
         """Oscillator-steps per second of wall time."""
         return self.work / self.seconds if self.seconds > 0 else float("nan")
 
+    def then(self, later: Execution) -> Execution:
+        """This execution followed by ``later`` (a sweep's rounds, added up)."""
+        return Execution(
+            self.computed + later.computed,
+            {**self.failed, **later.failed},
+            {**self.lost, **later.lost},
+            self.seconds + later.seconds,
+            self.work + later.work,
+        )
+
 
 def run_point(spec: PointSpec, threads: int | None = None):
     """Simulate one point; returns (point dataset, seconds, host). Never raises for a

@@ -93,7 +93,11 @@ OPTIONS: dict[str, Any] = {
     "integrator": "verlet",
     "backend": "numba",
     "groups": None,
+    "target_error": None,
+    "max_runs": None,
 }
+#: Batches of `runs` a point may grow to when ``max_runs`` is not given.
+DEFAULT_MAX_BATCHES = 8
 
 
 def canonical_name(name: str) -> str:
@@ -222,6 +226,10 @@ class Grid:
         in place of ``n`` and ``bpm``; then ``group_offset_bpm`` (swept or fixed) adds
         to the BPM of every group after the first, and ``sigma_bpm`` is the spread of
         the groups that give none.
+    target_error : run each point until the standard error of its mean r_eq is at
+        most this (`metrosync.sweeps.adaptive`): ``runs`` is then the batch that a
+        point starts with and grows by, up to ``max_runs`` (default
+        `DEFAULT_MAX_BATCHES` batches). None: ``runs`` runs a point.
     """
 
     axes: Mapping[str, Any]
@@ -234,6 +242,8 @@ class Grid:
     integrator: str = "verlet"
     backend: str = "numba"
     groups: Any = None
+    target_error: float | None = None
+    max_runs: int | None = None
 
     def __post_init__(self) -> None:
         axes: dict[str, tuple] = {}
@@ -261,6 +271,46 @@ class Grid:
         object.__setattr__(self, "fixed", fixed)
         get_preset(self.preset, warn=False)  # an unknown preset fails here, not per point
         self._check_model()
+        self._check_target()
+
+    def _check_target(self) -> None:
+        """Check ``target_error`` and ``max_runs``, and complete ``max_runs``."""
+        target, cap = self.target_error, self.max_runs
+        if target is None:
+            if cap is not None:
+                raise ParameterError(
+                    f"`max_runs` = {cap!r} caps the runs added to reach `target_error`: give "
+                    f"`target_error` too (e.g. 0.01), or set `runs` instead."
+                )
+            return
+        if (
+            isinstance(target, bool)
+            or not isinstance(target, int | float)
+            or not (math.isfinite(target) and target > 0)
+        ):
+            raise ParameterError(
+                f"`target_error` is the standard error of a point's mean r_eq to reach, a "
+                f"number > 0 such as 0.01; got {describe(target)}."
+            )
+        if "runs" in self.axes:
+            raise ParameterError(
+                "with `target_error` each point chooses its own number of runs: fix `runs` "
+                "(the batch it starts with and grows by) instead of sweeping it."
+            )
+        batch = self.fixed["runs"]
+        if batch < 2:
+            raise ParameterError(
+                f"with `target_error`, `runs` is the first batch of each point and needs at "
+                f"least 2 runs to estimate the spread, got {batch}."
+            )
+        if cap is None:
+            cap = DEFAULT_MAX_BATCHES * batch
+        if isinstance(cap, bool) or not isinstance(cap, int | np.integer) or cap < batch:
+            raise ParameterError(
+                f"`max_runs` must be a whole number >= `runs` ({batch}), got {describe(cap)}."
+            )
+        object.__setattr__(self, "target_error", float(target))
+        object.__setattr__(self, "max_runs", int(cap))
 
     def _check_groups(self, axes, fixed) -> None:
         if self.groups is None:
@@ -359,7 +409,13 @@ class Grid:
             coords = {name: self.axes[name][i] for name, i in zip(names, index, strict=True)}
             yield self._point(index, coords)
 
-    def _point(self, index: tuple[int, ...], coords: dict[str, Any]) -> PointSpec:
+    def batch(self, point: PointSpec, number: int) -> PointSpec:
+        """Batch ``number`` of ``point``: its runs again with new frequency draws (a seed
+        of its own). Batch 0 is the point itself, so a sweep with `target_error`
+        reuses the points of the same sweep without it."""
+        return point if number == 0 else self._point(point.index, point.coords, number)
+
+    def _point(self, index: tuple[int, ...], coords: dict[str, Any], batch: int = 0) -> PointSpec:
         values = {**self.fixed, **coords}
         changes = {k: v for k, v in values.items() if k in MODEL_PARAMETERS}
         if self.groups:
@@ -372,7 +428,7 @@ class Grid:
             "runs": values["runs"],
             "duration": values["duration"],
             "dt": values["dt"],
-            "seed": point_seed(values["seed"], {k: v for k, v in values.items() if k != "seed"}),
+            "seed": point_seed(values["seed"], _seeded_values(values, batch)),
             **({"groups": [[g.n, g.bpm, g.sigma_bpm] for g in groups]} if self.groups else {}),
             "preset": self.preset,
             "changes": changes or None,
@@ -398,6 +454,8 @@ class Grid:
             backend=self.backend,
             equilibrium_window=_attr(self.equilibrium_window),
             record_every=_attr(self.record_every),
+            target_error=_attr(self.target_error),
+            max_runs=_attr(self.max_runs),
             metrosync_version=__version__,
         )
         if self.groups:
@@ -415,6 +473,15 @@ def point_seed(sweep_seed: int, values: Mapping[str, Any]) -> int:
     digest = hashlib.sha256(canonical_json(dict(values)).encode()).digest()
     entropy = [int(sweep_seed), int.from_bytes(digest[:16], "little")]
     return int(np.random.SeedSequence(entropy).generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
+def _seeded_values(values: Mapping[str, Any], batch: int) -> dict[str, Any]:
+    """What a point's seed is drawn from besides the sweep seed; a batch after the first
+    adds its number (absent for batch 0, so the keys of earlier sweeps stay valid)."""
+    seeded = {k: v for k, v in values.items() if k != "seed"}
+    if batch:
+        seeded["batch"] = batch
+    return seeded
 
 
 def _attr(value: Any) -> Any:

@@ -39,6 +39,7 @@ from scipy.optimize import least_squares
 
 from .. import interrupts
 from ..errors import ParameterError
+from .resample import resample_runs
 
 #: (β/ν̄, 1/ν̄) of the Kuramoto transition with random natural frequencies.
 KURAMOTO_EXPONENTS = (0.2, 0.4)
@@ -385,8 +386,7 @@ def finite_size_scaling(
     runs = r_runs.shape[-1]
     for _ in range(n_boot):
         interrupts.check()  # a long loop of fits: let Ctrl-C land between two
-        pick = rng.integers(0, runs, size=(sizes.size, 1, runs))
-        rb, eb = mean_and_error(np.take_along_axis(r_runs, pick, axis=-1))
+        rb, eb = mean_and_error(resample_runs(r_runs, rng, (sizes.size, 1, runs)))
         try:
             boot.append(
                 collapse(

@@ -29,6 +29,7 @@ import numpy as np
 import xarray as xr
 
 from .._files import write_netcdf
+from ..observables.order import ensemble_statistics
 from ..status import STATUS_ABSENT, STATUS_FAILED
 from ..status import SWEEP_FLAG_MEANINGS as FLAG_MEANINGS
 from .grid import UNITS, Grid
@@ -129,21 +130,27 @@ class PointStore:
         return [json.loads(line)["key"] for line in lines if line.strip()]
 
 
-def merge(grid: Grid, store: PointStore) -> xr.Dataset:
+def merge(grid: Grid, store: PointStore, batches=None) -> xr.Dataset:
     """One dataset for the whole grid; a point not in the store is marked ``missing``.
+
+    ``batches`` : with ``grid.target_error``, each point's batches by grid index
+    (`metrosync.sweeps.adaptive`); a point's runs are those of its stored batches.
 
     Variables (``*axes`` = one dimension per swept parameter, in grid order):
     r_eq, r_eq_analytic (*axes, run); status (*axes, run) int8 bit flags, -1 for no
     such run; r_eq_mean, r_eq_std, n_flagged, seed, error (*axes); with groups
     r_eq_group (*axes, run, group) and its mean over runs r_eq_group_mean (*axes,
-    group); and with ``keep_r`` r, r_crossing (*axes, time, run).
+    group); with ``keep_r`` r, r_crossing (*axes, time, run); with ``target_error``
+    n_runs and r_eq_error, the standard error of r_eq_mean (*axes).
     """
     specs = list(grid.points())
-    loaded: dict[tuple[int, ...], xr.Dataset | None] = {
-        spec.index: store.read(spec.key) if store.has(spec.key) else None for spec in specs
-    }
+    batches = batches or {spec.index: [spec] for spec in specs}
+    loaded = {spec.index: _read_batches(store, batches[spec.index]) for spec in specs}
     shape = grid.shape
-    n_run = max(spec.kwargs["runs"] for spec in specs)
+    n_run = max(
+        max((ds.sizes["run"] for ds in loaded.values() if ds is not None), default=0),
+        max(spec.kwargs["runs"] for spec in specs),
+    )
     r_eq = np.full((*shape, n_run), np.nan)
     r_eq_analytic = np.full((*shape, n_run), np.nan)
     status = np.full((*shape, n_run), STATUS_ABSENT, dtype=np.int8)
@@ -215,6 +222,17 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
             {"long_name": "Kuramoto r (crossing phases)"},
         )
         coords["time"] = ("time", time, {"units": "s", "long_name": "simulated time"})
+    if grid.target_error is not None:
+        runs_done = (status != STATUS_ABSENT).sum(axis=-1).astype(np.int64)
+        finite = np.isfinite(r_eq).sum(axis=-1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            standard_error = np.where(finite > 1, std / np.sqrt(finite), np.nan)
+        data["n_runs"] = (dims, runs_done, {"long_name": "runs simulated at this point"})
+        data["r_eq_error"] = (
+            dims,
+            standard_error,
+            {"long_name": "standard error of r_eq_mean (r_eq_std / sqrt(finite runs))"},
+        )
     if n_groups:
         data["r_eq_group"] = (
             (*dims, "run", "group"),
@@ -230,6 +248,27 @@ def merge(grid: Grid, store: PointStore) -> xr.Dataset:
             {"long_name": "equilibrium r of each group, mean over runs"},
         )
     return xr.Dataset(data, coords=coords, attrs=grid.describe())
+
+
+def _read_batches(store: PointStore, batches) -> xr.Dataset | None:
+    """A point's stored batches as one dataset along ``run`` (None without its first);
+    its r_eq_mean and r_eq_std are those of all its runs."""
+    stored = [store.read(b.key) for b in batches if store.has(b.key)]
+    if not stored or not store.has(batches[0].key):
+        return None
+    if len(stored) == 1:
+        return stored[0]
+    ds = xr.concat(
+        stored,
+        dim="run",
+        data_vars="minimal",
+        coords="minimal",
+        compat="override",
+        join="override",
+        combine_attrs="override",
+    )
+    mean, spread = ensemble_statistics(ds.r_eq.values)
+    return ds.assign_attrs(r_eq_mean=mean, r_eq_std=spread)
 
 
 def _describe(name: str) -> dict[str, str]:

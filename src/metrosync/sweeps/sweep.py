@@ -14,7 +14,7 @@ import math
 import os
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,7 @@ from .._words import plural
 from ..budget import Budget, simulation_budget
 from ..errors import Interrupted, OverturnWarning, ParameterError
 from ..simulation.request import record_stride
+from . import adaptive
 from .executors import Execution, check_scheduler, execute
 from .grid import MODEL_PARAMETERS, Grid
 from .store import PointStore, merge, write_dataset
@@ -44,6 +45,8 @@ class SweepResult:
     reused: int
     execution: Execution
     out: Path | None = None
+    rounds: int = 1
+    precision: Mapping[tuple[int, ...], adaptive.Precision] = field(default_factory=dict)
 
     @property
     def complete(self) -> bool:
@@ -64,6 +67,25 @@ class SweepResult:
                 out.append((coords, message))
         return out
 
+    def _precision_line(self) -> str:
+        """How many runs the points took to reach `target_error`, and which did not."""
+        target, cap = self.grid.target_error, self.grid.max_runs
+        runs = [p.runs for p in self.precision.values()]
+        short = [p for p in self.precision.values() if not p.error <= target]
+        line = (
+            f"  runs until the standard error of mean r_eq is <= {target:g}: "
+            + (_span(runs) + " a point" if runs else "no point finished")
+            + f", in {plural(self.rounds, 'round')}"
+        )
+        if short:
+            finite = [p.error for p in short if math.isfinite(p.error)]
+            line += (
+                f"; {plural(len(short), 'point')} stopped short (at `max_runs` = {cap}, or "
+                f"with fewer than 2 finite runs)"
+                + (f": standard error up to {max(finite):.3g}" if finite else "")
+            )
+        return line
+
     def summary(self) -> str:
         """Human-readable report: points computed and reused, throughput, failures."""
         ex = self.execution
@@ -73,15 +95,19 @@ class SweepResult:
         missing = int((error == "missing").sum())
         simulated = int((ds.status.values[error == ""] >= 0).sum())
         flagged = int(ds.n_flagged.sum())
+        # With `target_error` a point is computed in batches of `runs`.
+        unit = " batches" if self.grid.target_error is not None else ""
         lines = [
             f"metrosync sweep: {plural(self.grid.size, 'point')} over {', '.join(self.grid.axes)}; "
-            f"{len(ex.computed)} computed, {self.reused} reused from {self.store}",
+            f"{len(ex.computed)}{unit} computed, {self.reused} reused from {self.store}",
             f"  {ex.seconds:.2f} s wall, {ex.work:.3g} oscillator-steps, "
             f"{ex.throughput:.3g} oscillator-steps/s",
             f"  runs flagged (overturned/diverged/stopped): {flagged} of "
             f"{plural(simulated, 'run')} simulated"
             + ("; their r is not meaningful (status bits: metrosync.status)" if flagged else ""),
         ]
+        if self.grid.target_error is not None:
+            lines.append(self._precision_line())
         failures = self.failures()
         if failures:
             lines.append(
@@ -141,25 +167,49 @@ def sweep(
         raise TypeError("give `fixed` and grid options only with a mapping of axes, not a Grid.")
     _warn_overturn(grid)
     points = PointStore(store)
-    specs = list(grid.points())
-    todo = [
-        spec
-        for spec in specs
-        if not points.has(spec.key) or (retry_failed and points.failed(spec.key))
-    ]
-    sweep_budget(specs, todo, scheduler=scheduler, n_workers=n_workers).check()
+    plan = adaptive.start(grid)
     show = sys.stderr.isatty() if progress is None else progress
+    execution, reused, rounds = Execution(), 0, 0
+    specs = [batch for batches in plan.values() for batch in batches]
     try:
-        execution = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
-        dataset = merge(grid, points)
+        # One round without `target_error`; with it, until no point needs another batch.
+        while specs:
+            todo = [
+                spec
+                for spec in specs
+                if not points.has(spec.key) or (retry_failed and points.failed(spec.key))
+            ]
+            sweep_budget(specs, todo, scheduler=scheduler, n_workers=n_workers).check()
+            done = execute(todo, points, scheduler=scheduler, n_workers=n_workers, progress=show)
+            execution = execution.then(done)
+            reused += len(specs) - len(todo)
+            rounds += 1
+            specs = adaptive.extend(grid, points, plan)
+        dataset = merge(grid, points, plan)
         out_path = write_dataset(dataset, out) if out is not None else None
     except KeyboardInterrupt:
-        kept = sum(points.has(spec.key) for spec in specs)
+        planned = [batch.key for batches in plan.values() for batch in batches]
         raise Interrupted(
-            f"{kept} of {len(specs)} points kept in {points.root}; run the same command "
-            f"again to resume"
+            f"{points.kept(planned)} of {plan_size(plan)} kept in {points.root}; run "
+            f"the same command again to resume"
         ) from None
-    return SweepResult(dataset, grid, points.root, len(specs) - len(todo), execution, out_path)
+    precision = adaptive.errors(grid, points, plan) if grid.target_error is not None else {}
+    return SweepResult(
+        dataset, grid, points.root, reused, execution, out_path, rounds=rounds, precision=precision
+    )
+
+
+def _span(values) -> str:
+    low, high = min(values), max(values)
+    return f"{low}" if low == high else f"{low}-{high}"
+
+
+def plan_size(plan) -> str:
+    """The planned work in words: points, and batches when a point has several."""
+    total = sum(len(batches) for batches in plan.values())
+    if total == len(plan):
+        return plural(total, "point")
+    return f"{plural(total, 'batch')} of {plural(len(plan), 'point')}"
 
 
 #: Memory of one point's dataset object while the sweep is merged, besides its arrays.
