@@ -1,0 +1,54 @@
+"""The large-N study's report section: read from a merged study sweep, its numbers
+and figures, and the check it adds to claim 4."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from metrosync.cli import main
+from metrosync.errors import ParameterError
+from metrosync.paper.large_n import claim_4_check, large_n_lines, onset, read_large_n, rise_span
+
+QUICK = Path(__file__).resolve().parents[2] / "studies" / "large_n" / "quick.toml"
+
+
+def test_rise_span_interpolates_between_grid_points():
+    bpm = np.array([160.0, 165.0, 170.0, 175.0, 180.0])
+    r = np.array([0.1, 0.1, 0.3, 0.9, 1.1])  # rise 1.0: 10 % at 0.2, 90 % at 1.0
+    assert rise_span(bpm, r) == pytest.approx((167.5, 177.5))
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("large_n")
+    out = folder / "quick.nc"
+    assert main(["sweep", str(QUICK), "--out", str(out), "--no-progress"]) == 0
+    return read_large_n(out, n_boot=20), folder
+
+
+def test_the_section_reports_every_estimate_and_draws_both_figures(quick):
+    study, folder = quick
+    assert study.sizes == (8, 16, 32) and study.sigma_bpm == 0.75
+    assert study.runs == (6, 18) and 0 < study.largest_error <= 0.06
+    assert study.work == pytest.approx(
+        float((study.r.notnull().sum("run") * study.r.n).sum()) * 6000
+    )
+    lines = large_n_lines([study], folder / "figures", folder)
+    text = "\n".join(lines)
+    assert "| 0.75 | 8, 16, 32 | 6–18 |" in text
+    assert (folder / "figures" / "large_n_sigma_0.75_collapse.png").stat().st_size > 1000
+    assert (folder / "figures" / "large_n_sigma_0.75_critical.png").stat().st_size > 1000
+    value, error, why = onset(study)
+    assert f"{value:.1f} ± {error:.1f} BPM" in text and why in text
+    words, holds = claim_4_check([study])
+    assert f"Claim 4 from this study: {words}: {'yes' if holds else 'no'}." in text
+
+
+def test_a_file_without_several_sizes_is_refused(tmp_path):
+    out = tmp_path / "one.nc"
+    args = ["sweep", "--n", "8", "--bpm", "170:180:5", "--runs", "3", "--duration", "60",
+            "--dt", "0.02", "--out", str(out), "--no-progress"]  # fmt: skip
+    assert main(args) == 0
+    with pytest.raises(ParameterError, match="is not a large-N study"):
+        read_large_n(out)
