@@ -8,7 +8,15 @@ import pytest
 
 from metrosync.cli import main
 from metrosync.errors import ParameterError
-from metrosync.paper.large_n import claim_4_check, large_n_lines, onset, read_large_n, rise_span
+from metrosync.paper.claims import Verdict
+from metrosync.paper.large_n import (
+    amend_claim_4,
+    claim_4_check,
+    large_n_lines,
+    onset,
+    read_large_n,
+    rise_span,
+)
 
 QUICK = Path(__file__).resolve().parents[2] / "studies" / "large_n" / "quick.toml"
 
@@ -52,3 +60,32 @@ def test_a_file_without_several_sizes_is_refused(tmp_path):
     assert main(args) == 0
     with pytest.raises(ParameterError, match="is not a large-N study"):
         read_large_n(out)
+
+
+def test_claim_4_takes_where_the_transition_sits_from_the_study(quick):
+    study, _ = quick
+    fig10 = Verdict(
+        4,
+        "partly reproduced",
+        "Fig. 10's numbers.",
+        "fig10",
+        {"checks": {"the rise sharpens with N": True, "the transition sits within 5 BPM": False}},
+    )
+    amended = amend_claim_4(fig10, [study])
+    words, holds = claim_4_check([study])
+    assert amended.values["checks"] == {"the rise sharpens with N": True, words: holds}
+    assert amended.verdict == ("reproduced" if holds else "partly reproduced")
+    assert amended.numbers.startswith("Fig. 10's numbers. From the large-N study")
+    unassessed = Verdict(4, "not assessed", "Fig. 10 did not run.")
+    assert amend_claim_4(unassessed, [study]) is unassessed
+
+
+@pytest.mark.parametrize(("name", "words"), [("nope.nc", "no file"), ("junk.nc", "not a NetCDF")])
+def test_reproduce_refuses_a_bad_large_n_file_before_any_work(tmp_path, capsys, name, words):
+    (tmp_path / "junk.nc").write_text("not a sweep")
+    out = tmp_path / "out"
+    code = main(["reproduce", "--large-n", str(tmp_path / name), "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "`large_n` (--large-n)" in err and words in err
+    assert not (out / "REPORT.md").exists()

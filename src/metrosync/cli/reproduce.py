@@ -50,6 +50,16 @@ def register(subparsers) -> None:
         help="light-gate logs, one folder per ω₀ named by its BPM (adds Fig. 9)",
     )
     parser.add_argument(
+        "--large-n",
+        type=Path,
+        nargs="+",
+        default=(),
+        metavar="SWEEP",
+        help="merged sweeps of the large-N study (studies/large_n/*.toml), the paper's sigma "
+        "first: adds its section, and claim 4's check of where the transition sits comes "
+        "from it",
+    )
+    parser.add_argument(
         "--only",
         nargs="+",
         default=None,
@@ -71,7 +81,7 @@ def register(subparsers) -> None:
         action="store_false",
         help="no progress bars (they show when stderr is a terminal)",
     )
-    add_aliases(parser, n_workers="--workers")
+    add_aliases(parser, n_workers="--workers", large_n="--large-n")
     parser.set_defaults(func=run)
 
 
@@ -96,6 +106,7 @@ def run(args) -> int:
             log=lambda line: print(line, flush=True),
             scheduler=args.scheduler,
             n_workers=args.workers,
+            large_n=args.large_n,
         )
     except StudyIncomplete as error:  # the work ran; what finished is kept
         print(f"metrosync reproduce: error: {error}", file=sys.stderr)

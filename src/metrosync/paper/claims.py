@@ -212,14 +212,7 @@ def claim_transition(ds: xr.Dataset) -> Verdict:
         )
         <= OMEGA_C_TOLERANCE,
     }
-    passed = sum(checks.values())
-    verdict = (
-        "reproduced"
-        if passed == len(checks)
-        else "not reproduced"
-        if passed == 0
-        else "partly reproduced"
-    )
+    verdict = verdict_of(checks)
     rows = "; ".join(
         f"N = {n}: r = 1/2 at {f['omega_half']:.1f} BPM, steepest {f['max_slope']:.4f}/BPM, "
         f"σ_r peak {f['peak_sigma_r']:.3f} at {f['peak_bpm']:g} BPM, width {f['peak_width']:g} BPM"
@@ -231,6 +224,14 @@ def claim_transition(ds: xr.Dataset) -> Verdict:
     return Verdict(
         4, verdict, numbers + ".", ds.attrs.get("study"), {"features": feats, "checks": checks}
     )
+
+
+def verdict_of(checks: dict[str, bool]) -> str:
+    """*reproduced* when every check holds, *not reproduced* when none does."""
+    passed = sum(checks.values())
+    if passed == len(checks):
+        return "reproduced"
+    return "not reproduced" if passed == 0 else "partly reproduced"
 
 
 def claim_z(ds: xr.Dataset) -> Verdict:

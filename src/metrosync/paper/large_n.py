@@ -30,6 +30,7 @@ import xarray as xr
 from ..errors import ParameterError
 from ..sweeps.critical import critical_frequency, plot_critical
 from ..sweeps.scaling import ScalingEstimate, mean_and_error, plot_collapse, sweep_scaling
+from .claims import Verdict, verdict_of
 
 #: χ²/dof up to which the data are said to collapse onto one curve.
 COLLAPSES = 3.0
@@ -65,8 +66,16 @@ class LargeN:
 def read_large_n(path: str | Path, *, n_boot: int = 200, seed: int = 0) -> LargeN:
     """The `LargeN` of the merged sweep at ``path`` (one σ, several N, a BPM grid)."""
     path = Path(path)
-    with xr.open_dataset(path, engine="h5netcdf") as opened:
-        ds = opened.load()
+    if not path.is_file():
+        raise ParameterError(
+            f"`large_n`: no file {str(path)!r}; give the merged sweep of the large-N study "
+            f"(`metrosync sweep studies/large_n/sigma_0.75.toml --out FILE.nc`)."
+        )
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as opened:
+            ds = opened.load()
+    except (OSError, ValueError) as error:
+        raise ParameterError(f"`large_n`: {str(path)!r} is not a NetCDF sweep: {error}") from None
     if "n" not in ds.dims or ds.sizes["n"] < 2:
         raise ParameterError(
             f"{path} is not a large-N study: it needs r_eq over several N (`n`), a `bpm` "
@@ -205,3 +214,19 @@ def large_n_lines(studies: list[LargeN], figures: Path, base: Path) -> list[str]
     words, holds = claim_4_check(studies)
     lines += ["", f"Claim 4 from this study: {words}: {'yes' if holds else 'no'}.", ""]
     return lines
+
+
+def amend_claim_4(verdict: Verdict, studies: list[LargeN]) -> Verdict:
+    """Claim 4's verdict with its check of where the transition sits taken from the
+    large-N study (N up to 4096, extrapolated) instead of Fig. 10's largest N."""
+    if "checks" not in verdict.values:  # Fig. 10 did not run: claim 4 is not assessed
+        return verdict
+    checks = {k: v for k, v in verdict.values["checks"].items() if "transition sits" not in k}
+    words, holds = claim_4_check(studies)
+    checks[words] = holds
+    numbers = (
+        f"{verdict.numbers} From the large-N study (its section below), the check of where "
+        f"the transition sits is replaced: {words}: {'yes' if holds else 'no'}."
+    )
+    values = {**verdict.values, "checks": checks, "large_n": True}
+    return Verdict(verdict.claim, verdict_of(checks), numbers, verdict.study, values)

@@ -8,6 +8,7 @@ Contract: ``reproduce(out, mode=...)`` writes into ``out``
     fig9.nc, figures/fig9.png|pdf         only with ``experiment``
     points/<key>.nc, log.jsonl            the point store (`metrosync.sweeps.PointStore`)
     REPORT.md                             verdicts, numbers, interpretations, timings
+    figures/large_n_sigma_*.png           only with ``large_n`` (the large-N study)
 
 and returns a `Reproduction`. Re-running with the same ``out`` reuses the points whose
 key (resolved parameters, package version, simulation sources) is unchanged and
@@ -37,6 +38,7 @@ from .claims_map import ClaimsMapStudy, best_work
 from .consistency import consistency_table
 from .experiment import compare_experiment, find_experiment, lightgate_analyze
 from .figures import PLOTTERS, plot_comparison
+from .large_n import LargeN, amend_claim_4, read_large_n
 from .report import write_report
 from .runner import StudyResult, points_of, run_study
 from .studies import (
@@ -72,6 +74,7 @@ class Reproduction:
     wall_s: float = 0.0
     compile_s: float = 0.0
     version: str = __version__
+    large_n: list[LargeN] = field(default_factory=list)
 
     @property
     def datasets(self) -> dict[str, xr.Dataset]:
@@ -88,6 +91,7 @@ def reproduce(
     log: Callable[[str], None] | None = None,
     scheduler: str | None = None,
     n_workers: int | None = None,
+    large_n: Sequence[Path | str] = (),
 ) -> Reproduction:
     """Reproduce the paper's simulation figures and check its claims.
 
@@ -103,6 +107,9 @@ def reproduce(
     scheduler, n_workers : where the points run, as for `metrosync.sweep`: None (in
         process), ``"local"`` (a Dask LocalCluster of ``n_workers``) or
         ``"tcp://HOST:PORT"``. Checked before anything runs.
+    large_n : merged sweeps of the large-N study (`studies/large_n/*.toml`), the paper's
+        σ first; adds its section and takes claim 4's check of where the transition
+        sits from it (`paper.large_n`). Read before anything runs.
 
     Returns
     -------
@@ -118,18 +125,24 @@ def reproduce(
         find_experiment(Path(experiment))
         lightgate_analyze()
     say = log or (lambda line: None)
+    if large_n:
+        say("large-N study: " + ", ".join(str(p) for p in large_n))
+    studies_large_n = [read_large_n(path) for path in large_n]
     try:
-        return _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
-                          n_workers)  # fmt: skip
+        rep = _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
+                         n_workers, studies_large_n)  # fmt: skip
     except KeyboardInterrupt:
         kept, total = kept_points(out, mode, chosen)
         raise Interrupted(
             f"{kept} of {total} points kept in {PointStore(out).points}; run the same command "
             f"again to resume"
         ) from None
+    return rep
 
 
-def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler, n_workers):
+def _reproduce(
+    out, mode, chosen, experiment, progress, say, started, scheduler, n_workers, large_n
+):
     compiled = compile_seconds()
     say("parameter consistency table")
     consistency = consistency_table(_bpms(chosen, mode))
@@ -161,6 +174,7 @@ def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
         consistency=consistency,
         figures=figures,
         full_work={s.name: _full_work(s) for s in chosen},
+        large_n=large_n,
     )
     if experiment is not None:
         sim = rep.datasets.get(FIG8_TOP.name)
@@ -173,6 +187,8 @@ def _reproduce(out, mode, chosen, experiment, progress, say, started, scheduler,
         figures["fig9"] = plot_comparison(rep.comparison, out / "figures" / "fig9")
         rep.comparison_note = f"Simulated r from the `{FIG8_TOP.name}` study ({mode} mode)."
     rep.verdicts = all_verdicts(rep.datasets)
+    if large_n:
+        rep.verdicts = [amend_claim_4(v, large_n) if v.claim == 4 else v for v in rep.verdicts]
     rep.wall_s = time.perf_counter() - started
     rep.compile_s = compile_seconds() - compiled
     rep.report = write_report(out / "REPORT.md", rep)

@@ -20,6 +20,7 @@ from .._files import write_text
 from ..model import PRESETS
 from .claims import Verdict
 from .consistency import markdown_table
+from .large_n import large_n_lines
 from .map_report import claims_map_section, conclusion, sigma_map_section, tuning_bullet
 from .studies import (
     ESTIMATION,
@@ -86,6 +87,8 @@ def write_report(path: Path, rep) -> Path:
         s += sigma_map_section(data["sigma_map"]) + _figure_line(rep, "sigma_map", base)
     if "claims_map" in data:
         s += claims_map_section(data["claims_map"]) + _figure_line(rep, "claims_map", base)
+    if rep.large_n:
+        s += large_n_lines(rep.large_n, base / "figures", base)
     s += ["## Parameter consistency", "", markdown_table(rep.consistency), ""]
     s += _timing_section(rep)
     s += ["## Figures", ""]
