@@ -141,6 +141,7 @@ def _trains(times, strength, voices: Voices, beat_range):
     for index in folded:
         head[index] = False
     found, groups = tr.join_fragments(times, found, of_voice)
+    found = tr.first_impacts(times, strength, found, head)
     return head, gaps, found, groups
 
 

@@ -373,6 +373,67 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
 
 
+def first_impacts(
+    times: np.ndarray, strength: np.ndarray, trains: list[Train], head: np.ndarray
+) -> list[Train]:
+    """Each train's ticks moved to their first impact: where, for one kind of beat (tick
+    or tock), most of a train's ticks follow a louder impact at a fixed lag (spread
+    below `PART_LAG_SPREAD`, within `MAX_TICK_LENGTH`) that no train holds, the train
+    was built on a later impact of each tick (its first impact sounded different, and
+    its voice's train was folded away or never followed). Those ticks are timed at that
+    impact instead; ``head`` (K,) is updated in place. A pre-echo comes ahead of a tick
+    too, but fainter, and two metronomes a few milliseconds apart keep a lag that
+    wanders by more."""
+    times = np.asarray(times, dtype=float)
+    held = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        held[t.index] = True
+    out = []
+    for t in trains:
+        index = t.index.copy()
+        for parity in (0, 1):
+            sel = np.flatnonzero((t.beat % 2 == parity) & ~t.masked)
+            if sel.size < 8:
+                continue
+            mine = times[index[sel]]
+            lo = np.searchsorted(times, mine - MAX_TICK_LENGTH)
+            hi = np.searchsorted(times, mine - 1e-3, side="right")
+            lags, owner = [], []
+            for s, (a, b) in enumerate(zip(lo, hi, strict=True)):
+                for i in range(a, b):
+                    if not held[i]:
+                        lags.append(mine[s] - times[i])
+                        owner.append(s)
+            if len(lags) < 0.5 * sel.size:
+                continue
+            lags_a = np.asarray(lags)
+            bins = np.round(lags_a / 0.5e-3)
+            values, counts = np.unique(bins, return_counts=True)
+            centre = values[np.argmax(counts)] * 0.5e-3
+            near = np.abs(lags_a - centre) <= 1e-3
+            if len(set(np.asarray(owner)[near])) < 0.5 * sel.size:
+                continue
+            lag = float(np.median(lags_a[near]))
+            if _robust_spread(lags_a[near]) >= PART_LAG_SPREAD:
+                continue
+            moves = {}
+            for s, x in zip(np.asarray(owner)[near], mine[np.asarray(owner)[near]] - lags_a[near],
+                            strict=True):  # fmt: skip
+                i = int(np.argmin(np.abs(times - x)))
+                if abs((mine[s] - times[i]) - lag) <= 1e-3 and s not in moves:
+                    moves[s] = i
+            earlier = np.array(list(moves.values()))
+            if np.median(strength[earlier]) <= np.median(strength[index[sel]]):
+                continue
+            for s, i in moves.items():
+                head[index[sel[s]]] = False
+                head[i] = True
+                held[i] = True
+                index[sel[s]] = i
+        out.append(Train(index, t.beat, t.period, t.masked))
+    return out
+
+
 def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
     """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
     (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
