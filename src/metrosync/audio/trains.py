@@ -71,10 +71,15 @@ LOCKED_SPREAD = 0.04
 MAX_FRAGMENT = 6
 #: Most beats between a train's end and a train that takes up its beat.
 MAX_BRIDGED = 64
+#: Largest drift (beats) of one piece of a metronome's train on another's grid over
+#: the time they share: two metronomes under 1 % apart in tempo drift by more.
+MAX_DRIFT = 0.05
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
 #: A tick farther than this from its train's beat is not its metronome's, s.
 OFF_BEAT = 3e-3
+#: Ticks of one kind on each side that put a tick where its beat is.
+NEIGHBOURS = 3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
 
@@ -437,7 +442,8 @@ def first_impacts(
 def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
     """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
     (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
-    to each kind of beat (tick, tock: a limp) apart; a later impact taken for a tick
+    to each kind of beat (tick, tock: a limp) apart, or from where its `NEIGHBOURS` of
+    the same kind put it; a later impact taken for a tick
     where the first was hidden, at the ends of a train, would bias its tempo."""
     times = np.asarray(times, dtype=float)
     out = np.zeros(times.size, dtype=bool)
@@ -450,6 +456,28 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
         residual = times[sel] - fit
         limit = max(OFF_BEAT, 5 * _robust_spread(residual))
         out[sel] = np.abs(residual - np.median(residual)) > limit
+        # and from its neighbours: where two metronomes of nearly one tempo drift
+        # through each other, a train that took some of the other's ticks bends away
+        # from any quadratic, which then hides a tick 10 ms off
+        local = times[sel] - _from_neighbours(n, times[sel])
+        inner = np.isfinite(local)
+        if inner.sum() >= 4:
+            limit = max(OFF_BEAT, 5 * _robust_spread(local[inner]))
+            out[sel[inner]] |= np.abs(local[inner] - np.median(local[inner])) > limit
+    return out
+
+
+def _from_neighbours(n: np.ndarray, t: np.ndarray, side: int = NEIGHBOURS) -> np.ndarray:
+    """(S,) each tick's time as its neighbours put it: the median over the lines through
+    one of the ``side`` ticks before it and one of the ``side`` after, so that one odd
+    neighbour does not move it; NaN within ``side`` of either end (with fewer, one odd
+    neighbour would)."""
+    size = t.size
+    out = np.full(size, np.nan)
+    for p in range(side, size - side):
+        guesses = [t[a] + (t[b] - t[a]) * (n[p] - n[a]) / (n[b] - n[a])
+                   for a in range(p - side, p) for b in range(p + 1, p + side + 1)]  # fmt: skip
+        out[p] = np.median(guesses)
     return out
 
 
@@ -509,17 +537,38 @@ def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
         spread = math.sqrt(max(0.0, -2 * math.log(max(abs(z), 1e-12)))) / (2 * np.pi)
         off_grid = abs(np.angle(z) / (2 * np.pi))
         if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
-            return beat
+            if _drift(t_b[inside], tb.beat[inside], gap_before / beat, z) < MAX_DRIFT:
+                return beat
     return None
+
+
+def _drift(t: np.ndarray, beat: np.ndarray, place: np.ndarray, z: complex) -> float:
+    """How far (beats) ticks at ``t`` drift on another train's grid over their span:
+    ``place`` (fractions of a beat after the grid's last beat) about its circular mean
+    ``z``, less each kind of beat's median (a limp), fitted by a line in time."""
+    x = np.angle(np.exp(2j * np.pi * place) / z) / (2 * np.pi)
+    for parity in (0, 1):
+        sel = beat % 2 == parity
+        if sel.any():
+            x[sel] -= np.median(x[sel])
+    ok = np.abs(x) < 0.1  # a tick timed by another's that hid it
+    if ok.sum() < 4 or np.ptp(t[ok]) <= 0:
+        return 0.0
+    slope = np.polyfit(t[ok], x[ok], 1)[0]
+    return float(abs(slope) * np.ptp(t))
 
 
 def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
     """The beat, when train b takes up train a's beat after a ended: one metronome
-    followed again after ticks of another hid it for more than `MAX_MISSING` beats."""
-    if abs(tb.period / ta.period - 1) > 0.01:
+    followed again after ticks of another hid it for more than `MAX_MISSING` beats, or
+    only every few of its beats heard (b's period a whole multiple of a's, up to
+    `MAX_FRAGMENT`, or a's of b's: the beat is the shorter)."""
+    short, long_ = sorted((ta.period, tb.period))
+    k = round(long_ / short)
+    if k > MAX_FRAGMENT or abs(long_ / (k * short) - 1) > 0.01:
         return None
     end, start = times[ta.index[-1]], times[tb.index[0]]
-    beat = 0.5 * (ta.period + tb.period)
+    beat = 0.5 * (short + long_ / k)
     beats = (start - end) / beat
     if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > 0.15:
         return None
