@@ -474,10 +474,13 @@ def _from_neighbours(n: np.ndarray, t: np.ndarray, side: int = NEIGHBOURS) -> np
     neighbour would)."""
     size = t.size
     out = np.full(size, np.nan)
-    for p in range(side, size - side):
-        guesses = [t[a] + (t[b] - t[a]) * (n[p] - n[a]) / (n[b] - n[a])
-                   for a in range(p - side, p) for b in range(p + 1, p + side + 1)]  # fmt: skip
-        out[p] = np.median(guesses)
+    if size <= 2 * side:
+        return out
+    p = np.arange(side, size - side)
+    n = n.astype(float)
+    guesses = [t[p - da] + (t[p + db] - t[p - da]) * (n[p] - n[p - da]) / (n[p + db] - n[p - da])
+               for da in range(1, side + 1) for db in range(1, side + 1)]  # fmt: skip
+    out[p] = np.median(guesses, axis=0)
     return out
 
 
