@@ -19,7 +19,9 @@ and the later ones up to `MAX_TICK_LENGTH` pile up, above the level unrelated
 impacts at the same rate would give, at the lags of the tick's own later impacts.
 The last lag bin where they do (at least `MIN_SHARE_LATE` of the impacts) bounds the
 tick: an impact of the same voice that follows a tick's first impact within that
-gap belongs to it. The tick's time is its first impact.
+gap belongs to it. The tick's time is its first impact, even where the first impact
+sounds unlike the later ones and the train was followed on a later one
+(`first_impacts`).
 
 Following a train. A seed tick's successor one beat later is the one whose multiples
 (2 to 6 beats on) are also heard; the train then goes on beat by beat: the next tick
@@ -41,10 +43,12 @@ two voices, each ticking once per swing; ringing and overlaps can split its tick
 among voices in other patterns too. Two trains are one metronome when both periods
 are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %), and
 the second's ticks fall on the first's grid of beats T (circular spread below
-2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp), almost
-never (10 %) within 0.3 T of the first's own ticks; or when one takes up the other's
-beat (the same period within 1 %, its first tick a whole number of beats, at most
-`MAX_BRIDGED`, within 15 %, after the other's last). (Two metronomes locked a whole
+2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp, drifting on
+it by under `MAX_DRIFT` of a beat over their shared time: two metronomes of nearly
+one tempo drift by more), almost never (10 %) within 0.3 T of the first's own ticks;
+or when one takes up the other's beat (the same period, or a whole multiple of it,
+within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
+15 %, after the other's last). (Two metronomes locked a whole
 number of beats apart at whole-number ratios of tempo would be taken for one;
 synchronized metronomes tick together, on each other's ticks.)
 """
