@@ -6,7 +6,9 @@ impacts start a tick (``head``), and each metronome's tick train (indices into t
 impacts), or none with the reason.
 
 Steps: the impacts are grouped into voices by their sound (`voices`: the grouping with
-the most voices in which every voice carries tick trains of its own); within each
+the most voices in which every voice carries tick trains of its own; where none does
+and tempo alone would make more metronomes than the first grouping whose trains each
+hold `trains.MIN_COVERAGE` of their beats, that grouping); within each
 voice the impacts of one tick become one tick, timed at its first impact, and the
 voice's ticks are followed as trains, one per metronome that sounds like it, told
 apart by tempo (`trains`); a tick and a tock that sound different are joined into
@@ -92,10 +94,17 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     beat_range = tr.BEAT_RANGE if bpm is None else (0.85 * 60 / bpm, 2.3 * 60 / bpm)
     times = impacts.time
     features = impact_features(recording, times)
+    weak = None
     for voices in cluster_voices(features, seed=seed):
         head, gaps, found, groups = _trains(times, impacts.strength, voices, beat_range)
         if voices.count == 1 or _all_voices_carry(head, voices, found, groups):
             break
+        if weak is None and _all_voices_carry(head, voices, found, groups, tr.MIN_COVERAGE):
+            weak = voices, head, gaps, found, groups
+    if voices.count == 1 and weak is not None and len(found) > len(weak[3]):
+        # tempo alone would make more metronomes than the sounds: a faint metronome,
+        # a third of its beats unheard, is one metronome, not pieces of several
+        voices, head, gaps, found, groups = weak
     if not found:
         return Separation(head, voices, gaps=gaps, note="no steady tick train was found")
     loud = [float(np.mean(impacts.strength[t.index])) for t in found]
@@ -141,16 +150,19 @@ def _trains(times, strength, voices: Voices, beat_range):
     for index in folded:
         head[index] = False
     found, groups = tr.join_fragments(times, found, of_voice)
+    found = tr.first_impacts(times, strength, found, head)
     return head, gaps, found, groups
 
 
-def _all_voices_carry(head, voices: Voices, found, groups) -> bool:
+def _all_voices_carry(
+    head, voices: Voices, found, groups, coverage: float = MIN_JOINED_COVERAGE
+) -> bool:
     """Each voice has at least `CARRIED` of its ticks in trains of its own, or in trains
     of other voices as ticks that hid theirs (a voice of ticks that fall together), and
     no train borrows more than `MOST_BORROWED` of its ticks from other voices (a voice
-    split in two by chance leaves each half with holes that the other fills) or, joined
-    from pieces, has fewer than `MIN_JOINED_COVERAGE` of its beats."""
-    if any(t.masked.mean() > MOST_BORROWED or t.coverage < MIN_JOINED_COVERAGE for t in found):
+    split in two by chance leaves each half with holes that the other fills) or has
+    fewer than ``coverage`` of its beats (`MIN_JOINED_COVERAGE`)."""
+    if any(t.masked.mean() > MOST_BORROWED or t.coverage < coverage for t in found):
         return False
     for v in range(voices.count):
         mine = head & (voices.labels == v)

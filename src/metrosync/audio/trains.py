@@ -19,7 +19,9 @@ and the later ones up to `MAX_TICK_LENGTH` pile up, above the level unrelated
 impacts at the same rate would give, at the lags of the tick's own later impacts.
 The last lag bin where they do (at least `MIN_SHARE_LATE` of the impacts) bounds the
 tick: an impact of the same voice that follows a tick's first impact within that
-gap belongs to it. The tick's time is its first impact.
+gap belongs to it. The tick's time is its first impact, even where the first impact
+sounds unlike the later ones and the train was followed on a later one
+(`first_impacts`).
 
 Following a train. A seed tick's successor one beat later is the one whose multiples
 (2 to 6 beats on) are also heard; the train then goes on beat by beat: the next tick
@@ -41,10 +43,12 @@ two voices, each ticking once per swing; ringing and overlaps can split its tick
 among voices in other patterns too. Two trains are one metronome when both periods
 are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %), and
 the second's ticks fall on the first's grid of beats T (circular spread below
-2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp), almost
-never (10 %) within 0.3 T of the first's own ticks; or when one takes up the other's
-beat (the same period within 1 %, its first tick a whole number of beats, at most
-`MAX_BRIDGED`, within 15 %, after the other's last). (Two metronomes locked a whole
+2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp, drifting on
+it by under `MAX_DRIFT` of a beat over their shared time: two metronomes of nearly
+one tempo drift by more), almost never (10 %) within 0.3 T of the first's own ticks;
+or when one takes up the other's beat (the same period, or a whole multiple of it,
+within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
+15 %, after the other's last). (Two metronomes locked a whole
 number of beats apart at whole-number ratios of tempo would be taken for one;
 synchronized metronomes tick together, on each other's ticks.)
 """
@@ -71,10 +75,15 @@ LOCKED_SPREAD = 0.04
 MAX_FRAGMENT = 6
 #: Most beats between a train's end and a train that takes up its beat.
 MAX_BRIDGED = 64
+#: Largest drift (beats) of one piece of a metronome's train on another's grid over
+#: the time they share: two metronomes under 1 % apart in tempo drift by more.
+MAX_DRIFT = 0.05
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
 #: A tick farther than this from its train's beat is not its metronome's, s.
 OFF_BEAT = 3e-3
+#: Ticks of one kind on each side that put a tick where its beat is.
+NEIGHBOURS = 3
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
 
@@ -373,10 +382,72 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
 
 
+def first_impacts(
+    times: np.ndarray, strength: np.ndarray, trains: list[Train], head: np.ndarray
+) -> list[Train]:
+    """Each train's ticks moved to their first impact: where, for one kind of beat (tick
+    or tock), most of a train's ticks follow a louder impact at a fixed lag (spread
+    below `PART_LAG_SPREAD`, within `MAX_TICK_LENGTH`) that no train holds, the train
+    was built on a later impact of each tick (its first impact sounded different, and
+    its voice's train was folded away or never followed). Those ticks are timed at that
+    impact instead; ``head`` (K,) is updated in place. A pre-echo comes ahead of a tick
+    too, but fainter, and two metronomes a few milliseconds apart keep a lag that
+    wanders by more."""
+    times = np.asarray(times, dtype=float)
+    held = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        held[t.index] = True
+    out = []
+    for t in trains:
+        index = t.index.copy()
+        for parity in (0, 1):
+            sel = np.flatnonzero((t.beat % 2 == parity) & ~t.masked)
+            if sel.size < 8:
+                continue
+            mine = times[index[sel]]
+            lo = np.searchsorted(times, mine - MAX_TICK_LENGTH)
+            hi = np.searchsorted(times, mine - 1e-3, side="right")
+            lags, owner = [], []
+            for s, (a, b) in enumerate(zip(lo, hi, strict=True)):
+                for i in range(a, b):
+                    if not held[i]:
+                        lags.append(mine[s] - times[i])
+                        owner.append(s)
+            if len(lags) < 0.5 * sel.size:
+                continue
+            lags_a = np.asarray(lags)
+            bins = np.round(lags_a / 0.5e-3)
+            values, counts = np.unique(bins, return_counts=True)
+            centre = values[np.argmax(counts)] * 0.5e-3
+            near = np.abs(lags_a - centre) <= 1e-3
+            if len(set(np.asarray(owner)[near])) < 0.5 * sel.size:
+                continue
+            lag = float(np.median(lags_a[near]))
+            if _robust_spread(lags_a[near]) >= PART_LAG_SPREAD:
+                continue
+            moves = {}
+            for s, x in zip(np.asarray(owner)[near], mine[np.asarray(owner)[near]] - lags_a[near],
+                            strict=True):  # fmt: skip
+                i = int(np.argmin(np.abs(times - x)))
+                if abs((mine[s] - times[i]) - lag) <= 1e-3 and s not in moves:
+                    moves[s] = i
+            earlier = np.array(list(moves.values()))
+            if np.median(strength[earlier]) <= np.median(strength[index[sel]]):
+                continue
+            for s, i in moves.items():
+                head[index[sel[s]]] = False
+                head[i] = True
+                held[i] = True
+                index[sel[s]] = i
+        out.append(Train(index, t.beat, t.period, t.masked))
+    return out
+
+
 def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
     """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
     (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
-    to each kind of beat (tick, tock: a limp) apart; a later impact taken for a tick
+    to each kind of beat (tick, tock: a limp) apart, or from where its `NEIGHBOURS` of
+    the same kind put it; a later impact taken for a tick
     where the first was hidden, at the ends of a train, would bias its tempo."""
     times = np.asarray(times, dtype=float)
     out = np.zeros(times.size, dtype=bool)
@@ -389,6 +460,31 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
         residual = times[sel] - fit
         limit = max(OFF_BEAT, 5 * _robust_spread(residual))
         out[sel] = np.abs(residual - np.median(residual)) > limit
+        # and from its neighbours: where two metronomes of nearly one tempo drift
+        # through each other, a train that took some of the other's ticks bends away
+        # from any quadratic, which then hides a tick 10 ms off
+        local = times[sel] - _from_neighbours(n, times[sel])
+        inner = np.isfinite(local)
+        if inner.sum() >= 4:
+            limit = max(OFF_BEAT, 5 * _robust_spread(local[inner]))
+            out[sel[inner]] |= np.abs(local[inner] - np.median(local[inner])) > limit
+    return out
+
+
+def _from_neighbours(n: np.ndarray, t: np.ndarray, side: int = NEIGHBOURS) -> np.ndarray:
+    """(S,) each tick's time as its neighbours put it: the median over the lines through
+    one of the ``side`` ticks before it and one of the ``side`` after, so that one odd
+    neighbour does not move it; NaN within ``side`` of either end (with fewer, one odd
+    neighbour would)."""
+    size = t.size
+    out = np.full(size, np.nan)
+    if size <= 2 * side:
+        return out
+    p = np.arange(side, size - side)
+    n = n.astype(float)
+    guesses = [t[p - da] + (t[p + db] - t[p - da]) * (n[p] - n[p - da]) / (n[p + db] - n[p - da])
+               for da in range(1, side + 1) for db in range(1, side + 1)]  # fmt: skip
+    out[p] = np.median(guesses, axis=0)
     return out
 
 
@@ -448,17 +544,38 @@ def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
         spread = math.sqrt(max(0.0, -2 * math.log(max(abs(z), 1e-12)))) / (2 * np.pi)
         off_grid = abs(np.angle(z) / (2 * np.pi))
         if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
-            return beat
+            if _drift(t_b[inside], tb.beat[inside], gap_before / beat, z) < MAX_DRIFT:
+                return beat
     return None
+
+
+def _drift(t: np.ndarray, beat: np.ndarray, place: np.ndarray, z: complex) -> float:
+    """How far (beats) ticks at ``t`` drift on another train's grid over their span:
+    ``place`` (fractions of a beat after the grid's last beat) about its circular mean
+    ``z``, less each kind of beat's median (a limp), fitted by a line in time."""
+    x = np.angle(np.exp(2j * np.pi * place) / z) / (2 * np.pi)
+    for parity in (0, 1):
+        sel = beat % 2 == parity
+        if sel.any():
+            x[sel] -= np.median(x[sel])
+    ok = np.abs(x) < 0.1  # a tick timed by another's that hid it
+    if ok.sum() < 4 or np.ptp(t[ok]) <= 0:
+        return 0.0
+    slope = np.polyfit(t[ok], x[ok], 1)[0]
+    return float(abs(slope) * np.ptp(t))
 
 
 def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
     """The beat, when train b takes up train a's beat after a ended: one metronome
-    followed again after ticks of another hid it for more than `MAX_MISSING` beats."""
-    if abs(tb.period / ta.period - 1) > 0.01:
+    followed again after ticks of another hid it for more than `MAX_MISSING` beats, or
+    only every few of its beats heard (b's period a whole multiple of a's, up to
+    `MAX_FRAGMENT`, or a's of b's: the beat is the shorter)."""
+    short, long_ = sorted((ta.period, tb.period))
+    k = round(long_ / short)
+    if k > MAX_FRAGMENT or abs(long_ / (k * short) - 1) > 0.01:
         return None
     end, start = times[ta.index[-1]], times[tb.index[0]]
-    beat = 0.5 * (ta.period + tb.period)
+    beat = 0.5 * (short + long_ / k)
     beats = (start - end) / beat
     if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > 0.15:
         return None
