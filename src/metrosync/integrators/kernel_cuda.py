@@ -302,8 +302,7 @@ def scheme_kernel(begin, impulse):
                             theta_dot[b, i], th_new[b, i], rest[b, i], after, half, dv, jrest
                         )
                         jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                for k in range(SUMS):
-                    sums[k, tid] = jumps[k]
+                sums[0, tid], sums[1, tid], sums[2, tid], sums[3, tid], sums[4, tid] = jumps
                 block_sum(sums, SUMS, tid, nt)
                 if tid == 0:
                     totals = (sums[0, 0], sums[1, 0], sums[2, 0], sums[3, 0], sums[4, 0])
