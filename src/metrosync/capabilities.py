@@ -289,6 +289,11 @@ CONSUMERS: dict[str, Consumer] = {
         Consumer("verlet/gpu", _ALL - {"dry-friction", "trajectories"}, "the GPU backend"),
         Consumer("located/numba", _ALL - {"dry-friction"}, "integrator 'located'"),
         Consumer("located/numpy", _ALL - {"dry-friction"}, "integrator 'located'", cost="numpy"),
+        Consumer(
+            "located/gpu",
+            _ALL - {"dry-friction", "trajectories"},
+            "integrator 'located' on the GPU",
+        ),
         Consumer("exact/scipy", _ALL, "integrator 'exact'", cost="whole-run"),
         Consumer("playground", PLAYGROUND_RUNS, "the playground"),
     )

@@ -1,5 +1,5 @@
-"""The GPU kernel, checked in numba's CUDA simulator (no GPU needed), and the clear
-refusal of ``backend="gpu"`` on a machine without one."""
+"""The GPU kernels (``verlet`` and ``located``), checked in numba's CUDA simulator (no
+GPU needed), and the clear refusal of ``backend="gpu"`` on a machine without one."""
 
 import os
 import subprocess
@@ -8,15 +8,21 @@ import sys
 import pytest
 
 from metrosync import ParameterError, simulate
-from metrosync.integrators import kernel_cuda
+from metrosync.capabilities import runs
+from metrosync.integrators import REGISTRY, kernel_cuda, load_backend
 
 SIMULATED_CHECK = """
 import math
+import sys
 import numpy as np
 from metrosync import build_ensemble, get_preset
 from metrosync.capabilities import FEATURES as TABLE, UnsupportedFeature, runs
 from metrosync.integrators import kernel_cuda, twin
 from metrosync.integrators._state import StepState
+
+SCHEME = sys.argv[1]  # verlet or located
+ON_GPU, REFERENCE = getattr(kernel_cuda, SCHEME.upper()), getattr(twin, SCHEME.upper())
+CONSUMER = f"{SCHEME}/gpu"
 
 def run(advance, **kw):
     st = StepState.start(ens.system, ens.theta0, ens.theta_dot0, ens.phi0, ens.phi_dot0,
@@ -33,10 +39,10 @@ def run(advance, **kw):
 # The platform is one of them: every other feature runs on the disk, and those the board
 # has (the disk's own parameters left out) on the board.
 from metrosync.model.platform import DISK_FIELDS
-FEATURES = {k: v for name, f in TABLE.items() if f.kind == "model" and runs("verlet/gpu", name)
+FEATURES = {k: v for name, f in TABLE.items() if f.kind == "model" and runs(CONSUMER, name)
             and name != "board" for k, v in f.example.items()}
 ON_BOARD = {"platform": "board", **{k: v for k, v in FEATURES.items() if k not in DISK_FIELDS}}
-assert runs("verlet/gpu", "board")
+assert runs(CONSUMER, "board")
 DEATH = ({"escapement_offset": 0.45}, {"theta0": [0.2, 0.3, 0.5, 0.6, 0.7],
                                         "theta_dot0": [0.0] * 5})
 for groups, changes, start in ((None, {}, {}), ([(2, 186.0), (3, 198.0)], {}, {}),
@@ -44,8 +50,8 @@ for groups, changes, start in ((None, {}, {}), ([(2, 186.0), (3, 198.0)], {}, {}
     params = get_preset("default").with_changes(**changes)
     ens = build_ensemble(5, 192.0, params=params, sigma_bpm=2.0, runs=2, seed=3,
                          groups=groups, **start)
-    gpu = run(kernel_cuda.advance_state, threads=4)
-    ref = run(twin.VERLET.advance_state)
+    gpu = run(ON_GPU.advance_state, threads=4)
+    ref = run(REFERENCE.advance_state)
     assert np.count_nonzero(ref.cross_count) > 0, "no crossing was booked"
     for name in ("theta", "theta_dot", "phi", "phi_dot", "p_phi", "r", "r_group", "cross_count",
                  "last_kick"):
@@ -61,19 +67,19 @@ theta_dot0 = np.zeros((2, 3))
 theta_dot0[1, 0] = 1e200
 ens = build_ensemble(3, 192.0, params=get_preset("default"), runs=2, seed=3,
                      theta0=np.full((2, 3), 0.3), theta_dot0=theta_dot0)
-gpu = run(kernel_cuda.advance_state, threads=4)
-ref = run(twin.VERLET.advance_state)
+gpu = run(ON_GPU.advance_state, threads=4)
+ref = run(REFERENCE.advance_state)
 assert ref.status[1] & 2 and np.isnan(ref.r[1]).all()
 np.testing.assert_array_equal(gpu.status, ref.status)
 np.testing.assert_allclose(gpu.r, ref.r, rtol=0, atol=1e-9)  # NaN in the same places
 
 # The model features the table says it lacks, it refuses by name.
 for name, f in TABLE.items():
-    if f.kind == "model" and not runs("verlet/gpu", name):
+    if f.kind == "model" and not runs(CONSUMER, name):
         params = get_preset("default").with_changes(**f.example)
         ens = build_ensemble(3, 192.0, params=params, runs=2, seed=3)
         try:
-            run(kernel_cuda.advance_state, threads=4)
+            run(ON_GPU.advance_state, threads=4)
         except UnsupportedFeature as refused:
             assert refused.feature == name and f.parameters[0] in str(refused), refused
         else:
@@ -82,11 +88,16 @@ print("ok")
 """
 
 
+#: Every scheme the registry runs on the GPU.
+ON_GPU = [name for name, scheme in REGISTRY.items() if "gpu" in scheme.backends]
+
+
 @pytest.mark.slow
-def test_gpu_kernel_matches_the_reference_in_the_cuda_simulator():
+@pytest.mark.parametrize("scheme", ON_GPU)
+def test_gpu_kernel_matches_the_reference_in_the_cuda_simulator(scheme):
     env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
-    done = subprocess.run([sys.executable, "-c", SIMULATED_CHECK], env=env, capture_output=True,
-                          text=True, timeout=600)  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", SIMULATED_CHECK, scheme], env=env,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-3000:]
 
 
@@ -100,3 +111,10 @@ def test_threads_per_block_cover_the_metronomes():
     assert kernel_cuda.threads_for(2) == 32
     assert kernel_cuda.threads_for(100) == 128
     assert kernel_cuda.threads_for(10_000) == kernel_cuda.MAX_THREADS
+
+
+def test_both_fixed_step_schemes_run_on_the_gpu_each_declared_in_the_table():
+    assert ON_GPU == ["verlet", "located"]
+    for name in ON_GPU:
+        assert load_backend(REGISTRY[name].modules["gpu"]).name == name
+        assert runs(f"{name}/gpu", "board") and not runs(f"{name}/gpu", "trajectories")

@@ -119,10 +119,10 @@ def order_against_exact(**kw):
     return np.polyfit(np.log(dts), np.log(errors), 1)[0], errors, exact
 
 
-def test_registered_with_both_cpu_backends():
+def test_registered_with_both_cpu_backends_and_the_gpu():
     scheme = REGISTRY["located"]
     assert scheme.order == 2 and scheme.order_with_kicks == 2
-    assert set(scheme.backends) == {"numba", "numpy"} and scheme.fixed_step
+    assert set(scheme.backends) == {"numba", "numpy", "gpu"} and scheme.fixed_step
     ds = simulate(3, 192, runs=2, duration=2, integrator="located", backend="numpy", seed=1)
     assert ds.attrs["integrator"] == "located" and np.isfinite(ds.r).all()
 

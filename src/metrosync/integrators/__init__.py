@@ -109,7 +109,7 @@ REGISTRY: dict[str, Integrator] = {
         modules={
             "numba": "metrosync.integrators.verlet",
             "numpy": "metrosync.integrators.twin:VERLET",
-            "gpu": "metrosync.integrators.kernel_cuda",
+            "gpu": "metrosync.integrators.kernel_cuda:VERLET",
         },
         fixed_step=True,
     ),
@@ -122,6 +122,7 @@ REGISTRY: dict[str, Integrator] = {
         modules={
             "numba": "metrosync.integrators.located",
             "numpy": "metrosync.integrators.twin:LOCATED",
+            "gpu": "metrosync.integrators.kernel_cuda:LOCATED",
         },
         fixed_step=True,
     ),

@@ -1,5 +1,8 @@
-"""Compiled pieces shared by every fixed-step CPU kernel: the scheme's updates (see
-`verlet`), crossing-phase bookkeeping and the per-record observables.
+"""Compiled pieces shared by every fixed-step kernel: the scheme's updates (see
+`verlet`), crossing-phase bookkeeping and the per-record observables. The CPU layouts
+inline them; `kernel_cuda` compiles the same source as CUDA device functions, with
+the sums' update (`accumulate`) made atomic and a run's order parameter
+(`analytic_order`, from `phase_vector` and `resultant`) summed over a thread block.
 
 Groups of metronomes (`metrosync.ensemble`) are contiguous: group g holds metronomes
 ``group_start[g]`` to ``group_start[g + 1] - 1``. The crossing-phase sums are kept per
@@ -17,6 +20,7 @@ import math
 
 import numba as nb
 
+from ._physics import disk_acceleration
 from .trig import sincos
 
 TWO_PI = 2.0 * math.pi
@@ -76,9 +80,9 @@ def add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_
     im, re = sincos(phase0)
     rot_im, rot_re = sincos(step)
     for g in range(g0, g1):
-        cross_re[b, g, grp] += re
-        cross_im[b, g, grp] += im
-        cross_count[b, g, grp] += 1
+        accumulate(cross_re, (b, g, grp), re)
+        accumulate(cross_im, (b, g, grp), im)
+        accumulate(cross_count, (b, g, grp), 1)
         re, im = re * rot_re - im * rot_im, re * rot_im + im * rot_re
 
 
@@ -110,13 +114,10 @@ def analytic_order(theta_row, theta_dot_row, omega_row):
     re = 0.0
     im = 0.0
     for i in range(n):  # branch-free, so that it vectorizes
-        x = theta_row[i]
-        y = -theta_dot_row[i] / omega_row[i]
-        rho = math.sqrt(x * x + y * y)
-        inv = 1.0 / rho if rho > 0.0 else 0.0  # a pendulum at rest has no phase
-        re += x * inv
-        im += y * inv
-    return math.sqrt(re * re + im * im) / n
+        x, y = phase_vector(theta_row[i], theta_dot_row[i], omega_row[i])
+        re += x
+        im += y
+    return resultant(re, im, n)
 
 
 @nb.njit(cache=True, inline="always")
@@ -138,3 +139,51 @@ def record_run(b, k, theta, theta_dot, phi, phi_dot, omega_row, r, r_group, grou
         group_orders(r_group, b, k, theta[b], theta_dot[b], omega_row, group_start)
     if traj_theta.shape[0] > 0:
         save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+
+
+@nb.njit(cache=True, inline="always")
+def accumulate(sums, index, value):
+    """``sums[index] += value``: the one update of the crossing-phase sums. The GPU
+    kernel compiles it as an atomic add, since a block's threads book crossings of the
+    same run at once."""
+    sums[index] += value
+
+
+@nb.njit(cache=True, inline="always")
+def phase_vector(theta, theta_dot, omega):
+    """e^{iΦ} of a metronome's analytic phase Φ = atan2(−θ̇/ω, θ), as (cos Φ, sin Φ);
+    (0, 0) for a pendulum at rest, which has no phase. Branch-free, so that a loop of it
+    vectorizes."""
+    y = -theta_dot / omega
+    rho = math.sqrt(theta * theta + y * y)
+    inv = 1.0 / rho if rho > 0.0 else 0.0
+    return theta * inv, y * inv
+
+
+@nb.njit(cache=True, inline="always")
+def resultant(re, im, count):
+    """The order parameter r = |Σ e^{iΦ}| / ``count`` from the sums of `phase_vector`."""
+    return math.sqrt(re * re + im * im) / count
+
+
+@nb.njit(cache=True, inline="always")
+def kicked(theta_dot, theta_next, rest, after, half, dv, jrest):
+    """A pendulum after its own impulse inside the step (``located``; ``dv``, ``jrest``
+    from `_located_parts.kick`, ``after`` the time left in the step, ``half`` = dt/2):
+    its velocity, net of the change of its forces that the second pass adds for dt/2;
+    its new angle, moved on by the jump for ``after``; and its ρ."""
+    return theta_dot + (dv + (after - half) * jrest), theta_next + after * dv, rest + jrest
+
+
+@nb.njit(cache=True, inline="always")
+def disk_jumps(c, r, jumps, sum_den):
+    """The disk's share of a step's impulses, from their sums ``jumps`` (the layouts'
+    ``add_jump``) and the step's denominator sum: its velocity jump Δφ̇, the shift of
+    its angle (each jump travelling for the time left after it), and the change of φ̈.
+    Every pendulum j then jumps by ``theta_ddot(c, j, r, 0, q_j, Δφ̇)`` and moves by
+    the same of the shift."""
+    return (
+        disk_acceleration(c, r, jumps[0], sum_den, jumps[1]),
+        disk_acceleration(c, r, jumps[2], sum_den, jumps[3]),
+        disk_acceleration(c, r, jumps[4], sum_den, 0.0),
+    )
