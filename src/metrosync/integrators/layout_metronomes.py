@@ -41,6 +41,9 @@ from ._physics import (
 from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 FASTMATH = {"reassoc", "contract"}
+#: Bits of a metronome's events in a step: an upward zero crossing, an impulse.
+UP = 1
+KICK = 2
 
 
 def arrange(constants):
@@ -63,7 +66,7 @@ def loop(st, c, settings, rec, begin, impulse):
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
         scratch = _scratch(n)
-        th_new, rest, q, crossed = scratch
+        th_new, rest, q, events = scratch
         pinned = math.isinf(c.total_inertia[b])
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
@@ -98,12 +101,15 @@ def loop(st, c, settings, rec, begin, impulse):
             impulses = n_imp > 0
             if n_up > 0 or n_imp > 0:
                 for i in range(n):  # stops after the last crossing and impulse
-                    if crossed[i]:
+                    event = events[i]
+                    if event == 0:
+                        continue
+                    if event & UP:
                         th = theta[b, i]
                         t_cross = t_old + dt * th / (th - th_new[i])
                         upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
                         n_up -= 1
-                    if n_imp > 0:
+                    if event & KICK:
                         kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt)  # fmt: skip  # noqa: E501
                         if kick != 0.0:
                             # The second pass adds dt/2 of the new accelerations, which
@@ -159,8 +165,8 @@ def loop(st, c, settings, rec, begin, impulse):
 @nb.njit(inline="always")
 def _scratch(n):
     """A run's scratch arrays, (N,) each: new angles, ρ_i and q_i of the step, and its
-    upward zero crossings."""
-    return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    events (`UP` | `KICK` bits)."""
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.uint8)
 
 
 @nb.njit(inline="always")
@@ -184,7 +190,7 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
     vectorizable `sincos` or, for far-wound angles, libm's; ``t_new`` into
     ``last_kick`` (the run's row) where an escapement fires. Returns the three sums and
     the counts of upward crossings, impulses, overturned and far-wound angles."""
-    th_new, rest, q, crossed = scratch
+    th_new, rest, q, events = scratch
     sum_num = 0.0
     sum_den = 0.0
     sum_kick = 0.0
@@ -197,9 +203,12 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
         tn, vp, fires, torque, kick = begin(c, (b, i), th, theta_dot[i], acc[i], dt, dt2)
         last_kick[i] = t_new if fires != 0.0 else last_kick[i]  # a select: it vectorizes
         up = upward(th, tn)
+        kicked = kick != 0.0  # a constant False for a scheme without impulses
         n_up += 1 if up else 0
-        crossed[i] = up  # stored, not recomputed later: measurably faster (!)
-        n_imp += 1 if kick != 0.0 else 0
+        n_imp += 1 if kicked else 0
+        # Stored, not recomputed in the scalar pass, which visits only the metronomes
+        # with an event: measurably faster (benchmarks/located.py).
+        events[i] = (UP if up else 0) | (KICK if kicked else 0)
         n_over += 1 if abs(tn) > overturn_angle else 0
         n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
         sn, cs = trig(tn)
