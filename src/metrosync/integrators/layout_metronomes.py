@@ -56,8 +56,32 @@ def loop(st, c, settings, rec, begin, impulse):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place,
     with the scheme's hooks ``begin`` and ``impulse``."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
+    (
+        theta,
+        theta_dot,
+        phi,
+        phi_dot,
+        acc_theta,
+        acc_phi,
+        p_phi,
+        force_phi,
+        last_up,
+        status,
+        last_kick,
+        rest_steps,
+    ) = st
+    (
+        r,
+        cross_re,
+        cross_im,
+        cross_count,
+        traj_theta,
+        traj_theta_dot,
+        traj_phi,
+        traj_phi_dot,
+        r_group,
+        group_start,
+    ) = rec
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
@@ -71,15 +95,58 @@ def loop(st, c, settings, rec, begin, impulse):
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
-            record_run(b, 0, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+            record_run(
+                b,
+                0,
+                theta,
+                theta_dot,
+                phi,
+                phi_dot,
+                c.omega[b],
+                r,
+                r_group,
+                group_start,
+                traj_theta,
+                traj_theta_dot,
+                traj_phi,
+                traj_phi_dot,
+            )
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
             t_old = s * dt
             t_new = (s + 1) * dt
-            sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, scratch, last_kick[b], t_new, begin, sincos)  # fmt: skip  # noqa: E501
+            sums = _first_pass(
+                c,
+                b,
+                theta[b],
+                theta_dot[b],
+                acc_theta[b],
+                dt,
+                dt2,
+                overturn_angle,
+                scratch,
+                last_kick[b],
+                t_new,
+                begin,
+                sincos,
+            )
             if sums[6] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, scratch, last_kick[b], t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
+                sums = _first_pass(
+                    c,
+                    b,
+                    theta[b],
+                    theta_dot[b],
+                    acc_theta[b],
+                    dt,
+                    dt2,
+                    overturn_angle,
+                    scratch,
+                    last_kick[b],
+                    t_new,
+                    begin,
+                    libm_sincos,
+                )
             sum_num, sum_den, sum_kick, n_up, n_imp, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
@@ -107,10 +174,23 @@ def loop(st, c, settings, rec, begin, impulse):
                     if event & UP:
                         th = theta[b, i]
                         t_cross = t_old + dt * th / (th - th_new[i])
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
+                        upward_crossing(
+                            last_up,
+                            cross_re,
+                            cross_im,
+                            cross_count,
+                            b,
+                            i,
+                            t_cross,
+                            grid_dt,
+                            n_rec,
+                            group_start,
+                        )
                         n_up -= 1
                     if event & KICK:
-                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt)  # fmt: skip  # noqa: E501
+                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(
+                            c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt
+                        )
                         if kick != 0.0:
                             # The second pass adds dt/2 of the new accelerations, which
                             # include the forces' change: the velocity's terms are net of it.
@@ -150,7 +230,25 @@ def loop(st, c, settings, rec, begin, impulse):
                 p_phi[b] += jump_p
             phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
             if dry:
-                force, phdd, held, sum_p = _settle_disk(c, b, theta_dot[b], acc_theta[b], rest, q, p_phi, phi_dot, sum_num, sum_den, sum_p, others, friction, force, phdd, held, dt)  # fmt: skip  # noqa: E501
+                force, phdd, held, sum_p = _settle_disk(
+                    c,
+                    b,
+                    theta_dot[b],
+                    acc_theta[b],
+                    rest,
+                    q,
+                    p_phi,
+                    phi_dot,
+                    sum_num,
+                    sum_den,
+                    sum_p,
+                    others,
+                    friction,
+                    force,
+                    phdd,
+                    held,
+                    dt,
+                )
                 if held:
                     rest_steps[b] += 1
             force_phi[b] = force
@@ -159,7 +257,22 @@ def loop(st, c, settings, rec, begin, impulse):
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
-                record_run(b, k, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                record_run(
+                    b,
+                    k,
+                    theta,
+                    theta_dot,
+                    phi,
+                    phi_dot,
+                    c.omega[b],
+                    r,
+                    r_group,
+                    group_start,
+                    traj_theta,
+                    traj_theta_dot,
+                    traj_phi,
+                    traj_phi_dot,
+                )
 
 
 @nb.njit(inline="always")
@@ -184,7 +297,9 @@ def add_jump(jumps, after, half, dnum, dforce, jnum):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, last_kick, t_new, begin, trig):  # fmt: skip  # noqa: E501
+def _first_pass(
+    c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, last_kick, t_new, begin, trig
+):
     """New angles, the escapement and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s
     metronomes (rows ``theta``, ``theta_dot``, ``acc``), with ``trig`` = the
     vectorizable `sincos` or, for far-wound angles, libm's; ``t_new`` into
@@ -223,7 +338,25 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
 
 
 @nb.njit(cache=True)
-def _settle_disk(c, b, theta_dot, acc, rest, q, p_phi, phi_dot, sum_num, sum_den, sum_p, others, friction, force, phdd, held, dt):  # fmt: skip  # noqa: E501
+def _settle_disk(
+    c,
+    b,
+    theta_dot,
+    acc,
+    rest,
+    q,
+    p_phi,
+    phi_dot,
+    sum_num,
+    sum_den,
+    sum_p,
+    others,
+    friction,
+    force,
+    phdd,
+    held,
+    dt,
+):
     """Run ``b``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (the scheme is in
     `verlet`'s docstring). Returns the torque and φ̈ to store, whether the disk ends
