@@ -87,18 +87,29 @@ def add_crossing_phase(cross_re, cross_im, cross_count, b, t_prev, t_next, grid_
 
 
 @nb.njit(cache=True, inline="always")
-def upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start):  # fmt: skip  # noqa: E501
+def upward_crossing(
+    last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start
+):
     """Book an upward zero crossing of metronome ``i`` of run ``b`` at ``t_cross``."""
     if last_up[b, i] >= 0.0:
         add_crossing_phase(
-            cross_re, cross_im, cross_count, b, last_up[b, i], t_cross, grid_dt, n_rec,
+            cross_re,
+            cross_im,
+            cross_count,
+            b,
+            last_up[b, i],
+            t_cross,
+            grid_dt,
+            n_rec,
             group_of(i, group_start),
-        )  # fmt: skip
+        )
     last_up[b, i] = t_cross
 
 
 @nb.njit(cache=True, inline="always")
-def save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+def save_state(
+    b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot
+):
     """Copy run ``b``'s state into record ``k`` of the trajectory buffers."""
     for i in range(theta.shape[1]):
         traj_theta[b, k, i] = theta[b, i]
@@ -131,14 +142,31 @@ def group_orders(r_group, b, k, theta_row, theta_dot_row, omega_row, group_start
 
 
 @nb.njit(cache=True, inline="always")
-def record_run(b, k, theta, theta_dot, phi, phi_dot, omega_row, r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot):  # fmt: skip  # noqa: E501
+def record_run(
+    b,
+    k,
+    theta,
+    theta_dot,
+    phi,
+    phi_dot,
+    omega_row,
+    r,
+    r_group,
+    group_start,
+    traj_theta,
+    traj_theta_dot,
+    traj_phi,
+    traj_phi_dot,
+):
     """Record ``k`` of run ``b`` (metronomes innermost): r, each group's r when there are
     several groups, and the state when trajectories are kept."""
     r[b, k] = analytic_order(theta[b], theta_dot[b], omega_row)
     if group_start.shape[0] > 2:  # several groups
         group_orders(r_group, b, k, theta[b], theta_dot[b], omega_row, group_start)
     if traj_theta.shape[0] > 0:
-        save_state(b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+        save_state(
+            b, k, theta, theta_dot, phi, phi_dot, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot
+        )
 
 
 @nb.njit(cache=True, inline="always")

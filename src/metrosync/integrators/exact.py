@@ -81,9 +81,15 @@ def integrate(
     )
     for b in range(runs):
         samples, upcrossings, status, out.last_kick[b], out.rest_time[b] = _integrate_run(
-            sys.run(b), theta0[b], theta_dot0[b], phi_dot0[b], grid, duration, overturn_angle,
+            sys.run(b),
+            theta0[b],
+            theta_dot0[b],
+            phi_dot0[b],
+            grid,
+            duration,
+            overturn_angle,
             rest_since,
-        )  # fmt: skip
+        )
         out.status[b] = status
         out.crossings.append(upcrossings)
         th, thd = samples[:, 1 : n + 1], samples[:, n + 2 :]
@@ -150,9 +156,14 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
 
     while t < duration:
         solver = DOP853(
-            lambda s, u, m=mode: rhs(s, u, m), t, y, duration,
-            rtol=RTOL, atol=ATOL, max_step=period / 8,
-        )  # fmt: skip
+            lambda s, u, m=mode: rhs(s, u, m),
+            t,
+            y,
+            duration,
+            rtol=RTOL,
+            atol=ATOL,
+            max_step=period / 8,
+        )
         restarted = False
         while solver.status == "running":
             y_old = solver.y.copy()

@@ -41,6 +41,9 @@ from ._physics import (
 from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 FASTMATH = {"reassoc", "contract"}
+#: Bits of a metronome's events in a step: an upward zero crossing, an impulse.
+UP = 1
+KICK = 2
 
 
 def arrange(constants):
@@ -53,8 +56,32 @@ def loop(st, c, settings, rec, begin, impulse):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place,
     with the scheme's hooks ``begin`` and ``impulse``."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
+    (
+        theta,
+        theta_dot,
+        phi,
+        phi_dot,
+        acc_theta,
+        acc_phi,
+        p_phi,
+        force_phi,
+        last_up,
+        status,
+        last_kick,
+        rest_steps,
+    ) = st
+    (
+        r,
+        cross_re,
+        cross_im,
+        cross_count,
+        traj_theta,
+        traj_theta_dot,
+        traj_phi,
+        traj_phi_dot,
+        r_group,
+        group_start,
+    ) = rec
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_rec = r.shape[1]
@@ -63,20 +90,63 @@ def loop(st, c, settings, rec, begin, impulse):
     grid_dt = record_every * dt
     for b in nb.prange(n_runs):
         scratch = _scratch(n)
-        th_new, rest, q, crossed = scratch
+        th_new, rest, q, events = scratch
         pinned = math.isinf(c.total_inertia[b])
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
-            record_run(b, 0, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+            record_run(
+                b,
+                0,
+                theta,
+                theta_dot,
+                phi,
+                phi_dot,
+                c.omega[b],
+                r,
+                r_group,
+                group_start,
+                traj_theta,
+                traj_theta_dot,
+                traj_phi,
+                traj_phi_dot,
+            )
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
             t_old = s * dt
             t_new = (s + 1) * dt
-            sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, scratch, last_kick[b], t_new, begin, sincos)  # fmt: skip  # noqa: E501
+            sums = _first_pass(
+                c,
+                b,
+                theta[b],
+                theta_dot[b],
+                acc_theta[b],
+                dt,
+                dt2,
+                overturn_angle,
+                scratch,
+                last_kick[b],
+                t_new,
+                begin,
+                sincos,
+            )
             if sums[6] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sums = _first_pass(c, b, theta[b], theta_dot[b], acc_theta[b], dt, dt2, overturn_angle, scratch, last_kick[b], t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
+                sums = _first_pass(
+                    c,
+                    b,
+                    theta[b],
+                    theta_dot[b],
+                    acc_theta[b],
+                    dt,
+                    dt2,
+                    overturn_angle,
+                    scratch,
+                    last_kick[b],
+                    t_new,
+                    begin,
+                    libm_sincos,
+                )
             sum_num, sum_den, sum_kick, n_up, n_imp, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
@@ -98,13 +168,29 @@ def loop(st, c, settings, rec, begin, impulse):
             impulses = n_imp > 0
             if n_up > 0 or n_imp > 0:
                 for i in range(n):  # stops after the last crossing and impulse
-                    if crossed[i]:
+                    event = events[i]
+                    if event == 0:
+                        continue
+                    if event & UP:
                         th = theta[b, i]
                         t_cross = t_old + dt * th / (th - th_new[i])
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
+                        upward_crossing(
+                            last_up,
+                            cross_re,
+                            cross_im,
+                            cross_count,
+                            b,
+                            i,
+                            t_cross,
+                            grid_dt,
+                            n_rec,
+                            group_start,
+                        )
                         n_up -= 1
-                    if n_imp > 0:
-                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt)  # fmt: skip  # noqa: E501
+                    if event & KICK:
+                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(
+                            c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt
+                        )
                         if kick != 0.0:
                             # The second pass adds dt/2 of the new accelerations, which
                             # include the forces' change: the velocity's terms are net of it.
@@ -144,7 +230,25 @@ def loop(st, c, settings, rec, begin, impulse):
                 p_phi[b] += jump_p
             phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
             if dry:
-                force, phdd, held, sum_p = _settle_disk(c, b, theta_dot[b], acc_theta[b], rest, q, p_phi, phi_dot, sum_num, sum_den, sum_p, others, friction, force, phdd, held, dt)  # fmt: skip  # noqa: E501
+                force, phdd, held, sum_p = _settle_disk(
+                    c,
+                    b,
+                    theta_dot[b],
+                    acc_theta[b],
+                    rest,
+                    q,
+                    p_phi,
+                    phi_dot,
+                    sum_num,
+                    sum_den,
+                    sum_p,
+                    others,
+                    friction,
+                    force,
+                    phdd,
+                    held,
+                    dt,
+                )
                 if held:
                     rest_steps[b] += 1
             force_phi[b] = force
@@ -153,14 +257,29 @@ def loop(st, c, settings, rec, begin, impulse):
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
-                record_run(b, k, theta, theta_dot, phi, phi_dot, c.omega[b], r, r_group, group_start, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)  # fmt: skip  # noqa: E501
+                record_run(
+                    b,
+                    k,
+                    theta,
+                    theta_dot,
+                    phi,
+                    phi_dot,
+                    c.omega[b],
+                    r,
+                    r_group,
+                    group_start,
+                    traj_theta,
+                    traj_theta_dot,
+                    traj_phi,
+                    traj_phi_dot,
+                )
 
 
 @nb.njit(inline="always")
 def _scratch(n):
     """A run's scratch arrays, (N,) each: new angles, ρ_i and q_i of the step, and its
-    upward zero crossings."""
-    return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    events (`UP` | `KICK` bits)."""
+    return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.uint8)
 
 
 @nb.njit(inline="always")
@@ -178,13 +297,15 @@ def add_jump(jumps, after, half, dnum, dforce, jnum):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, last_kick, t_new, begin, trig):  # fmt: skip  # noqa: E501
+def _first_pass(
+    c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, last_kick, t_new, begin, trig
+):
     """New angles, the escapement and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s
     metronomes (rows ``theta``, ``theta_dot``, ``acc``), with ``trig`` = the
     vectorizable `sincos` or, for far-wound angles, libm's; ``t_new`` into
     ``last_kick`` (the run's row) where an escapement fires. Returns the three sums and
     the counts of upward crossings, impulses, overturned and far-wound angles."""
-    th_new, rest, q, crossed = scratch
+    th_new, rest, q, events = scratch
     sum_num = 0.0
     sum_den = 0.0
     sum_kick = 0.0
@@ -197,9 +318,12 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
         tn, vp, fires, torque, kick = begin(c, (b, i), th, theta_dot[i], acc[i], dt, dt2)
         last_kick[i] = t_new if fires != 0.0 else last_kick[i]  # a select: it vectorizes
         up = upward(th, tn)
+        kicked = kick != 0.0  # a constant False for a scheme without impulses
         n_up += 1 if up else 0
-        crossed[i] = up  # stored, not recomputed later: measurably faster (!)
-        n_imp += 1 if kick != 0.0 else 0
+        n_imp += 1 if kicked else 0
+        # Stored, not recomputed in the scalar pass, which visits only the metronomes
+        # with an event: measurably faster (benchmarks/located.py).
+        events[i] = (UP if up else 0) | (KICK if kicked else 0)
         n_over += 1 if abs(tn) > overturn_angle else 0
         n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
         sn, cs = trig(tn)
@@ -214,7 +338,25 @@ def _first_pass(c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, l
 
 
 @nb.njit(cache=True)
-def _settle_disk(c, b, theta_dot, acc, rest, q, p_phi, phi_dot, sum_num, sum_den, sum_p, others, friction, force, phdd, held, dt):  # fmt: skip  # noqa: E501
+def _settle_disk(
+    c,
+    b,
+    theta_dot,
+    acc,
+    rest,
+    q,
+    p_phi,
+    phi_dot,
+    sum_num,
+    sum_den,
+    sum_p,
+    others,
+    friction,
+    force,
+    phdd,
+    held,
+    dt,
+):
     """Run ``b``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (the scheme is in
     `verlet`'s docstring). Returns the torque and φ̈ to store, whether the disk ends

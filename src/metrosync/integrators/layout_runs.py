@@ -75,8 +75,32 @@ def loop(st, c, settings, rec, begin, impulse):
     with the scheme's hooks; the state uses the usual (B, N) layout and is transposed
     into blocks here, once per call; ``c`` comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
-    theta, theta_dot, phi, phi_dot, acc_theta, acc_phi, p_phi, force_phi, last_up, status, last_kick, rest_steps = st  # fmt: skip  # noqa: E501
-    r, cross_re, cross_im, cross_count, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start = rec  # fmt: skip  # noqa: E501
+    (
+        theta,
+        theta_dot,
+        phi,
+        phi_dot,
+        acc_theta,
+        acc_phi,
+        p_phi,
+        force_phi,
+        last_up,
+        status,
+        last_kick,
+        rest_steps,
+    ) = st
+    (
+        r,
+        cross_re,
+        cross_im,
+        cross_count,
+        traj_theta,
+        traj_theta_dot,
+        traj_phi,
+        traj_phi_dot,
+        r_group,
+        group_start,
+    ) = rec
     dt, step0, n_steps, record_every, overturn_angle = settings
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
@@ -88,7 +112,9 @@ def loop(st, c, settings, rec, begin, impulse):
     for blk in nb.prange(n_blocks):
         b0 = blk * LANES
         lanes = min(LANES, n_runs - b0)
-        th, thd, acc, ph, phd, aph, pp, fph, alive = load_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes)  # fmt: skip  # noqa: E501
+        th, thd, acc, ph, phd, aph, pp, fph, alive = load_block(
+            theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes
+        )
         tn_s = np.empty((n, LANES))
         rest = np.empty((n, LANES))
         q = np.empty((n, LANES))
@@ -112,7 +138,7 @@ def loop(st, c, settings, rec, begin, impulse):
         lk = load_last_kick(last_kick, b0, lanes)
         dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
-            dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])  # fmt: skip  # noqa: E501
+            dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])
         dry = dry_lane.any()
         others = np.empty(LANES)
         friction = np.empty(LANES)
@@ -124,13 +150,77 @@ def loop(st, c, settings, rec, begin, impulse):
         if step0 == 0:
             for w in range(lanes):
                 if alive[w] > 0.0:
-                    _record(b0 + w, blk, w, 0, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
+                    _record(
+                        b0 + w,
+                        blk,
+                        w,
+                        0,
+                        th,
+                        thd,
+                        ph,
+                        phd,
+                        c,
+                        r,
+                        save,
+                        traj_theta,
+                        traj_theta_dot,
+                        traj_phi,
+                        traj_phi_dot,
+                        r_group,
+                        group_start,
+                    )
         for s in range(step0, step0 + n_steps):
             t_old = s * dt
             t_new = (s + 1) * dt
-            n_far = _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, sincos)  # fmt: skip  # noqa: E501
+            n_far = _first_pass(
+                c,
+                blk,
+                th,
+                thd,
+                acc,
+                dt,
+                dt2,
+                overturn_angle,
+                tn_s,
+                rest,
+                q,
+                s_num,
+                s_den,
+                s_kick,
+                ups,
+                imps,
+                overs,
+                lk,
+                alive,
+                t_new,
+                begin,
+                sincos,
+            )
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, libm_sincos)  # fmt: skip  # noqa: E501
+                _first_pass(
+                    c,
+                    blk,
+                    th,
+                    thd,
+                    acc,
+                    dt,
+                    dt2,
+                    overturn_angle,
+                    tn_s,
+                    rest,
+                    q,
+                    s_num,
+                    s_den,
+                    s_kick,
+                    ups,
+                    imps,
+                    overs,
+                    lk,
+                    alive,
+                    t_new,
+                    begin,
+                    libm_sincos,
+                )
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -140,7 +230,9 @@ def loop(st, c, settings, rec, begin, impulse):
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
             if dry:  # the block has a run with dry friction on the disk (`verlet`)
-                _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held)  # fmt: skip  # noqa: E501
+                _dry_friction(
+                    c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held
+                )
             any_impulse = False
             for w in range(lanes):
                 if alive[w] == 0.0:
@@ -162,10 +254,23 @@ def loop(st, c, settings, rec, begin, impulse):
                     tn = tn_s[i, w]
                     if upward(t0, tn):
                         t_cross = t_old + dt * t0 / (t0 - tn)
-                        upward_crossing(last_up, cross_re, cross_im, cross_count, b0 + w, i, t_cross, grid_dt, n_rec, group_start)  # fmt: skip  # noqa: E501
+                        upward_crossing(
+                            last_up,
+                            cross_re,
+                            cross_im,
+                            cross_count,
+                            b0 + w,
+                            i,
+                            t_cross,
+                            grid_dt,
+                            n_rec,
+                            group_start,
+                        )
                         ups[w] -= 1
                     if imps[w] > 0:
-                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt)  # fmt: skip  # noqa: E501
+                        kick, after, dv, dnum, dforce, jrest, jnum = impulse(
+                            c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt
+                        )
                         if kick != 0.0:
                             thd[i, w] += dv + (after - half) * jrest
                             tn_s[i, w] += after * dv
@@ -219,27 +324,112 @@ def loop(st, c, settings, rec, begin, impulse):
                 for w in range(LANES):
                     if alive[w] > 0.0:
                         ph[w] = ph_new[w]
-                        pp[w] = momentum(pp[w], fph[w], force[w], dt, math.isinf(c.total_inertia[blk, w]))  # fmt: skip  # noqa: E501
+                        pp[w] = momentum(
+                            pp[w], fph[w], force[w], dt, math.isinf(c.total_inertia[blk, w])
+                        )
                         phd[w] = disk_velocity(c, (blk, w), pp[w], s_p[w])
                         fph[w] = force[w]
                         aph[w] = phdd[w]
             if dry:
-                _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0)  # fmt: skip  # noqa: E501
+                _settle_disks(
+                    c,
+                    blk,
+                    lanes,
+                    alive,
+                    dry_lane,
+                    thd,
+                    acc,
+                    rest,
+                    q,
+                    s_num,
+                    s_den,
+                    s_p,
+                    others,
+                    friction,
+                    held,
+                    pp,
+                    phd,
+                    fph,
+                    aph,
+                    dt,
+                    rest_steps,
+                    b0,
+                )
             until_record -= 1
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
                 for w in range(lanes):
                     if alive[w] > 0.0:
-                        _record(b0 + w, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start)  # fmt: skip  # noqa: E501
-        store_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, b0, lanes, th, thd, acc, ph, phd, aph, pp, fph)  # fmt: skip  # noqa: E501
+                        _record(
+                            b0 + w,
+                            blk,
+                            w,
+                            k,
+                            th,
+                            thd,
+                            ph,
+                            phd,
+                            c,
+                            r,
+                            save,
+                            traj_theta,
+                            traj_theta_dot,
+                            traj_phi,
+                            traj_phi_dot,
+                            r_group,
+                            group_start,
+                        )
+        store_block(
+            theta,
+            theta_dot,
+            acc_theta,
+            phi,
+            phi_dot,
+            acc_phi,
+            p_phi,
+            force_phi,
+            b0,
+            lanes,
+            th,
+            thd,
+            acc,
+            ph,
+            phd,
+            aph,
+            pp,
+            fph,
+        )
         for w in range(lanes):
             for i in range(n):
                 last_kick[b0 + w, i] = lk[i, w]
 
 
 @nb.njit(inline="always")
-def _first_pass(c, blk, th, thd, acc, dt, dt2, overturn_angle, tn_s, rest, q, s_num, s_den, s_kick, ups, imps, overs, lk, alive, t_new, begin, trig):  # fmt: skip  # noqa: E501
+def _first_pass(
+    c,
+    blk,
+    th,
+    thd,
+    acc,
+    dt,
+    dt2,
+    overturn_angle,
+    tn_s,
+    rest,
+    q,
+    s_num,
+    s_den,
+    s_kick,
+    ups,
+    imps,
+    overs,
+    lk,
+    alive,
+    t_new,
+    begin,
+    trig,
+):
     """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
     ``blk``, with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's;
     ``t_new`` into ``lk`` where a live lane's escapement fires. Fills the per-lane
@@ -286,7 +476,7 @@ def load_last_kick(last_kick, b0, lanes):
 
 
 @nb.njit(cache=True)
-def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held):  # fmt: skip  # noqa: E501
+def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held):
     """The dry friction of each lane with it as the step starts resolving the disk
     (`_physics.disk_friction`); adds it to ``force`` and recomputes ``phdd``. Called,
     not inlined, like `_settle_disks`."""
@@ -297,23 +487,69 @@ def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, fric
         if dry_lane[w]:
             friction[w], held[w] = disk_friction(c, (blk, w), phd[w], s_num[w], others[w])
             force[w] = others[w] + friction[w]
-            phdd[w] = 0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])  # fmt: skip  # noqa: E501
+            phdd[w] = (
+                0.0 if held[w] else disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
+            )
 
 
 @nb.njit(cache=True)
-def _settle_disks(c, blk, lanes, alive, dry_lane, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt, rest_steps, b0):  # fmt: skip  # noqa: E501
+def _settle_disks(
+    c,
+    blk,
+    lanes,
+    alive,
+    dry_lane,
+    thd,
+    acc,
+    rest,
+    q,
+    s_num,
+    s_den,
+    s_p,
+    others,
+    friction,
+    held,
+    pp,
+    phd,
+    fph,
+    aph,
+    dt,
+    rest_steps,
+    b0,
+):
     """The disks with dry friction after a step (`_settle_disk`); counts the steps that
     end with a disk held in ``rest_steps``. One call per step, and two levels deep:
     code of this in the step's loop slows the kernel without the feature by about 6 %
     (benchmarks/kernel.py at (100, 7))."""
     for w in range(lanes):
         if alive[w] > 0.0 and dry_lane[w]:
-            if _settle_disk(c, blk, w, thd, acc, rest, q, s_num[w], s_den[w], s_p[w], others[w], friction[w], held[w], pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+            if _settle_disk(
+                c,
+                blk,
+                w,
+                thd,
+                acc,
+                rest,
+                q,
+                s_num[w],
+                s_den[w],
+                s_p[w],
+                others[w],
+                friction[w],
+                held[w],
+                pp,
+                phd,
+                fph,
+                aph,
+                dt,
+            ):
                 rest_steps[b0 + w] += 1
 
 
 @nb.njit(cache=True)
-def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt):  # fmt: skip  # noqa: E501
+def _settle_disk(
+    c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt
+):
     """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (`verlet`). Returns whether
     it ends the step held at rest."""
@@ -341,7 +577,25 @@ def _settle_disk(c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, fricti
 
 
 @nb.njit(cache=True, inline="always")
-def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_dot, traj_phi, traj_phi_dot, r_group, group_start):  # fmt: skip  # noqa: E501
+def _record(
+    b,
+    blk,
+    w,
+    k,
+    th,
+    thd,
+    ph,
+    phd,
+    c,
+    r,
+    save,
+    traj_theta,
+    traj_theta_dot,
+    traj_phi,
+    traj_phi_dot,
+    r_group,
+    group_start,
+):
     r[b, k] = analytic_order(th[:, w], thd[:, w], c.omega[blk, :, w])
     if group_start.shape[0] > 2:  # several groups
         group_orders(r_group, b, k, th[:, w], thd[:, w], c.omega[blk, :, w], group_start)
@@ -354,7 +608,9 @@ def _record(b, blk, w, k, th, thd, ph, phd, c, r, save, traj_theta, traj_theta_d
 
 
 @nb.njit(cache=True, inline="always")
-def load_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes):  # fmt: skip  # noqa: E501
+def load_block(
+    theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes
+):
     """Block-local copies of runs ``b0`` … ``b0 + lanes − 1``, runs innermost: (n, LANES)
     per metronome, (LANES,) per run, and 1.0 for each lane still alive. Missing lanes
     repeat the last run and are never written back (`store_block`)."""
@@ -386,7 +642,26 @@ def load_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_
 
 
 @nb.njit(cache=True, inline="always")
-def store_block(theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, b0, lanes, th, thd, acc, ph, phd, aph, pp, fph):  # fmt: skip  # noqa: E501
+def store_block(
+    theta,
+    theta_dot,
+    acc_theta,
+    phi,
+    phi_dot,
+    acc_phi,
+    p_phi,
+    force_phi,
+    b0,
+    lanes,
+    th,
+    thd,
+    acc,
+    ph,
+    phd,
+    aph,
+    pp,
+    fph,
+):
     """Write a block's real lanes back (the inverse of `load_block`). The arrays come
     unpacked, not in a tuple: numba may lose writes through a tuple field in `prange`."""
     for w in range(lanes):

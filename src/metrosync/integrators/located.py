@@ -99,6 +99,13 @@ def advance_state(
     ``layout`` (default: chosen from the problem's size, as for ``verlet``)."""
     require("located/numba", sys)
     advance_in_layout(
-        LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
-        overturn_angle=overturn_angle, layout=layout,
-    )  # fmt: skip
+        LAYOUTS,
+        state,
+        sys,
+        dt=dt,
+        step0=step0,
+        n_steps=n_steps,
+        record_every=record_every,
+        overturn_angle=overturn_angle,
+        layout=layout,
+    )

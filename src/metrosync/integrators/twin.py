@@ -131,13 +131,18 @@ class _Step:
         # for an impulse), with q at the step's end; all 0 for a step without impulses.
         thdd = thdd + own_change - through_disk * q_new * change[:, None]
         new_theta_dot = (
-            thd + own + (after - half) * own_change + 0.5 * (acc + thdd) * dt
+            thd
+            + own
+            + (after - half) * own_change
+            + 0.5 * (acc + thdd) * dt
             - through_disk * q_new * jump[:, None]
-        )  # fmt: skip
+        )
         new_theta = th_new + after * own - through_disk * q_new * shift[:, None]
         phdd = phdd + change
         new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt + momentum_jump
-        stopping = self.dry & ~held & (friction * _disk_velocity(sys, new_p, th_new, new_theta_dot) >= 0)  # fmt: skip  # noqa: E501
+        stopping = (
+            self.dry & ~held & (friction * _disk_velocity(sys, new_p, th_new, new_theta_dot) >= 0)
+        )
         if stopping.any():  # rare: the disk's velocity reached 0 within the step
             end, stops = _friction_at_stop(sys, friction, new_p, th_new, new_theta_dot, dt)
             end = np.where(stopping, end, friction)
@@ -186,7 +191,9 @@ class _Step:
             t_cross = t_old + self.dt * th[b, i] / (th[b, i] - th_new[b, i])
             if state.last_up[b, i] >= 0:
                 grp = np.searchsorted(state.group_start, i, side="right") - 1
-                _add_crossing_phase(state, b, grp, state.last_up[b, i], t_cross, self.grid_dt, self.n_rec)  # fmt: skip  # noqa: E501
+                _add_crossing_phase(
+                    state, b, grp, state.last_up[b, i], t_cross, self.grid_dt, self.n_rec
+                )
             state.last_up[b, i] = t_cross
 
     def _impulses(self, state, kicks, th, th_new, ok, q_new):
@@ -234,7 +241,10 @@ def _disk_velocity(sys, p_phi, theta, theta_dot):
 def _friction_at_stop(sys, friction, p_phi, theta, theta_dot, dt):
     """The twin of `_physics.disk_friction_stop`: the friction's end value that brings the
     disk to rest, where it is within ±T (then True), else the reversed friction."""
-    stop = friction - 2.0 * effective_inertia(sys, theta) * _disk_velocity(sys, p_phi, theta, theta_dot) / dt  # fmt: skip  # noqa: E501
+    stop = (
+        friction
+        - 2.0 * effective_inertia(sys, theta) * _disk_velocity(sys, p_phi, theta, theta_dot) / dt
+    )
     stops = np.abs(stop) <= sys.dry_friction
     return np.where(stops, stop, -friction), stops
 

@@ -100,6 +100,13 @@ def advance_state(
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from the problem's size, `layouts.choose_layout`)."""
     advance_in_layout(
-        LAYOUTS, state, sys, dt=dt, step0=step0, n_steps=n_steps, record_every=record_every,
-        overturn_angle=overturn_angle, layout=layout,
-    )  # fmt: skip
+        LAYOUTS,
+        state,
+        sys,
+        dt=dt,
+        step0=step0,
+        n_steps=n_steps,
+        record_every=record_every,
+        overturn_angle=overturn_angle,
+        layout=layout,
+    )
