@@ -26,7 +26,16 @@ import numba as nb
 import numpy as np
 
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
-from ._kernel_parts import drift, momentum, record_run, upward, upward_crossing, velocity
+from ._kernel_parts import (
+    disk_jumps,
+    drift,
+    kicked,
+    momentum,
+    record_run,
+    upward,
+    upward_crossing,
+    velocity,
+)
 from ._physics import (
     applied_torque,
     disk_acceleration,
@@ -194,9 +203,9 @@ def loop(st, c, settings, rec, begin, impulse):
                         if kick != 0.0:
                             # The second pass adds dt/2 of the new accelerations, which
                             # include the forces' change: the velocity's terms are net of it.
-                            theta_dot[b, i] += dv + (after - half) * jrest
-                            th_new[i] += after * dv
-                            rest[i] += jrest
+                            theta_dot[b, i], th_new[i], rest[i] = kicked(
+                                theta_dot[b, i], th_new[i], rest[i], after, half, dv, jrest
+                            )
                             jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
                             n_imp -= 1
                     if n_up == 0 and n_imp == 0:
@@ -204,9 +213,8 @@ def loop(st, c, settings, rec, begin, impulse):
             sum_p = 0.0
             jump_p = jumps[1]  # the disk's momentum jump
             if impulses:
-                jump = disk_acceleration(c, b, jumps[0], sum_den, jumps[1])
-                shift = disk_acceleration(c, b, jumps[2], sum_den, jumps[3])
-                phdd += disk_acceleration(c, b, jumps[4], sum_den, 0.0)
+                jump, shift, change = disk_jumps(c, b, jumps, sum_den)
+                phdd += change
                 for i in range(n):  # vectorized pass, with the jumps through the disk
                     thdd = theta_ddot(c, (b, i), b, rest[i], q[i], phdd)
                     v = velocity(theta_dot[b, i], acc_theta[b, i], thdd, dt)

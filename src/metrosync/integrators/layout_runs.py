@@ -25,8 +25,10 @@ import numpy as np
 from ..status import STATUS_DIVERGED, STATUS_OVERTURNED
 from ._kernel_parts import (
     analytic_order,
+    disk_jumps,
     drift,
     group_orders,
+    kicked,
     momentum,
     upward,
     upward_crossing,
@@ -272,17 +274,16 @@ def loop(st, c, settings, rec, begin, impulse):
                             c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt
                         )
                         if kick != 0.0:
-                            thd[i, w] += dv + (after - half) * jrest
-                            tn_s[i, w] += after * dv
-                            rest[i, w] += jrest
+                            thd[i, w], tn_s[i, w], rest[i, w] = kicked(
+                                thd[i, w], tn_s[i, w], rest[i, w], after, half, dv, jrest
+                            )
                             jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
                             imps[w] -= 1
                     if ups[w] == 0 and imps[w] == 0:
                         break
                 if impulses:
-                    jump[w] = disk_acceleration(c, (blk, w), jumps[0], s_den[w], jumps[1])
-                    shift[w] = disk_acceleration(c, (blk, w), jumps[2], s_den[w], jumps[3])
-                    phdd[w] += disk_acceleration(c, (blk, w), jumps[4], s_den[w], 0.0)
+                    jump[w], shift[w], change = disk_jumps(c, (blk, w), jumps, s_den[w])
+                    phdd[w] += change
                     jump_p[w] = jumps[1]
             if any_impulse:
                 for i in range(n):
