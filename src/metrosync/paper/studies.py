@@ -347,6 +347,11 @@ def _bpm_range(start: float, stop: float, step: float) -> tuple[float, ...]:
 #: Fig. 8 in both modes: the paper's 100 runs of the experiments' 10 minutes, cheap
 #: enough to keep even in quick mode.
 FIG8_STATISTICS = Statistics(runs=100, duration=600.0)
+#: Fig. 8 (both panels): ``located`` at four times the paper's step. Measured with
+#: `benchmarks/reproduce_accuracy.py` (every case, 100 runs, the same draws): r_eq moves
+#: by 0.009 (top) and −0.006 (bottom) on average, at most 1.7 standard errors at one
+#: case; at dt = 0.02 s the top panel moves by 0.014, 2.2 SE at 208 BPM.
+FIG8_STEPPING = Stepping("located", 0.04)
 
 FIG8_TOP = TimeSeriesStudy(
     name="fig8_top",
@@ -358,7 +363,7 @@ FIG8_TOP = TimeSeriesStudy(
     ),
     quick=FIG8_STATISTICS,
     full=FIG8_STATISTICS,
-    stepping=PAPER_STEPPING,
+    stepping=FIG8_STEPPING,
     legend_title="N = 7",
 )
 
@@ -370,7 +375,7 @@ FIG8_BOTTOM = TimeSeriesStudy(
     # The paper calls this decrease "not as evident" in simulation: it needs every run.
     quick=FIG8_STATISTICS,
     full=FIG8_STATISTICS,
-    stepping=PAPER_STEPPING,
+    stepping=FIG8_STEPPING,
     legend_title="ω₀ = 192 BPM",
 )
 
@@ -389,6 +394,9 @@ FIG10 = SweepStudy(
         bpms=_bpm_range(150.0, 220.0, 2.5),
         stats=Statistics(runs=100, duration=1000.0),
     ),
+    # The paper's scheme and step: near the onset `located` reads r_eq 0.05–0.075 higher
+    # at dt = 0.02 s (4–9 SE; it is the better converged, docs/reproducing.md) and loses
+    # the onset at 0.04 s (−0.29 at N = 256, 172.5 BPM); benchmarks/reproduce_accuracy.py.
     stepping=PAPER_STEPPING,
 )
 
@@ -399,6 +407,9 @@ FIG11 = TimeSeriesStudy(
     cases=tuple(Case(n, 192.0, 0.0, f"N = {n}") for n in (2, 4, 8, 16, 32, 64)),
     quick=Statistics(runs=10, duration=600.0),
     full=Statistics(runs=100, duration=1000.0),
+    # The paper's scheme and step: with `located` (dt = 0.02 or 0.04 s) the runs at N = 2
+    # and 4 that do not synchronize under `verlet` do (r_eq +0.057 at N = 4, 3.4 SE),
+    # which would change claim 1's verdict; benchmarks/reproduce_accuracy.py.
     stepping=PAPER_STEPPING,
     legend_title="σ = 0, ω₀ = 192 BPM",
 )
@@ -422,6 +433,8 @@ Z_STUDY = ZStudy(
     ),
     quick=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 21), 6)), duration=1500.0),
     full=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 81), 6)), duration=4000.0),
+    # The paper's scheme and step: two metronomes cost seconds, and its basins (which
+    # θ₂(0) lock in phase) are what a coarser step could move; not re-measured.
     stepping=PAPER_STEPPING,
 )
 
