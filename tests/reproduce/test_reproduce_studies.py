@@ -95,3 +95,37 @@ def test_lookup_errors_name_the_valid_choices():
         FIG10.grid("medium")
     with pytest.raises(ParameterError, match="`runs`"):
         Statistics(runs=0, duration=1.0)
+
+
+def test_each_study_runs_its_points_with_its_own_declared_stepping():
+    from metrosync.paper.claims_map import CLAIMS_MAP, _plan
+    from metrosync.paper.readings import SCREEN, Reading
+    from metrosync.paper.runner import points_of
+
+    own = {s.name: s.stepping for s in STUDIES if hasattr(s, "stepping")}
+    # every study with points declares one, except the claims map (below)
+    assert set(own) == {s.name for s in STUDIES if points_of(s, "quick")} - {CLAIMS_MAP.name}
+    for study in STUDIES:
+        if study.name not in own:
+            continue
+        for spec in points_of(study, "quick"):
+            stepping = study.stepping
+            assert spec.kwargs["integrator"] == stepping.integrator, study.name
+            assert spec.kwargs["dt"] == stepping.dt, study.name
+    # the claims map runs each claim with the step of the study that checks it
+    for reading in (Reading(), *CLAIMS_MAP.readings[1:3]):
+        for _, _, study, specs in _plan([reading], SCREEN):
+            for spec in specs:
+                assert spec.kwargs["integrator"] == own[study.name].integrator
+                assert spec.kwargs["dt"] == own[study.name].dt
+
+
+def test_a_stepping_refuses_an_unknown_scheme_or_step():
+    from metrosync.paper.runner import PAPER_STEPPING, Stepping
+
+    assert PAPER_STEPPING.kwargs() == {"dt": 0.01, "integrator": "verlet"}
+    assert Stepping("located", 0.02).describe() == "located, dt = 0.02 s"
+    with pytest.raises(ParameterError, match="verlet"):
+        Stepping("exact", 0.01)  # not a fixed-step scheme
+    with pytest.raises(ParameterError, match="`dt`"):
+        Stepping("located", 0.0)

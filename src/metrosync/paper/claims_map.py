@@ -11,6 +11,11 @@ functions (`metrosync.paper.claims`). Readings are ranked by their score (1 per 
 reproduced, ½ per claim partly reproduced); with a ``best`` level (``--full``), the
 ``top`` readings are simulated again at the paper's statistics and judged again.
 
+Each claim runs with the integrator and step of the study that checks it (the
+``stepping`` of `metrosync.paper.studies`' Figs. 8, 10, 11 and z-study, carried into
+every reading by `reading_studies`), so today's reading at the ``best`` level reuses
+the reproduction's own points.
+
 Two guards keep a verdict honest where the model leaves its domain: a claim whose
 runs mostly overturn (a pendulum past the horizontal) is *not reproduced*, whatever
 r says; and claim 4's sweep is not simulated for a reading whose energy-balance

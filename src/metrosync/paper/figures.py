@@ -38,7 +38,10 @@ def _subtitle(ds: xr.Dataset) -> str:
     a = ds.attrs
     runs = ds.sizes.get("run", a.get("runs", "?"))
     mode = a.get("mode", "")
-    return f"{mode} mode: mean of {runs} runs × {a.get('duration', 0):g} s, dt = {a.get('dt')} s"
+    return (
+        f"{mode} mode: mean of {runs} runs × {a.get('duration', 0):g} s, "
+        f"{a.get('integrator', 'verlet')}, dt = {a.get('dt')} s"
+    )
 
 
 def plot_order_in_time(ds: xr.Dataset, stem: Path) -> list[Path]:
@@ -125,7 +128,8 @@ def plot_z(ds: xr.Dataset, stem: Path) -> list[Path]:
     a = ds.attrs
     ax.set_title(
         f"z figure (§6): N = 2, {a['bpm']:g} BPM, θ₁(0) = {a['theta1_0']} rad, θ̇(0) = 0\n"
-        f"{a.get('mode', '')} mode: t = {a.get('duration', 0):g} s, dt = {a.get('dt')} s",
+        f"{a.get('mode', '')} mode: t = {a.get('duration', 0):g} s, "
+        f"{a.get('integrator', 'verlet')}, dt = {a.get('dt')} s",
         fontsize=9,
     )
     return save_formats(fig, stem)

@@ -28,6 +28,12 @@ is its wall time.
 
 Seeds are a fixed function of the study and point names, so results never depend on
 the order or the number of points computed in one go, nor on the executor.
+
+How a study integrates is its own declared choice, a `Stepping` (integrator and time
+step) in its ``stepping`` field, which the points carry into `simulate`; there is no
+step shared by all studies. Each was chosen from measured accuracy against the
+paper's scheme and step, `PAPER_STEPPING`: the cheapest whose statistics stay within
+the study's statistical error (`benchmarks/reproduce_accuracy.py`, docs/reproducing.md).
 """
 
 from __future__ import annotations
@@ -45,13 +51,44 @@ import xarray as xr
 
 from .._files import write_netcdf
 from .._version import __version__
-from ..errors import MetrosyncError
+from ..errors import MetrosyncError, ParameterError
 from ..sweeps import PointStore
 from ..sweeps.executors import execute
 from ..sweeps.points import PointSpec, make_point
 
-#: Time step of the ensemble studies' points, s (the paper's).
-DT = 0.01
+
+@dataclass(frozen=True)
+class Stepping:
+    """The integrator (a name of `metrosync.integrators.REGISTRY`, fixed-step) and the
+    time step ``dt`` (s) of a study's `simulate` calls."""
+
+    integrator: str
+    dt: float
+
+    def __post_init__(self) -> None:
+        from ..integrators import REGISTRY
+
+        scheme = REGISTRY.get(self.integrator)
+        if scheme is None or not scheme.fixed_step:
+            fixed = [name for name, s in REGISTRY.items() if s.fixed_step]
+            raise ParameterError(
+                f"unknown fixed-step `integrator` {self.integrator!r}; choose one of {fixed}."
+            )
+        if not (math.isfinite(self.dt) and self.dt > 0):
+            raise ParameterError(f"`dt` must be a finite time > 0 s, got {self.dt!r}.")
+
+    def kwargs(self) -> dict[str, float | str]:
+        """The `simulate` keyword arguments of this choice."""
+        return {"dt": float(self.dt), "integrator": self.integrator}
+
+    def describe(self) -> str:
+        """E.g. ``located, dt = 0.02 s`` (for figures and reports)."""
+        return f"{self.integrator}, dt = {self.dt:g} s"
+
+
+#: The paper's scheme and step: the reference against which each study's choice is
+#: measured.
+PAPER_STEPPING = Stepping("verlet", 0.01)
 
 #: ``compute(name, specs, label)``: the points of ``specs`` computed or reused
 #: (`compute_points` with the run's output folder, executor and log).
@@ -293,16 +330,19 @@ def point_seed(study: str, key: str) -> int:
     return zlib.crc32(f"{study}/{key}".encode())
 
 
-def ensemble_points(study: str, cells, stats, preset: str, changes) -> list[PointSpec]:
+def ensemble_points(
+    study: str, cells, stats, preset: str, changes, stepping: Stepping
+) -> list[PointSpec]:
     """The points of an ensemble study: one per cell ``(key, n, bpm, sigma, coords)``, with
-    the statistics ``stats`` (runs, duration) and the model ``changes`` of the study."""
+    the statistics ``stats`` (runs, duration), the model ``changes`` and the ``stepping``
+    of the study."""
     return [
-        ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, dict(changes))
+        ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, dict(changes), stepping)
         for i, (key, n, bpm, sigma, coords) in enumerate(cells)
     ]
 
 
-def ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes=None):
+def ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes, stepping):
     """One ensemble point; its seed depends on the study's and the cell's names only, so
     every reading of the claims map draws the same frequencies and starts."""
     kwargs = {
@@ -311,7 +351,7 @@ def ensemble_point(study, i, key, n, bpm, sigma, stats, preset, coords, changes=
         "sigma_bpm": float(sigma),
         "runs": int(stats.runs),
         "duration": float(stats.duration),
-        "dt": DT,
+        **stepping.kwargs(),
         "preset": preset,
         "seed": point_seed(study, key),
     }

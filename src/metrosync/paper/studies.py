@@ -28,7 +28,7 @@ import xarray as xr
 from ..errors import ParameterError
 from ..sweeps.points import PointSpec, make_point
 from .assemble import assemble_sweep, assemble_time_series, assemble_z
-from .runner import Compute, Study, ensemble_points, run_points
+from .runner import PAPER_STEPPING, Compute, Stepping, Study, ensemble_points, run_points
 
 #: Runs per `simulate` call of the z-study: bounds the memory of full trajectories.
 Z_BATCH = 12
@@ -118,6 +118,8 @@ class TimeSeriesStudy:
     cases: tuple[Case, ...]
     quick: Statistics
     full: Statistics
+    #: Integrator and step of every point, chosen from measured accuracy (see `STEPPING`).
+    stepping: Stepping
     preset: str = "default"
     legend_title: str = ""
     #: Model parameters changed from the preset, by name (a reading of the claims map).
@@ -131,7 +133,9 @@ class TimeSeriesStudy:
         cells = [
             (f"case{i:02d}", c.n, c.bpm, c.sigma_bpm, {"case": i}) for i, c in enumerate(self.cases)
         ]
-        return ensemble_points(self.name, cells, self.statistics(mode), self.preset, self.changes)
+        return ensemble_points(
+            self.name, cells, self.statistics(mode), self.preset, self.changes, self.stepping
+        )
 
     def point_label(self, spec: PointSpec) -> str:
         return self.cases[spec.coords["case"]].label
@@ -162,6 +166,8 @@ class SweepStudy:
     sigma_bpm: float
     quick: SweepGrid
     full: SweepGrid
+    #: Integrator and step of every point, chosen from measured accuracy (see `STEPPING`).
+    stepping: Stepping
     preset: str = "default"
     #: Model parameters changed from the preset, by name (a reading of the claims map).
     changes: tuple[tuple[str, float | str], ...] = ()
@@ -177,7 +183,9 @@ class SweepStudy:
             for n in grid.ns
             for bpm in grid.bpms
         ]
-        return ensemble_points(self.name, cells, grid.stats, self.preset, self.changes)
+        return ensemble_points(
+            self.name, cells, grid.stats, self.preset, self.changes, self.stepping
+        )
 
     def point_label(self, spec: PointSpec) -> str:
         return f"N = {spec.coords['n']}, ω₀ = {spec.coords['bpm']:g} BPM"
@@ -218,9 +226,15 @@ class ZStudy:
     regimes: tuple[Regime, ...]
     quick: ZGrid
     full: ZGrid
+    #: Integrator and step of every point (see `STEPPING`); ``record_every`` counts steps.
+    stepping: Stepping
     bpm: float = 192.0
     theta1: float = 0.1
-    dt: float = 0.01
+
+    @property
+    def dt(self) -> float:
+        """The time step, s (``stepping.dt``)."""
+        return self.stepping.dt
 
     def grid(self, mode: str) -> ZGrid:
         return getattr(self, _check_mode(mode))
@@ -239,7 +253,7 @@ class ZStudy:
                     "bpm": self.bpm,
                     "runs": int(chunk.size),
                     "duration": grid.duration,
-                    "dt": self.dt,
+                    **self.stepping.kwargs(),
                     "preset": regime.preset,
                     "changes": dict(regime.changes) or None,
                     "theta0": theta0.tolist(),
@@ -333,6 +347,11 @@ def _bpm_range(start: float, stop: float, step: float) -> tuple[float, ...]:
 #: Fig. 8 in both modes: the paper's 100 runs of the experiments' 10 minutes, cheap
 #: enough to keep even in quick mode.
 FIG8_STATISTICS = Statistics(runs=100, duration=600.0)
+#: Fig. 8 (both panels): the paper's scheme and step. `located` at 0.04 s keeps each
+#: case within 1.7 standard errors (benchmarks/reproduce_accuracy.py, 100 runs, the same
+#: draws), but saves seconds and, through the claims map's 20-run screen, moves claim 3's
+#: weak slope across 2 SE under some readings (6 readings tie at 3.5 of 5, then 4).
+FIG8_STEPPING = PAPER_STEPPING
 
 FIG8_TOP = TimeSeriesStudy(
     name="fig8_top",
@@ -344,6 +363,7 @@ FIG8_TOP = TimeSeriesStudy(
     ),
     quick=FIG8_STATISTICS,
     full=FIG8_STATISTICS,
+    stepping=FIG8_STEPPING,
     legend_title="N = 7",
 )
 
@@ -355,6 +375,7 @@ FIG8_BOTTOM = TimeSeriesStudy(
     # The paper calls this decrease "not as evident" in simulation: it needs every run.
     quick=FIG8_STATISTICS,
     full=FIG8_STATISTICS,
+    stepping=FIG8_STEPPING,
     legend_title="ω₀ = 192 BPM",
 )
 
@@ -373,6 +394,10 @@ FIG10 = SweepStudy(
         bpms=_bpm_range(150.0, 220.0, 2.5),
         stats=Statistics(runs=100, duration=1000.0),
     ),
+    # The paper's scheme and step: near the onset `located` reads r_eq 0.05–0.075 higher
+    # at dt = 0.02 s (4–9 SE; it is the better converged, docs/reproducing.md) and loses
+    # the onset at 0.04 s (−0.29 at N = 256, 172.5 BPM); benchmarks/reproduce_accuracy.py.
+    stepping=PAPER_STEPPING,
 )
 
 FIG11 = TimeSeriesStudy(
@@ -382,6 +407,10 @@ FIG11 = TimeSeriesStudy(
     cases=tuple(Case(n, 192.0, 0.0, f"N = {n}") for n in (2, 4, 8, 16, 32, 64)),
     quick=Statistics(runs=10, duration=600.0),
     full=Statistics(runs=100, duration=1000.0),
+    # The paper's scheme and step: with `located` (dt = 0.02 or 0.04 s) the runs at N = 2
+    # and 4 that do not synchronize under `verlet` do (r_eq +0.057 at N = 4, 3.4 SE),
+    # which would change claim 1's verdict; benchmarks/reproduce_accuracy.py.
+    stepping=PAPER_STEPPING,
     legend_title="σ = 0, ω₀ = 192 BPM",
 )
 
@@ -404,6 +433,9 @@ Z_STUDY = ZStudy(
     ),
     quick=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 21), 6)), duration=1500.0),
     full=ZGrid(theta2=tuple(np.round(np.linspace(-0.1, 0.1, 81), 6)), duration=4000.0),
+    # The paper's scheme and step: two metronomes cost seconds, and its basins (which
+    # θ₂(0) lock in phase) are what a coarser step could move; not re-measured.
+    stepping=PAPER_STEPPING,
 )
 
 ESTIMATION = EstimationStudy(
