@@ -50,6 +50,7 @@ from ..observables.order import equilibrium_order
 from . import detection as det
 from . import templates
 from .attribution import phase_difference
+from .hidden import hidden_count, hidden_trains
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
@@ -143,7 +144,10 @@ def analyze_audio(
     trains = [_on_ticks(t, where) for t in sep.trains]
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
-    if trains:
+    trains, behind = _told_apart(ticks, trains)
+    if behind:
+        heard = float(np.median([60.0 / t.period for t in trains])) if trains else heard
+    if trains and not behind:
         # the median of the metronomes' tempi; where the trains may have gone wrong (a
         # very noisy recording), from all the ticks, as without trains
         period, tempo_source = 60.0 / heard, "the median of the metronomes' own tempi"
@@ -155,7 +159,7 @@ def analyze_audio(
             except AnalysisError:
                 pass
     else:
-        heard = 60.0 / beat_period(ticks.time)
+        heard = 60.0 / beat_period(ticks.time) if not trains else heard
         period = beat_period(ticks.time, bpm)
         tempo_source = "given (bpm)" if bpm is not None else "found from the ticks"
     if bpm is not None:
@@ -170,13 +174,20 @@ def analyze_audio(
     if metronomes is not None:
         n = int(metronomes)
         source = "given"
+    elif behind:
+        n = len(trains) + behind["metronomes"]
+        source = (f"{len(trains)} told apart by {sep.method}, " if trains else "") + (
+            f"{behind['metronomes']} that could not be told apart, from their ticks per beat"
+        )
     elif trains:
         n = len(trains)
         source = "one tick train" if n == 1 else f"told apart by {sep.method}"
     else:
         n = busiest
         source = "most ticks per beat in a window (95th percentile), rounded"
-    if trains and n != len(trains):
+    if behind:
+        note = ""
+    elif trains and n != len(trains):
         note = (f"{plural(len(trains), 'metronome')} told apart, {n} expected"
                 + (f"; {note}" if note else ""))  # fmt: skip
     elif trains and busiest > len(trains):
@@ -195,9 +206,7 @@ def analyze_audio(
     for m, t in enumerate(trains):
         # a metronome's timing from its own ticks: one it took from another (that hid
         # its own) is that other's onset
-        own = t.index[~t.masked]
-        own = own[~off_the_beat(ticks.time[own], t.beat[~t.masked])]
-        s = beat_statistics(ticks.time[own], t.period, ticks.strength[own])
+        own, s = _own_statistics(ticks, t)
         stats.append(s)
         mine = label[own] == m
         is_tock[own[mine]] = s.is_tock[mine]
@@ -253,10 +262,60 @@ def analyze_audio(
         attribution_confidence=sep.confidence if trains else 0.0,
         attribution_sureness=sureness(sep.confidence) if trains else "",
         attribution_note=note,
+        metronomes_hidden=behind["metronomes"] if behind else 0,
         metrosync_version=__version__,
     )
+    if behind:
+        ds.attrs.update(
+            hidden_bpm=behind["bpm"],
+            hidden_clusters=behind["clusters"],
+            hidden_ticks_per_beat=behind["per_beat"],
+            hidden_r_acoustic=behind["r"],
+            hidden_note=(
+                f"{behind['metronomes']} metronomes could not be told apart: they tick "
+                f"together at about {behind['bpm']:.1f} BPM, one hidden behind another "
+                f"most of the time; only what needs no identities is reported for them: "
+                f"{behind['per_beat']:.2f} ticks per beat heard in "
+                f"{behind['clusters']:.1f} distinct ticks per beat, acoustic R "
+                f"{behind['r']:.3f} (their {plural(behind['ticks'], 'tick')})"
+            ),
+        )
     ds.attrs["summary"] = summary_text(ds)
     return ds
+
+
+def _own_statistics(ticks, train: Train):
+    """(own tick indices, `BeatStatistics`) of a metronome from its own ticks: one it
+    took from another (that hid its own) is that other's onset."""
+    own = train.index[~train.masked]
+    own = own[~off_the_beat(ticks.time[own], train.beat[~train.masked])]
+    return own, beat_statistics(ticks.time[own], train.period, ticks.strength[own])
+
+
+def _told_apart(ticks, trains: list[Train]) -> tuple[list[Train], dict]:
+    """(the trains of metronomes told apart, what is known of those that could not be:
+    {} when none) (`hidden`)."""
+    if len(trains) < 2:
+        return trains, {}
+    jitters = [_own_statistics(ticks, t)[1].jitter for t in trains]
+    gone = hidden_trains([t.period for t in trains], jitters)
+    if not gone:
+        return trains, {}
+    kept = [t for i, t in enumerate(trains) if i not in gone]
+    held = np.zeros(ticks.time.size, dtype=bool)
+    for t in kept:
+        held[t.index] = True
+    rest = ticks.time[~held]
+    span = ticks.time[-1] - ticks.time[0]
+    count, period, per_beat = hidden_count(rest, span, len(gone))
+    r = clusters = math.nan
+    if np.isfinite(period):
+        order = acoustic_order(rest, period)
+        r = float(np.nanmedian(order.r))
+        clusters = float(np.nanmedian(order.clusters))
+    behind = {"metronomes": count, "bpm": 60.0 / period, "clusters": clusters, "r": r,
+              "ticks": int(rest.size), "per_beat": per_beat}  # fmt: skip
+    return kept, behind
 
 
 def _retimed(recording, scan, ticks, trains: list[Train]):

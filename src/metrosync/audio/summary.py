@@ -35,6 +35,8 @@ def summary_text(ds) -> str:
         f"  metronomes: {n} ({a['metronomes_source']})"
         + (f"; not told apart ({a['attribution_note']})" if a["attribution_note"] else ""),
     ]
+    if a.get("metronomes_hidden"):
+        lines.append(f"  {a['hidden_note']}")
     if "metronome" in ds.dims:
         for m in range(ds.sizes["metronome"]):
             lines.append(
@@ -49,7 +51,7 @@ def summary_text(ds) -> str:
             lines.append(f"    {str(ds.beat_verdict.values[m])}")
     if a.get("attribution_sureness"):
         lines.insert(
-            4,
+            5 if a.get("metronomes_hidden") else 4,
             f"  attribution: {a['attribution_sureness']} (confidence "
             f"{a['attribution_confidence']:.2f}: share of ticks in a train x share of beats "
             f"heard x how far apart the sounds are)",
