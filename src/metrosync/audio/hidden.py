@@ -63,8 +63,8 @@ def hidden_trains(periods, jitters) -> list[int]:
     jitters = np.nan_to_num(np.asarray(jitters, dtype=float), nan=0.0)
     unsteady = jitters > MAX_JITTER
     group: set[int] = set()
-    for i in np.flatnonzero(unsteady):
-        for j in np.flatnonzero(unsteady):
+    for i in np.flatnonzero(unsteady).tolist():
+        for j in np.flatnonzero(unsteady).tolist():
             ab = _locked(periods[i], periods[j], harmonic=False) if i < j else None
             if ab is not None and ab != (1, 1):
                 group |= {int(i), int(j)}

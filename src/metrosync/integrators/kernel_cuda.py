@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import types
 from dataclasses import dataclass
+from typing import Any
 
 from numba import cuda, float64
 from numba.core.registry import CPUDispatcher
@@ -352,7 +353,7 @@ class GpuScheme:
     ``<name>/gpu``) and its kernel (`scheme_kernel`)."""
 
     name: str
-    kernel: object
+    kernel: Any
 
     def advance_state(
         self,

@@ -226,7 +226,7 @@ def claim_transition(ds: xr.Dataset) -> Verdict:
     )
 
 
-def verdict_of(checks: dict[str, bool]) -> str:
+def verdict_of(checks) -> str:
     """*reproduced* when every check holds, *not reproduced* when none does."""
     passed = sum(checks.values())
     if passed == len(checks):

@@ -70,6 +70,7 @@ class SweepResult:
     def _precision_line(self) -> str:
         """How many runs the points took to reach `target_error`, and which did not."""
         target, cap = self.grid.target_error, self.grid.max_runs
+        assert target is not None  # only called with a target
         runs = [p.runs for p in self.precision.values()]
         short = [p for p in self.precision.values() if not p.error <= target]
         line = (
