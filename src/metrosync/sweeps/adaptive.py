@@ -80,16 +80,6 @@ def extend(grid: Grid, store: PointStore, plan: Plan) -> list[PointSpec]:
     return added
 
 
-def errors(grid: Grid, store: PointStore, plan: Plan) -> dict[tuple[int, ...], Precision]:
-    """The `Precision` of every point whose batches are all stored and succeeded."""
-    out = {}
-    for index, batches in plan.items():
-        r_eq = stored_r_eq(store, batches)
-        if r_eq is not None:
-            out[index] = precision(r_eq, grid.target_error or math.inf)
-    return out
-
-
 def stored_r_eq(store: PointStore, batches: list[PointSpec]) -> np.ndarray | None:
     """The per-run r_eq of all of a point's batches, or None unless each is stored and
     succeeded."""

@@ -14,10 +14,11 @@ import math
 import os
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import xarray as xr
 
 from .._words import plural
@@ -46,7 +47,6 @@ class SweepResult:
     execution: Execution
     out: Path | None = None
     rounds: int = 1
-    precision: Mapping[tuple[int, ...], adaptive.Precision] = field(default_factory=dict)
 
     @property
     def complete(self) -> bool:
@@ -71,19 +71,24 @@ class SweepResult:
         """How many runs the points took to reach `target_error`, and which did not."""
         target, cap = self.grid.target_error, self.grid.max_runs
         assert target is not None  # only called with a target
-        runs = [p.runs for p in self.precision.values()]
-        short = [p for p in self.precision.values() if not p.error <= target]
+        # Read from the merged file: the points that have a result, and their runs.
+        ds = self.dataset
+        done = ds.error.values == ""
+        finite = np.isfinite(ds.r_eq.values).sum(axis=-1)[done]
+        error = ds.r_eq_error.values[done]
+        runs = finite.tolist()
+        short = error[~(error <= target)]
         line = (
             f"  runs until the standard error of mean r_eq is <= {target:g}: "
             + (_span(runs) + " a point" if runs else "no point finished")
             + f", in {plural(self.rounds, 'round')}"
         )
-        if short:
-            finite = [p.error for p in short if math.isfinite(p.error)]
+        if short.size:
+            known = short[np.isfinite(short)]
             line += (
-                f"; {plural(len(short), 'point')} stopped short (at `max_runs` = {cap}, or "
+                f"; {plural(short.size, 'point')} stopped short (at `max_runs` = {cap}, or "
                 f"with fewer than 2 finite runs)"
-                + (f": standard error up to {max(finite):.3g}" if finite else "")
+                + (f": standard error up to {known.max():.3g}" if known.size else "")
             )
         return line
 
@@ -194,10 +199,7 @@ def sweep(
             f"{points.kept(planned)} of {plan_size(plan)} kept in {points.root}; run "
             f"the same command again to resume"
         ) from None
-    precision = adaptive.errors(grid, points, plan) if grid.target_error is not None else {}
-    return SweepResult(
-        dataset, grid, points.root, reused, execution, out_path, rounds=rounds, precision=precision
-    )
+    return SweepResult(dataset, grid, points.root, reused, execution, out_path, rounds=rounds)
 
 
 def _span(values) -> str:
