@@ -1,10 +1,12 @@
 """The large-N study's report section: read from a merged study sweep, its numbers
 and figures, and the check it adds to claim 4."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from metrosync.cli import main
 from metrosync.errors import ParameterError
@@ -16,6 +18,9 @@ from metrosync.paper.large_n import (
     onset,
     read_large_n,
     rise_span,
+    scaling_words,
+    settled_lines,
+    sigma_at_paper_onset,
 )
 
 QUICK = Path(__file__).resolve().parents[2] / "studies" / "large_n" / "quick.toml"
@@ -89,3 +94,62 @@ def test_reproduce_refuses_a_bad_large_n_file_before_any_work(tmp_path, capsys, 
     err = capsys.readouterr().err
     assert "`large_n` (--large-n)" in err and words in err
     assert not (out / "REPORT.md").exists()
+
+
+def _shifted(study, sigma, by):
+    """``study`` at another σ with every onset estimate moved by ``by`` BPM."""
+    k, f, (v, stat, syst) = study.kuramoto, study.free, study.rise_inf
+    return replace(
+        study,
+        sigma_bpm=sigma,
+        kuramoto=replace(k, x_c=k.x_c + by),
+        free=replace(f, x_c=f.x_c + by),
+        rise_inf=(v + by, stat, syst),
+    )
+
+
+def test_the_sigma_of_the_paper_onset_lies_on_the_line_through_two_studies(quick):
+    study, _ = quick
+    assert sigma_at_paper_onset([study]) is None
+    w, e, _ = onset(study)
+    other = _shifted(study, 1.5, 185.0 - w + 2.0)  # the onset 2 BPM past 185 at σ = 1.5
+    sigma, error, between = sigma_at_paper_onset([study, other])
+    w2 = onset(other)[0]
+    assert w + (sigma - 0.75) * (w2 - w) / 0.75 == pytest.approx(185.0)
+    assert between and 0 < error < 1
+    # Both onsets below 185: the σ is extrapolated and said to be.
+    lower = _shifted(study, 1.5, 185.0 - w - 2.0)
+    assert sigma_at_paper_onset([study, lower])[2] is False
+    text = settled_lines([study, lower])[0]
+    assert "extrapolated from the study's σ" in text and "σ = 1.5 BPM" in text
+
+
+def test_the_scaling_is_called_kuramoto_only_when_his_exponents_collapse(quick):
+    study, _ = quick
+    good = replace(study.kuramoto, best=replace(study.kuramoto.best, chi2_dof=1.0))
+    bad = replace(study.kuramoto, best=replace(study.kuramoto.best, chi2_dof=50.0))
+    assert scaling_words(replace(study, kuramoto=good)).endswith("the scaling is Kuramoto's")
+    assert "do not collapse" in scaling_words(replace(study, kuramoto=bad))
+
+
+def test_the_sigma_map_and_theory_are_compared_at_the_study_sigma(quick):
+    study, _ = quick
+    cells = {
+        "omega_inf_rise": [170.0, 180.0],
+        "omega_inf_rise_err": [1.0, 3.0],
+        "theory_omega_c": [160.0, 170.0],
+        "theory_omega_c_low": [159.0, 169.0],
+        "theory_omega_c_high": [161.0, 171.0],
+    }
+    sigma_map = xr.Dataset(
+        {k: (("tuning", "sigma"), [v]) for k, v in cells.items()},
+        coords={"tuning": [study.tuning], "sigma": [0.5, 1.0], "n": [4, 8, 16]},
+        attrs={"runs": 3, "duration": 60.0},
+    )
+    text = settled_lines([study], sigma_map)[0]
+    # σ = 0.75 halfway: the map's values interpolated in σ.
+    assert "(N ≤ 16, 3 runs × 60 s a point) extrapolates to 175.0 ± 2.0 BPM" in text
+    assert "threshold is 165.0 BPM [164.0, 166.0]" in text
+    other = sigma_map.assign_coords(tuning=["another tuning"])
+    assert "σ map" not in settled_lines([study], other)[0]
+    assert "σ map" not in settled_lines([study], sigma_map.assign_coords(sigma=[1.0, 2.0]))[0]

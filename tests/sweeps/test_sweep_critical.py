@@ -5,7 +5,13 @@ import pytest
 import xarray as xr
 
 from metrosync import ParameterError
-from metrosync.sweeps.critical import critical_frequency, estimate, extrapolate, plot_critical
+from metrosync.sweeps.critical import (
+    critical_frequency,
+    estimate,
+    extrapolate,
+    plot_critical,
+    size_set_spread,
+)
 
 OMEGA_INF, AMPLITUDE, NU = 185.0, 60.0, 0.8
 
@@ -69,6 +75,20 @@ def test_fewer_sizes_fall_back_to_simpler_fits():
     fit = extrapolate(n, exact, np.full(3, 0.1), step=1.0)
     assert fit.form == "omega_inf + a/N" and fit.omega_inf == pytest.approx(185.0)
     assert extrapolate(n[:2], exact[:2], np.full(2, 0.1), step=1.0).form.startswith("none")
+
+
+def test_size_set_spread_is_the_shift_when_an_end_size_is_left_out():
+    n = np.array([64.0, 256.0, 1024.0, 4096.0])
+    exact = 171 + 200 / n
+    fit, spread = size_set_spread(n, exact, np.full(4, 0.05), step=2.5)
+    assert fit.omega_inf == pytest.approx(171.0, abs=1e-3) and spread < 1e-3
+    # The largest N off the law by 0.4: leaving it out moves the fit, and the
+    # spread is that move (the three-size fit is then linear in 1/N and exact).
+    bent = exact + np.array([0, 0, 0, 0.4])
+    fit, spread = size_set_spread(n, bent, np.full(4, 0.05), step=2.5)
+    assert spread == pytest.approx(abs(fit.omega_inf - 171.0), abs=1e-6) and spread > 0.1
+    # Three sizes leave no variant of three.
+    assert np.isnan(size_set_spread(n[:3], exact[:3], np.full(3, 0.05), step=2.5)[1])
 
 
 def test_single_size_sweep_and_bad_inputs(tmp_path):

@@ -115,10 +115,12 @@ def run(args) -> int:
         if note:  # an extrapolation the data do not support is not printed as a result
             print(f"  N -> inf ({m}): not extrapolated: {note}")
             continue
+        syst = a[f"omega_c_inf_{m}_syst"]
+        spread = "" if np.isnan(syst) else f" +- {syst:.2f} leaving out the smallest or largest N"
         print(
             f"  N -> inf ({m}): omega_c = {a[f'omega_c_inf_{m}']:.2f} +- "
-            f"{a[f'omega_c_inf_{m}_err']:.2f} BPM, fit {a[f'fit_form_{m}']} "
-            f"(a = {a[f'fit_a_{m}']:.3g}, nu = {a[f'fit_nu_{m}']:.3g})"
+            f"{a[f'omega_c_inf_{m}_err']:.2f} BPM over runs{spread}, fit "
+            f"{a[f'fit_form_{m}']} (a = {a[f'fit_a_{m}']:.3g}, nu = {a[f'fit_nu_{m}']:.3g})"
         )
     if at_edge:
         print(

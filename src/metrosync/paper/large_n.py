@@ -4,7 +4,8 @@ Contract: `read_large_n(path)` reads one merged sweep of the study
 (`studies/large_n/*.toml`, run by `metrosync sweep`: r_eq over ``n``, ``bpm`` and
 ``run`` at one σ) and returns a `LargeN`:
 
-- ω_c(N) from the steepest rise of r̄(ω₀) and its N → ∞ fit (`sweeps.critical`);
+- ω_c(N) from the steepest rise of r̄(ω₀) and its N → ∞ fit (`sweeps.critical`), with
+  the fit's spread when the smallest or the largest N is left out;
 - ω_c(∞) from the finite-size-scaling collapse, with Kuramoto's exponents and with
   fitted ones (`sweeps.scaling`), each with the spread over fit windows and N sets;
 - how sharp the transition is at the largest N: the steepest slope of r̄ and the
@@ -14,8 +15,11 @@ Contract: `read_large_n(path)` reads one merged sweep of the study
 
 `onset(study)` picks the ω_c(∞) to believe, and says why: the collapse whose
 exponents collapse the data (χ²/dof ≤ `COLLAPSES`), Kuramoto's first; otherwise the
-fit of the steepest rise. `large_n_lines` writes the report's section, and
-`claim_4_check` the check that claim 4's verdict adds from it.
+fit of the steepest rise. `large_n_lines` writes the report's section, which ends with
+what the study settles (`settled_lines`: at which σ the onset sits at 185 BPM, how
+sharp it is at the largest N, whether it scales as Kuramoto's, and how the onset
+compares with the σ map and the reduced theory when the same reproduction made the
+σ map), and `claim_4_check` the check that claim 4's verdict adds from it.
 """
 
 from __future__ import annotations
@@ -29,7 +33,13 @@ import xarray as xr
 
 from ..errors import ParameterError
 from ..sweeps.critical import critical_frequency, plot_critical
-from ..sweeps.scaling import ScalingEstimate, mean_and_error, plot_collapse, sweep_scaling
+from ..sweeps.scaling import (
+    KURAMOTO_EXPONENTS,
+    ScalingEstimate,
+    mean_and_error,
+    plot_collapse,
+    sweep_scaling,
+)
 from .claims import Verdict, verdict_of
 
 #: χ²/dof up to which the data are said to collapse onto one curve.
@@ -52,6 +62,7 @@ class LargeN:
     kuramoto: ScalingEstimate
     free: ScalingEstimate
     steepest: float
+    rise_inf: tuple[float, float, float]
     rise_span: tuple[float, float]
     runs: tuple[int, int]
     largest_error: float
@@ -99,6 +110,11 @@ def read_large_n(path: str | Path, *, n_boot: int = 200, seed: int = 0) -> Large
         kuramoto=kuramoto,
         free=free,
         steepest=float(np.nanmax(np.diff(top) / np.diff(bpm))),
+        rise_inf=(
+            float(critical.attrs["omega_c_inf_rise"]),
+            float(critical.attrs["omega_c_inf_rise_err"]),
+            float(critical.attrs["omega_c_inf_rise_syst"]),
+        ),
         rise_span=rise_span(bpm, top),
         runs=(int(runs.min()), int(runs.max())),
         largest_error=float(np.nanmax(errors)),
@@ -141,12 +157,13 @@ def onset(study: LargeN) -> tuple[float, float, str]:
                 f"Kuramoto's it is {k.best.chi2_dof:.1f}: the data do not collapse with them)"
             ),
         )
-    a = study.critical.attrs
+    value, stat, syst = study.rise_inf
     return (
-        a["omega_c_inf_rise"],
-        a["omega_c_inf_rise_err"],
+        value,
+        math.hypot(stat, 0.0 if math.isnan(syst) else syst),
         (
-            "the fit of the steepest rise in N (no collapse fits: χ²/dof "
+            f"the fit of the steepest rise in N (± {stat:.2f} over runs, ± {syst:.2f} when "
+            "the smallest or the largest N is left out; no collapse fits: χ²/dof "
             f"{k.best.chi2_dof:.1f} with Kuramoto's exponents, {f.best.chi2_dof:.1f} fitted)"
         ),
     )
@@ -164,8 +181,11 @@ def claim_4_check(studies: list[LargeN]) -> tuple[str, bool]:
     return words, bool(abs(value - OMEGA_C_PAPER) <= OMEGA_C_TOLERANCE + error)
 
 
-def large_n_lines(studies: list[LargeN], figures: Path, base: Path) -> list[str]:
-    """The report's section on the large-N study, its figures written to ``figures``."""
+def large_n_lines(
+    studies: list[LargeN], figures: Path, base: Path, sigma_map: xr.Dataset | None = None
+) -> list[str]:
+    """The report's section on the large-N study, its figures written to ``figures``;
+    ``sigma_map``, the same reproduction's σ map when it made one, for the comparison."""
     lines = ["## The transition at large N: finite-size scaling", ""]
     lines += [
         "| σ (BPM) | N | runs a point | largest s.e. of r̄ | ω_c(∞), Kuramoto exponents | "
@@ -174,13 +194,14 @@ def large_n_lines(studies: list[LargeN], figures: Path, base: Path) -> list[str]
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for s in studies:
-        k, f, a = s.kuramoto, s.free, s.critical.attrs
+        k, f = s.kuramoto, s.free
+        rise, rise_err = s.rise_inf[0], math.hypot(s.rise_inf[1], np.nan_to_num(s.rise_inf[2]))
         lines.append(
             f"| {s.sigma_bpm:g} | {', '.join(map(str, s.sizes))} | {s.runs[0]}–{s.runs[1]} | "
             f"{s.largest_error:.4f} | {k.x_c:.1f} ± {k.x_c_err:.1f} (χ²/dof "
             f"{k.best.chi2_dof:.2f}) | {f.x_c:.1f} ± {f.x_c_err:.1f} (χ²/dof "
             f"{f.best.chi2_dof:.2f}) | {f.a:.2f} ± {f.a_err:.2f}, {f.b:.2f} ± {f.b_err:.2f} | "
-            f"{a['omega_c_inf_rise']:.1f} ± {a['omega_c_inf_rise_err']:.1f} | "
+            f"{rise:.1f} ± {rise_err:.1f} | "
             f"{s.steepest:.3f} /BPM | {s.rise_span[0]:.1f}–{s.rise_span[1]:.1f} BPM |"
         )
     lines.append("")
@@ -211,9 +232,102 @@ def large_n_lines(studies: list[LargeN], figures: Path, base: Path) -> list[str]
         critical_path = figures / f"{stem}_critical.png"
         lines.append(f"  ![r_eq(ω₀) for each N]({critical_path.relative_to(base)})")
         lines.append(f"  ![the collapse]({collapse_path.relative_to(base)})")
+    lines += ["", *settled_lines(studies, sigma_map)]
     words, holds = claim_4_check(studies)
     lines += ["", f"Claim 4 from this study: {words}: {'yes' if holds else 'no'}.", ""]
     return lines
+
+
+def sigma_at_paper_onset(studies: list[LargeN]) -> tuple[float, float, bool] | None:
+    """σ at which the N → ∞ onset sits at 185 BPM, on the line through the onsets of the
+    two studies of the first study's tuning furthest apart in σ: (σ, its error from the
+    two onsets' errors, whether 185 BPM lies between them). None with fewer than two σ."""
+    same = [s for s in studies if s.tuning == studies[0].tuning]
+    low = min(same, key=lambda s: s.sigma_bpm)
+    high = max(same, key=lambda s: s.sigma_bpm)
+    (w1, e1, _), (w2, e2, _) = onset(low), onset(high)
+    if high.sigma_bpm == low.sigma_bpm or w1 == w2:
+        return None
+    span, rise = high.sigma_bpm - low.sigma_bpm, w2 - w1
+    sigma = low.sigma_bpm + (OMEGA_C_PAPER - w1) * span / rise
+    error = abs(span) / rise**2 * math.hypot((OMEGA_C_PAPER - w2) * e1, (OMEGA_C_PAPER - w1) * e2)
+    return sigma, error, min(w1, w2) <= OMEGA_C_PAPER <= max(w1, w2)
+
+
+def scaling_words(study: LargeN) -> str:
+    """Whether the study's r_eq scale as Kuramoto oscillators with random frequencies do."""
+    k, f = study.kuramoto, study.free
+    a0, b0 = KURAMOTO_EXPONENTS
+    fitted = (
+        f"fitted, β/ν̄ = {f.a:.2f} ± {f.a_err:.2f} and 1/ν̄ = {f.b:.2f} ± {f.b_err:.2f} "
+        f"(χ²/dof = {f.best.chi2_dof:.2f})"
+    )
+    if k.best.chi2_dof <= COLLAPSES:
+        return (
+            f"with Kuramoto's exponents (β/ν̄ = {a0:g}, 1/ν̄ = {b0:g}) the r_eq collapse "
+            f"(χ²/dof = {k.best.chi2_dof:.2f}); {fitted}: the scaling is Kuramoto's"
+        )
+    far = max(abs(f.a - a0) / f.a_err, abs(f.b - b0) / f.b_err)
+    ending = (
+        "the transition does not scale as Kuramoto's at these sizes"
+        if far > 2 or f.best.chi2_dof > COLLAPSES
+        else "the fitted exponents do not rule Kuramoto's out, but his do not collapse the data"
+    )
+    return (
+        f"with Kuramoto's exponents (β/ν̄ = {a0:g}, 1/ν̄ = {b0:g}) the r_eq do not collapse "
+        f"(χ²/dof = {k.best.chi2_dof:.1f}); {fitted}"
+        f"{'' if f.best.chi2_dof <= COLLAPSES else ', no collapse either'}: {ending}"
+    )
+
+
+def _map_at(sigma_map: xr.Dataset, study: LargeN) -> xr.Dataset | None:
+    """The σ map's row for the study's tuning, linear in σ at the study's σ; None when
+    the map has not that tuning or does not span that σ."""
+    if study.tuning not in sigma_map.tuning.values:
+        return None
+    row = sigma_map.sel(tuning=study.tuning)
+    if not row.sigma.min() <= study.sigma_bpm <= row.sigma.max():
+        return None
+    names = ["omega_inf_rise", "omega_inf_rise_err", "theory_omega_c", "theory_omega_c_low",
+             "theory_omega_c_high"]  # fmt: skip
+    return row[names].interp(sigma=study.sigma_bpm)
+
+
+def settled_lines(studies: list[LargeN], sigma_map: xr.Dataset | None = None) -> list[str]:
+    """What the study settles: one paragraph (see the module docstring)."""
+    first = studies[0]
+    out = ["**What the study settles.**"]
+    found = sigma_at_paper_onset(studies)
+    if found is not None:
+        sigma, error, between = found
+        out.append(
+            f"The N → ∞ onset sits at {OMEGA_C_PAPER:g} BPM for σ = {sigma:.2f} ± {error:.2f} "
+            f"BPM ({first.tuning} tuning; {'between' if between else 'extrapolated from'} "
+            f"the study's σ on a line)."
+        )
+    for s in studies:
+        value, error, _ = onset(s)
+        at = f"{value - OMEGA_C_PAPER:+.1f} BPM from {OMEGA_C_PAPER:g}"
+        out.append(
+            f"At σ = {s.sigma_bpm:g} BPM ({s.tuning} tuning) the N → ∞ onset is {value:.1f} ± "
+            f"{error:.1f} BPM ({at}); at N = {s.sizes[-1]} r̄ climbs from 10 % to 90 % of its "
+            f"rise over {s.rise_width:.1f} BPM ({s.rise_span[0]:.1f}–{s.rise_span[1]:.1f} BPM, "
+            f"at most {s.steepest:.3f} per BPM); {scaling_words(s)}."
+        )
+        row = None if sigma_map is None else _map_at(sigma_map, s)
+        if sigma_map is not None and row is not None:
+            largest = int(sigma_map.n.max())
+            out.append(
+                f"The σ map of this reproduction (N ≤ {largest}, {sigma_map.attrs['runs']} "
+                f"runs × {sigma_map.attrs['duration']:g} s a point) extrapolates to "
+                f"{float(row.omega_inf_rise):.1f} ± {float(row.omega_inf_rise_err):.1f} BPM "
+                f"there, and the reduced theory's threshold is "
+                f"{float(row.theory_omega_c):.1f} BPM [{float(row.theory_omega_c_low):.1f}, "
+                f"{float(row.theory_omega_c_high):.1f}]; the study measures the full model "
+                f"itself up to N = {s.sizes[-1]}, so its onset needs the shortest "
+                f"extrapolation, and it is the one to believe."
+            )
+    return [" ".join(out)]
 
 
 def amend_claim_4(verdict: Verdict, studies: list[LargeN]) -> Verdict:

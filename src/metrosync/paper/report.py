@@ -88,7 +88,7 @@ def write_report(path: Path, rep) -> Path:
     if "claims_map" in data:
         s += claims_map_section(data["claims_map"]) + _figure_line(rep, "claims_map", base)
     if rep.large_n:
-        s += large_n_lines(rep.large_n, base / "figures", base)
+        s += large_n_lines(rep.large_n, base / "figures", base, data.get("sigma_map"))
     s += ["## Parameter consistency", "", markdown_table(rep.consistency), ""]
     s += _timing_section(rep)
     s += ["## Figures", ""]

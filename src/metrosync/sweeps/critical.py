@@ -16,9 +16,11 @@ error is the standard deviation of the replicas.
 `extrapolate` fits ω_c(N) = ω_c∞ + a·N^(−ν) (weighted by the bootstrap errors, which
 are floored at 1 % of the grid step, the estimators' resolution). With only three
 sizes ν is fixed to 1 (ω_c linear in 1/N); with fewer there is no extrapolation.
-`judge` says why a fit is not to be trusted: ω_c∞ outside the swept grid (the data
-say nothing there), an uncertainty over half the grid, or an exponent at the fit's
-bound; `critical_frequency` stores that as ``fit_note_<method>`` ('' = trusted).
+`size_set_spread` adds the fit's systematic error: how far ω_c∞ moves when the
+smallest or the largest N is left out. `judge` says why a fit is not to be trusted:
+ω_c∞ outside the swept grid (the data say nothing there), an uncertainty over half the
+grid, or an exponent at the fit's bound; `critical_frequency` stores that as
+``fit_note_<method>`` ('' = trusted).
 All frequencies are in BPM.
 """
 
@@ -200,6 +202,27 @@ def extrapolate(
     return Extrapolation(math.nan, math.nan, math.nan, math.nan, "none (fewer than 3 sizes)")
 
 
+def size_set_spread(
+    n: np.ndarray, omega_c: np.ndarray, err: np.ndarray, *, step: float
+) -> tuple[Extrapolation, float]:
+    """The extrapolation of all sizes and its systematic error: the largest shift of
+    omega_inf when the smallest or the largest N is left out (as the collapse's size
+    sets in `sweeps.scaling`). A left-out set of fewer than 3 sizes gives no fit and
+    no shift; with no variant at all the spread is NaN.
+    """
+    n, omega_c, err = (np.asarray(v, dtype=float) for v in (n, omega_c, err))
+    main = extrapolate(n, omega_c, err, step=step)
+    order = np.argsort(n)
+    shifts = []
+    for keep in (order[1:], order[:-1]):
+        if keep.size < 3:
+            continue
+        fit = extrapolate(n[keep], omega_c[keep], err[keep], step=step)
+        if np.isfinite(fit.omega_inf):
+            shifts.append(abs(fit.omega_inf - main.omega_inf))
+    return main, max(shifts, default=math.nan)
+
+
 def judge(fit: Extrapolation, bpm: np.ndarray, sizes: int) -> str:
     """Why the extrapolation ``fit`` is not to be trusted, or '' when it is.
 
@@ -279,7 +302,9 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
     Returns
     -------
     xarray.Dataset with r_mean, sigma_r (n, bpm) and omega_c_{peak,rise} and their
-    ``_err`` (n); attrs hold the extrapolation for each method.
+    ``_err`` (n); attrs hold the extrapolation for each method, its error over runs
+    (``omega_c_inf_<method>_err``) and its spread over size sets (``_syst``, NaN
+    with fewer than 4 sizes).
     """
     if isinstance(n_boot, bool) or not isinstance(n_boot, int) or n_boot < 2:
         raise ParameterError(f"`n_boot` must be an integer >= 2, got {n_boot!r}.")
@@ -307,11 +332,12 @@ def critical_frequency(sweep: xr.Dataset, *, n_boot: int = 1000, seed: int = 0) 
     for m in METHODS:
         data[f"omega_c_{m}"] = ("n", central[m], {**bpm_units, "long_name": f"ω_c from the {m}"})
         data[f"omega_c_{m}_err"] = ("n", errors[m], {**bpm_units, "long_name": "bootstrap std"})
-        fit = extrapolate(r.n.values, central[m], errors[m], step=step)
+        fit, spread = size_set_spread(r.n.values, central[m], errors[m], step=step)
         attrs.update(
             {
                 f"omega_c_inf_{m}": fit.omega_inf,
                 f"omega_c_inf_{m}_err": fit.omega_inf_err,
+                f"omega_c_inf_{m}_syst": spread,
                 f"fit_a_{m}": fit.a,
                 f"fit_nu_{m}": fit.nu,
                 f"fit_form_{m}": fit.form,
