@@ -153,3 +153,18 @@ def test_the_sigma_map_and_theory_are_compared_at_the_study_sigma(quick):
     other = sigma_map.assign_coords(tuning=["another tuning"])
     assert "σ map" not in settled_lines([study], other)[0]
     assert "σ map" not in settled_lines([study], sigma_map.assign_coords(sigma=[1.0, 2.0]))[0]
+
+
+def test_the_kept_study_results_reach_their_target_error():
+    """The study's merged sweeps that `make run` reads: every point's mean r_eq to the
+    grid file's target error, or the point stopped at its cap of draws."""
+    results = QUICK.parent / "results"
+    kept = sorted(results.glob("*.nc"))
+    assert kept, f"no study results in {results}"
+    for path in kept:
+        ds = xr.load_dataset(path, engine="h5netcdf")
+        assert ds.n.values.tolist() == [64, 256, 1024, 4096]
+        target, cap = ds.attrs["target_error"], ds.attrs["max_runs"]
+        reached = (ds.r_eq_error <= target) | (ds.n_runs >= cap)
+        assert bool(reached.all()), f"{path.name}: points short of the target"
+        assert int(ds.n_runs.min()) >= 48 and ds.attrs["fixed_duration"] == 3000

@@ -301,7 +301,7 @@ def settled_lines(studies: list[LargeN], sigma_map: xr.Dataset | None = None) ->
     if found is not None:
         sigma, error, between = found
         out.append(
-            f"The N → ∞ onset sits at {OMEGA_C_PAPER:g} BPM for σ = {sigma:.2f} ± {error:.2f} "
+            f"The N → ∞ onset sits at {OMEGA_C_PAPER:g} BPM for σ = {sigma:.3f} ± {error:.3f} "
             f"BPM ({first.tuning} tuning; {'between' if between else 'extrapolated from'} "
             f"the study's σ on a line)."
         )

@@ -400,8 +400,10 @@ def plot_critical(result: xr.Dataset, path=None):
         grid = np.geomspace(n.min(), n.max() * 4, 100)
         ax.plot(grid, w + a * grid ** (-nu), lw=1, color=color)
         err = result.attrs[f"omega_c_inf_{m}_err"]
+        syst = result.attrs.get(f"omega_c_inf_{m}_syst", math.nan)
+        spread = "" if np.isnan(syst) else f" ± {syst:.1f} (N set)"
         ax.axhline(w, ls="--", lw=0.8, color=color)
-        ax.annotate(rf"{m}: $\omega_{{c,\infty}}$ = {w:.1f} ± {err:.1f} BPM", where,
+        ax.annotate(rf"{m}: $\omega_{{c,\infty}}$ = {w:.1f} ± {err:.1f}{spread} BPM", where,
                     xycoords="axes fraction", fontsize=8, va="top")  # fmt: skip
     ax.set(xscale="log", xlabel="N (metronomes)", ylabel=r"$\omega_c$ (BPM)",
            title="finite-size extrapolation")  # fmt: skip
