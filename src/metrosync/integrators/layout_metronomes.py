@@ -100,10 +100,9 @@ def loop(st, c, settings, rec, begin, impulse):
     for b in nb.prange(n_runs):
         scratch = _scratch(n)
         th_new, rest, q, events = scratch
-        # Bundles: a tuple is unpacked where it is compiled, at no cost. The loop's
-        # arguments are written through one only in called functions (`_record`,
-        # `_settle_disk`): inlined into `prange`, such a write can be lost (numba issue
-        # 7135), as the run's rows are read only through ``rows``.
+        # Bundles: a tuple is unpacked where it is compiled, at no cost. The loop's arrays
+        # are written through a bundle only in called functions (`_record`,
+        # `_settle_disk`): such a write inlined into `prange` was lost (`layout_runs._save`).
         rows = (theta[b], theta_dot[b], acc_theta[b])
         out = (theta, theta_dot, phi, phi_dot, r, r_group, group_start)
         trajectories = (traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)
