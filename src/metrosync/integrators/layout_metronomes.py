@@ -100,62 +100,26 @@ def loop(st, c, settings, rec, begin, impulse):
     for b in nb.prange(n_runs):
         scratch = _scratch(n)
         th_new, rest, q, events = scratch
+        # Bundles: a tuple is unpacked where it is compiled, at no cost. The loop's arrays
+        # are written through a bundle only in called functions (`_record`,
+        # `_settle_disk`): such a write inlined into `prange` was lost (`layout_runs._save`).
+        rows = (theta[b], theta_dot[b], acc_theta[b])
+        out = (theta, theta_dot, phi, phi_dot, r, r_group, group_start)
+        trajectories = (traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)
         pinned = math.isinf(c.total_inertia[b])
         dry = c.dry_friction[b] > 0.0 and not pinned
         until_record = record_every - step0 % record_every
         if step0 == 0 and not status[b] & STATUS_DIVERGED:
-            record_run(
-                b,
-                0,
-                theta,
-                theta_dot,
-                phi,
-                phi_dot,
-                c.omega[b],
-                r,
-                r_group,
-                group_start,
-                traj_theta,
-                traj_theta_dot,
-                traj_phi,
-                traj_phi_dot,
-            )
+            _record(b, 0, c.omega[b], out, trajectories)
         for s in range(step0, step0 + n_steps):
             if status[b] & STATUS_DIVERGED:
                 break
             t_old = s * dt
             t_new = (s + 1) * dt
-            sums = _first_pass(
-                c,
-                b,
-                theta[b],
-                theta_dot[b],
-                acc_theta[b],
-                dt,
-                dt2,
-                overturn_angle,
-                scratch,
-                last_kick[b],
-                t_new,
-                begin,
-                sincos,
-            )
+            now = (t_new, dt, overturn_angle)
+            sums = _first_pass(c, b, rows, last_kick[b], scratch, now, begin, sincos)
             if sums[6] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sums = _first_pass(
-                    c,
-                    b,
-                    theta[b],
-                    theta_dot[b],
-                    acc_theta[b],
-                    dt,
-                    dt2,
-                    overturn_angle,
-                    scratch,
-                    last_kick[b],
-                    t_new,
-                    begin,
-                    libm_sincos,
-                )
+                sums = _first_pass(c, b, rows, last_kick[b], scratch, now, begin, libm_sincos)
             sum_num, sum_den, sum_kick, n_up, n_imp, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
@@ -238,24 +202,10 @@ def loop(st, c, settings, rec, begin, impulse):
                 p_phi[b] += jump_p
             phi_dot[b] = disk_velocity(c, b, p_phi[b], sum_p)
             if dry:
+                torques = (others, friction, force, phdd, held)
+                disk = (p_phi, phi_dot)
                 force, phdd, held, sum_p = _settle_disk(
-                    c,
-                    b,
-                    theta_dot[b],
-                    acc_theta[b],
-                    rest,
-                    q,
-                    p_phi,
-                    phi_dot,
-                    sum_num,
-                    sum_den,
-                    sum_p,
-                    others,
-                    friction,
-                    force,
-                    phdd,
-                    held,
-                    dt,
+                    c, b, rows, scratch, disk, (sum_num, sum_den, sum_p), torques, dt
                 )
                 if held:
                     rest_steps[b] += 1
@@ -265,22 +215,7 @@ def loop(st, c, settings, rec, begin, impulse):
             if until_record == 0:
                 until_record = record_every
                 k = (s + 1) // record_every
-                record_run(
-                    b,
-                    k,
-                    theta,
-                    theta_dot,
-                    phi,
-                    phi_dot,
-                    c.omega[b],
-                    r,
-                    r_group,
-                    group_start,
-                    traj_theta,
-                    traj_theta_dot,
-                    traj_phi,
-                    traj_phi_dot,
-                )
+                _record(b, k, c.omega[b], out, trajectories)
 
 
 @nb.njit(inline="always")
@@ -288,6 +223,31 @@ def _scratch(n):
     """A run's scratch arrays, (N,) each: new angles, ρ_i and q_i of the step, and its
     events (`UP` | `KICK` bits)."""
     return np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.uint8)
+
+
+@nb.njit(cache=True, fastmath=FASTMATH)
+def _record(b, k, omega_row, out, trajectories):
+    """Record ``k`` of run ``b`` (`_kernel_parts.record_run`) from ``out`` = (θ, θ̇, φ, φ̇,
+    r, r_group, group_start) into them and the ``trajectories``. Called, not inlined, as
+    it writes through bundles; with the loop's fastmath, so that r is summed as there."""
+    theta, theta_dot, phi, phi_dot, r, r_group, group_start = out
+    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = trajectories
+    record_run(
+        b,
+        k,
+        theta,
+        theta_dot,
+        phi,
+        phi_dot,
+        omega_row,
+        r,
+        r_group,
+        group_start,
+        traj_theta,
+        traj_theta_dot,
+        traj_phi,
+        traj_phi_dot,
+    )
 
 
 @nb.njit(inline="always")
@@ -305,15 +265,16 @@ def add_jump(jumps, after, half, dnum, dforce, jnum):
 
 
 @nb.njit(inline="always")
-def _first_pass(
-    c, b, theta, theta_dot, acc, dt, dt2, overturn_angle, scratch, last_kick, t_new, begin, trig
-):
+def _first_pass(c, b, rows, last_kick, scratch, now, begin, trig):
     """New angles, the escapement and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s
-    metronomes (rows ``theta``, ``theta_dot``, ``acc``), with ``trig`` = the
-    vectorizable `sincos` or, for far-wound angles, libm's; ``t_new`` into
+    metronomes (``rows`` = its θ, θ̇, θ̈), with ``trig`` = the vectorizable `sincos` or,
+    for far-wound angles, libm's; ``now`` = (t_new, dt, overturn angle): ``t_new`` into
     ``last_kick`` (the run's row) where an escapement fires. Returns the three sums and
     the counts of upward crossings, impulses, overturned and far-wound angles."""
+    theta, theta_dot, acc = rows
     th_new, rest, q, events = scratch
+    t_new, dt, overturn_angle = now
+    dt2 = dt * dt
     sum_num = 0.0
     sum_den = 0.0
     sum_kick = 0.0
@@ -346,30 +307,19 @@ def _first_pass(
 
 
 @nb.njit(cache=True)
-def _settle_disk(
-    c,
-    b,
-    theta_dot,
-    acc,
-    rest,
-    q,
-    p_phi,
-    phi_dot,
-    sum_num,
-    sum_den,
-    sum_p,
-    others,
-    friction,
-    force,
-    phdd,
-    held,
-    dt,
-):
+def _settle_disk(c, b, rows, scratch, disk, sums, torques, dt):
     """Run ``b``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (the scheme is in
-    `verlet`'s docstring). Returns the torque and φ̈ to store, whether the disk ends
-    the step held, and Σ q θ̇. Called, not inlined: one call per step at most, and code
-    of this in the step's loop slows the loop without the feature."""
+    `verlet`'s docstring). ``disk`` = (p_φ, φ̇), ``sums`` = (Σ num, Σ den, Σ q θ̇) and
+    ``torques`` = (the torque without the friction, the friction, the torque, φ̈, held).
+    Returns the torque and φ̈ to store, whether the disk ends the step held, and
+    Σ q θ̇. Called, not inlined: one call per step at most, and code of this in the
+    step's loop slows the loop without the feature."""
+    _, theta_dot, acc = rows
+    _, rest, q, _ = scratch
+    p_phi, phi_dot = disk
+    sum_num, sum_den, sum_p = sums
+    others, friction, force, phdd, held = torques
     if not held and friction * phi_dot[b] >= 0.0:  # rare: φ̇ reached 0 within the step
         end, held = disk_friction_stop(c, b, friction, phi_dot[b], sum_den, dt)
         p_phi[b] += 0.5 * dt * (end - friction)

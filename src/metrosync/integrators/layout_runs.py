@@ -107,25 +107,26 @@ def loop(st, c, settings, rec, begin, impulse):
     n_runs, n = theta.shape
     n_blocks = (n_runs + LANES - 1) // LANES
     n_rec = r.shape[1]
-    save = traj_theta.shape[0] > 0
     dt2 = dt * dt
     half = 0.5 * dt
     grid_dt = record_every * dt
     for blk in nb.prange(n_blocks):
         b0 = blk * LANES
         lanes = min(LANES, n_runs - b0)
-        th, thd, acc, ph, phd, aph, pp, fph, alive = load_block(
-            theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes
-        )
-        tn_s = np.empty((n, LANES))
-        rest = np.empty((n, LANES))
-        q = np.empty((n, LANES))
+        # Bundles of arrays, made here from the unpacked names: a tuple is unpacked where it
+        # is compiled, at no cost. The block's own arrays are written through bundles in
+        # inlined code; the loop's arguments only directly or in called functions (`_save`).
+        kept = (theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi)
+        trajectories = (traj_theta, traj_theta_dot, traj_phi, traj_phi_dot)
+        swing, disk, alive = load_block(kept, status, b0, lanes)
+        th, thd, acc = swing
+        ph, phd, aph, pp, fph = disk
+        step, sums, stick = _scratch(n)
+        tn_s, rest, q = step
+        s_num, s_den, s_kick, s_p = sums
+        dry_lane, others, friction, held = stick
         ph_new = np.empty(LANES)
         phd_pred = np.empty(LANES)
-        s_num = np.empty(LANES)
-        s_den = np.empty(LANES)
-        s_kick = np.empty(LANES)
-        s_p = np.empty(LANES)
         phdd = np.empty(LANES)
         force = np.empty(LANES)
         tau = np.zeros(LANES)  # applied torque, computed only for a forced block
@@ -138,13 +139,9 @@ def loop(st, c, settings, rec, begin, impulse):
         counts = np.empty((3, LANES), dtype=np.int64)
         ups, imps, overs = counts[0], counts[1], counts[2]
         lk = load_last_kick(last_kick, b0, lanes)
-        dry_lane = np.empty(LANES, dtype=np.bool_)
         for w in range(LANES):
             dry_lane[w] = c.dry_friction[blk, w] > 0.0 and not math.isinf(c.total_inertia[blk, w])
         dry = dry_lane.any()
-        others = np.empty(LANES)
-        friction = np.empty(LANES)
-        held = np.empty(LANES, dtype=np.bool_)
         jump = np.zeros(LANES)  # the disk's jumps from the step's impulses, per lane
         shift = np.zeros(LANES)
         jump_p = np.zeros(LANES)
@@ -152,77 +149,14 @@ def loop(st, c, settings, rec, begin, impulse):
         if step0 == 0:
             for w in range(lanes):
                 if alive[w] > 0.0:
-                    _record(
-                        b0 + w,
-                        blk,
-                        w,
-                        0,
-                        th,
-                        thd,
-                        ph,
-                        phd,
-                        c,
-                        r,
-                        save,
-                        traj_theta,
-                        traj_theta_dot,
-                        traj_phi,
-                        traj_phi_dot,
-                        r_group,
-                        group_start,
-                    )
+                    _record(c, r, r_group, group_start, blk, w, 0, swing, disk, trajectories)
         for s in range(step0, step0 + n_steps):
             t_old = s * dt
             t_new = (s + 1) * dt
-            n_far = _first_pass(
-                c,
-                blk,
-                th,
-                thd,
-                acc,
-                dt,
-                dt2,
-                overturn_angle,
-                tn_s,
-                rest,
-                q,
-                s_num,
-                s_den,
-                s_kick,
-                ups,
-                imps,
-                overs,
-                lk,
-                alive,
-                t_new,
-                begin,
-                sincos,
-            )
+            now = (t_new, dt, overturn_angle)
+            n_far = _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, sincos)
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(
-                    c,
-                    blk,
-                    th,
-                    thd,
-                    acc,
-                    dt,
-                    dt2,
-                    overturn_angle,
-                    tn_s,
-                    rest,
-                    q,
-                    s_num,
-                    s_den,
-                    s_kick,
-                    ups,
-                    imps,
-                    overs,
-                    lk,
-                    alive,
-                    t_new,
-                    begin,
-                    libm_sincos,
-                )
+                _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, libm_sincos)
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -232,9 +166,7 @@ def loop(st, c, settings, rec, begin, impulse):
                 phdd[w] = disk_acceleration(c, (blk, w), s_num[w], s_den[w], force[w])
                 s_p[w] = 0.0
             if dry:  # the block has a run with dry friction on the disk (`verlet`)
-                _dry_friction(
-                    c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held
-                )
+                _dry_friction(c, blk, phd, sums, force, phdd, stick)
             any_impulse = False
             for w in range(lanes):
                 if alive[w] == 0.0:
@@ -333,28 +265,7 @@ def loop(st, c, settings, rec, begin, impulse):
                         aph[w] = phdd[w]
             if dry:
                 _settle_disks(
-                    c,
-                    blk,
-                    lanes,
-                    alive,
-                    dry_lane,
-                    thd,
-                    acc,
-                    rest,
-                    q,
-                    s_num,
-                    s_den,
-                    s_p,
-                    others,
-                    friction,
-                    held,
-                    pp,
-                    phd,
-                    fph,
-                    aph,
-                    dt,
-                    rest_steps,
-                    b0,
+                    c, blk, b0, lanes, alive, swing, disk, step, sums, stick, dt, rest_steps
                 )
             until_record -= 1
             if until_record == 0:
@@ -362,80 +273,44 @@ def loop(st, c, settings, rec, begin, impulse):
                 k = (s + 1) // record_every
                 for w in range(lanes):
                     if alive[w] > 0.0:
-                        _record(
-                            b0 + w,
-                            blk,
-                            w,
-                            k,
-                            th,
-                            thd,
-                            ph,
-                            phd,
-                            c,
-                            r,
-                            save,
-                            traj_theta,
-                            traj_theta_dot,
-                            traj_phi,
-                            traj_phi_dot,
-                            r_group,
-                            group_start,
-                        )
-        store_block(
-            theta,
-            theta_dot,
-            acc_theta,
-            phi,
-            phi_dot,
-            acc_phi,
-            p_phi,
-            force_phi,
-            b0,
-            lanes,
-            th,
-            thd,
-            acc,
-            ph,
-            phd,
-            aph,
-            pp,
-            fph,
-        )
+                        _record(c, r, r_group, group_start, blk, w, k, swing, disk, trajectories)
+        store_block(kept, b0, lanes, swing, disk)
         for w in range(lanes):
             for i in range(n):
                 last_kick[b0 + w, i] = lk[i, w]
 
 
 @nb.njit(inline="always")
-def _first_pass(
-    c,
-    blk,
-    th,
-    thd,
-    acc,
-    dt,
-    dt2,
-    overturn_angle,
-    tn_s,
-    rest,
-    q,
-    s_num,
-    s_den,
-    s_kick,
-    ups,
-    imps,
-    overs,
-    lk,
-    alive,
-    t_new,
-    begin,
-    trig,
-):
+def _scratch(n):
+    """A block's scratch bundles, runs innermost: the step's new angles, ρ_i and q_i,
+    (n, LANES) each; the per-lane sums of eqs. (eqm1)–(eqm2), Σ num, Σ den, Σ torque,
+    and Σ q θ̇ after the step; and for the disk's dry friction (`_dry_friction`), the
+    lanes that have it, the torque without it, the friction and whether it holds."""
+    step = (np.empty((n, LANES)), np.empty((n, LANES)), np.empty((n, LANES)))
+    sums = (np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES))
+    stick = (
+        np.empty(LANES, dtype=np.bool_),
+        np.empty(LANES),
+        np.empty(LANES),
+        np.empty(LANES, dtype=np.bool_),
+    )
+    return step, sums, stick
+
+
+@nb.njit(inline="always")
+def _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, trig):
     """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
-    ``blk``, with ``trig`` = the vectorizable `sincos` or, for far-wound angles, libm's;
-    ``t_new`` into ``lk`` where a live lane's escapement fires. Fills the per-lane
-    counts of upward crossings, impulses and overturns (``ups``, ``imps``, ``overs``);
+    ``blk`` (the bundles of `load_block` and `_scratch`), with ``trig`` = the
+    vectorizable `sincos` or, for far-wound angles, libm's; ``now`` = (t_new, dt,
+    overturn angle): ``t_new`` into ``lk`` where a live lane's escapement fires. Fills
+    the per-lane counts of upward crossings, impulses and overturns (``counts``' rows);
     returns the number of far-wound angles."""
+    th, thd, acc = swing
+    tn_s, rest, q = step
+    s_num, s_den, s_kick, _ = sums
+    ups, imps, overs = counts[0], counts[1], counts[2]
+    t_new, dt, overturn_angle = now
+    dt2 = dt * dt
     n_far = 0
     for w in range(th.shape[1]):
         ups[w] = 0
@@ -477,10 +352,12 @@ def load_last_kick(last_kick, b0, lanes):
 
 
 @nb.njit(cache=True)
-def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, friction, held):
+def _dry_friction(c, blk, phd, sums, force, phdd, stick):
     """The dry friction of each lane with it as the step starts resolving the disk
     (`_physics.disk_friction`); adds it to ``force`` and recomputes ``phdd``. Called,
     not inlined, like `_settle_disks`."""
+    s_num, s_den, _, _ = sums
+    dry_lane, others, friction, held = stick
     for w in range(phd.shape[0]):
         others[w] = force[w]
         friction[w] = 0.0
@@ -494,66 +371,28 @@ def _dry_friction(c, blk, dry_lane, phd, s_num, s_den, force, phdd, others, fric
 
 
 @nb.njit(cache=True)
-def _settle_disks(
-    c,
-    blk,
-    lanes,
-    alive,
-    dry_lane,
-    thd,
-    acc,
-    rest,
-    q,
-    s_num,
-    s_den,
-    s_p,
-    others,
-    friction,
-    held,
-    pp,
-    phd,
-    fph,
-    aph,
-    dt,
-    rest_steps,
-    b0,
-):
+def _settle_disks(c, blk, b0, lanes, alive, swing, disk, step, sums, stick, dt, rest_steps):
     """The disks with dry friction after a step (`_settle_disk`); counts the steps that
     end with a disk held in ``rest_steps``. One call per step, and two levels deep:
     code of this in the step's loop slows the kernel without the feature by about 6 %
     (benchmarks/kernel.py at (100, 7))."""
+    dry_lane = stick[0]
     for w in range(lanes):
         if alive[w] > 0.0 and dry_lane[w]:
-            if _settle_disk(
-                c,
-                blk,
-                w,
-                thd,
-                acc,
-                rest,
-                q,
-                s_num[w],
-                s_den[w],
-                s_p[w],
-                others[w],
-                friction[w],
-                held[w],
-                pp,
-                phd,
-                fph,
-                aph,
-                dt,
-            ):
+            if _settle_disk(c, blk, w, swing, disk, step, sums, stick, dt):
                 rest_steps[b0 + w] += 1
 
 
 @nb.njit(cache=True)
-def _settle_disk(
-    c, blk, w, thd, acc, rest, q, s_num, s_den, s_p, others, friction, held, pp, phd, fph, aph, dt
-):
+def _settle_disk(c, blk, w, swing, disk, step, sums, stick, dt):
     """Lane ``w``'s disk after a step with dry friction: held at rest, or, when its
     velocity reached 0 within the step, stopped or reversed (`verlet`). Returns whether
     it ends the step held at rest."""
+    _, thd, acc = swing
+    _, phd, aph, pp, fph = disk
+    _, rest, q = step
+    s_num, s_den, s_p = sums[0][w], sums[1][w], sums[3][w]
+    others, friction, held = stick[1][w], stick[2][w], stick[3][w]
     if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step
         end, held = disk_friction_stop(c, (blk, w), friction, phd[w], s_den, dt)
         pp[w] += 0.5 * dt * (end - friction)
@@ -578,43 +417,42 @@ def _settle_disk(
 
 
 @nb.njit(cache=True, inline="always")
-def _record(
-    b,
-    blk,
-    w,
-    k,
-    th,
-    thd,
-    ph,
-    phd,
-    c,
-    r,
-    save,
-    traj_theta,
-    traj_theta_dot,
-    traj_phi,
-    traj_phi_dot,
-    r_group,
-    group_start,
-):
+def _record(c, r, r_group, group_start, blk, w, k, swing, disk, trajectories):
+    """Record ``k`` of lane ``w`` of block ``blk``: r and, with several groups, each
+    group's r; the state into ``trajectories`` when they are kept (`_save`). Inlined,
+    so that r is summed with the loop's own fastmath flags (a scheme's choice)."""
+    b = blk * LANES + w
+    th, thd = swing[0], swing[1]
     r[b, k] = analytic_order(th[:, w], thd[:, w], c.omega[blk, :, w])
     if group_start.shape[0] > 2:  # several groups
         group_orders(r_group, b, k, th[:, w], thd[:, w], c.omega[blk, :, w], group_start)
-    if save:
-        for i in range(th.shape[0]):
-            traj_theta[b, k, i] = th[i, w]
-            traj_theta_dot[b, k, i] = thd[i, w]
-        traj_phi[b, k] = ph[w]
-        traj_phi_dot[b, k] = phd[w]
+    if trajectories[0].shape[0] > 0:
+        _save(trajectories, b, k, w, swing, disk)
+
+
+@nb.njit(cache=True)
+def _save(trajectories, b, k, w, swing, disk):
+    """Lane ``w``'s state into record ``k`` of run ``b`` of the ``trajectories`` (θ, θ̇,
+    φ, φ̇). Called, not inlined: a write through a bundle of the loop's arrays, inlined
+    into `prange`, was lost (the trajectories of φ stayed NaN; numba issue 7135)."""
+    traj_theta, traj_theta_dot, traj_phi, traj_phi_dot = trajectories
+    th, thd, _ = swing
+    ph, phd, _, _, _ = disk
+    for i in range(th.shape[0]):
+        traj_theta[b, k, i] = th[i, w]
+        traj_theta_dot[b, k, i] = thd[i, w]
+    traj_phi[b, k] = ph[w]
+    traj_phi_dot[b, k] = phd[w]
 
 
 @nb.njit(cache=True, inline="always")
-def load_block(
-    theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi, status, b0, lanes
-):
-    """Block-local copies of runs ``b0`` … ``b0 + lanes − 1``, runs innermost: (n, LANES)
-    per metronome, (LANES,) per run, and 1.0 for each lane still alive. Missing lanes
-    repeat the last run and are never written back (`store_block`)."""
+def load_block(kept, status, b0, lanes):
+    """Block-local copies of runs ``b0`` … ``b0 + lanes − 1`` of the state ``kept`` =
+    (θ, θ̇, θ̈, φ, φ̇, φ̈, p_φ, the disk's torque), runs innermost: (n, LANES) per
+    metronome, ``swing`` = (θ, θ̇, θ̈); (LANES,) per run, ``disk`` = (φ, φ̇, φ̈, p_φ,
+    torque); and 1.0 for each lane still alive. Missing lanes repeat the last run and
+    are never written back (`store_block`)."""
+    theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi = kept
     n = theta.shape[1]
     th = np.empty((n, LANES))
     thd = np.empty((n, LANES))
@@ -639,32 +477,16 @@ def load_block(
         pp[w] = p_phi[b]
         fph[w] = force_phi[b]
         alive[w] = 0.0 if status[b] & STATUS_DIVERGED else 1.0
-    return th, thd, acc, ph, phd, aph, pp, fph, alive
+    return (th, thd, acc), (ph, phd, aph, pp, fph), alive
 
 
-@nb.njit(cache=True, inline="always")
-def store_block(
-    theta,
-    theta_dot,
-    acc_theta,
-    phi,
-    phi_dot,
-    acc_phi,
-    p_phi,
-    force_phi,
-    b0,
-    lanes,
-    th,
-    thd,
-    acc,
-    ph,
-    phd,
-    aph,
-    pp,
-    fph,
-):
-    """Write a block's real lanes back (the inverse of `load_block`). The arrays come
-    unpacked, not in a tuple: numba may lose writes through a tuple field in `prange`."""
+@nb.njit(cache=True)
+def store_block(kept, b0, lanes, swing, disk):
+    """Write a block's real lanes back into ``kept`` (the inverse of `load_block`).
+    Called, not inlined, as `_save`: it writes through a bundle."""
+    theta, theta_dot, acc_theta, phi, phi_dot, acc_phi, p_phi, force_phi = kept
+    th, thd, acc = swing
+    ph, phd, aph, pp, fph = disk
     for w in range(lanes):
         b = b0 + w
         for i in range(theta.shape[1]):
