@@ -145,8 +145,6 @@ def analyze_audio(
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
     trains, behind = _told_apart(ticks, trains)
-    if behind:
-        heard = float(np.median([60.0 / t.period for t in trains])) if trains else heard
     if trains and not behind:
         # the median of the metronomes' tempi; where the trains may have gone wrong (a
         # very noisy recording), from all the ticks, as without trains
@@ -159,7 +157,12 @@ def analyze_audio(
             except AnalysisError:
                 pass
     else:
-        heard = 60.0 / beat_period(ticks.time) if not trains else heard
+        # with hidden metronomes set aside, the tempo heard is the kept metronomes'
+        heard = (
+            float(np.median([60.0 / t.period for t in trains]))
+            if trains
+            else 60.0 / beat_period(ticks.time)
+        )
         period = beat_period(ticks.time, bpm)
         tempo_source = "given (bpm)" if bpm is not None else "found from the ticks"
     if bpm is not None:
