@@ -70,6 +70,12 @@ class LargeN:
     r: xr.DataArray
 
     @property
+    def rise_error(self) -> float:
+        """The error of the steepest rise's ω_c(∞): over runs and over size sets."""
+        _, stat, syst = self.rise_inf
+        return math.hypot(stat, 0.0 if math.isnan(syst) else syst)
+
+    @property
     def rise_width(self) -> float:
         return self.rise_span[1] - self.rise_span[0]
 
@@ -160,7 +166,7 @@ def onset(study: LargeN) -> tuple[float, float, str]:
     value, stat, syst = study.rise_inf
     return (
         value,
-        math.hypot(stat, 0.0 if math.isnan(syst) else syst),
+        study.rise_error,
         (
             f"the fit of the steepest rise in N (± {stat:.2f} over runs, ± {syst:.2f} when "
             "the smallest or the largest N is left out; no collapse fits: χ²/dof "
@@ -195,13 +201,12 @@ def large_n_lines(
     ]
     for s in studies:
         k, f = s.kuramoto, s.free
-        rise, rise_err = s.rise_inf[0], math.hypot(s.rise_inf[1], np.nan_to_num(s.rise_inf[2]))
         lines.append(
             f"| {s.sigma_bpm:g} | {', '.join(map(str, s.sizes))} | {s.runs[0]}–{s.runs[1]} | "
             f"{s.largest_error:.4f} | {k.x_c:.1f} ± {k.x_c_err:.1f} (χ²/dof "
             f"{k.best.chi2_dof:.2f}) | {f.x_c:.1f} ± {f.x_c_err:.1f} (χ²/dof "
             f"{f.best.chi2_dof:.2f}) | {f.a:.2f} ± {f.a_err:.2f}, {f.b:.2f} ± {f.b_err:.2f} | "
-            f"{rise:.1f} ± {rise_err:.1f} | "
+            f"{s.rise_inf[0]:.1f} ± {s.rise_error:.1f} | "
             f"{s.steepest:.3f} /BPM | {s.rise_span[0]:.1f}–{s.rise_span[1]:.1f} BPM |"
         )
     lines.append("")
@@ -314,8 +319,7 @@ def settled_lines(studies: list[LargeN], sigma_map: xr.Dataset | None = None) ->
             f"rise over {s.rise_width:.1f} BPM ({s.rise_span[0]:.1f}–{s.rise_span[1]:.1f} BPM, "
             f"at most {s.steepest:.3f} per BPM); {scaling_words(s)}."
         )
-        row = None if sigma_map is None else _map_at(sigma_map, s)
-        if sigma_map is not None and row is not None:
+        if sigma_map is not None and (row := _map_at(sigma_map, s)) is not None:
             largest = int(sigma_map.n.max())
             out.append(
                 f"The σ map of this reproduction (N ≤ {largest}, {sigma_map.attrs['runs']} "
