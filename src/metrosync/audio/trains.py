@@ -80,6 +80,9 @@ MAX_BRIDGED = 64
 MAX_DRIFT = 0.05
 #: Largest spread (s) of the lag of a train that is part of another's ticks.
 PART_LAG_SPREAD = 0.3e-3
+#: ... and of one that comes after it and is this much fainter (dB): a later impact,
+#: timed in the first one's ring, less precisely (twice the spread allowed).
+LATER_FAINTER = 3.0
 #: A tick farther than this from its train's beat is not its metronome's, s.
 OFF_BEAT = 3e-3
 #: Ticks of one kind on each side that put a tick where its beat is.
@@ -341,6 +344,25 @@ def drop_shared(trains: list[Train], voice: list[int]) -> tuple[list[Train], lis
             [v for v, k in zip(voice, keep, strict=True) if k])  # fmt: skip
 
 
+def holders(k: int, trains: list[Train]) -> np.ndarray:
+    """(K,) the train that holds each of ``k`` ticks as its own: the one train that holds
+    it unmasked, or, where none does, the one train that holds it at all; −1 for none,
+    or two (their ticks fell together). A train that holds a tick masked took it from
+    the metronome whose tick hid its own."""
+    own = np.zeros(k, dtype=np.int64)
+    claims = np.zeros(k, dtype=np.int64)
+    for t in trains:
+        claims[t.index] += 1
+        own[t.index[~t.masked]] += 1
+    out = np.full(k, -1, dtype=np.int64)
+    for m, t in enumerate(trains):
+        unmasked = t.index[~t.masked]
+        out[unmasked[own[unmasked] == 1]] = m
+        masked = t.index[t.masked]
+        out[masked[(own[masked] == 0) & (claims[masked] == 1)]] = m
+    return out
+
+
 def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strength=None):
     """Trains that are part of another's ticks, folded into it: (trains, voices,
     indices of the folded ticks).
@@ -350,8 +372,10 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
     multiple (2 or more) of A's (a sound ahead of or after every few ticks: the
     pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
     A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
-    different from the first. Two metronomes locked a few milliseconds apart keep a
-    lag that wanders by more than that, as each one's beat jitters.
+    different from the first. A later impact at least `LATER_FAINTER` dB fainter is
+    timed in the first one's ring: its lag may spread twice as much. Two metronomes
+    locked a few milliseconds apart keep a lag that wanders by more than that, as each
+    one's beat jitters.
     """
     keep = [True] * len(trains)
     folded = []
@@ -368,7 +392,12 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
                            t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
             middle = float(np.median(lag))
-            if abs(middle) >= MAX_TICK_LENGTH or _robust_spread(lag) >= PART_LAG_SPREAD:
+            fainter = (
+                strength is not None
+                and np.mean(strength[tb.index]) < np.mean(strength[ta.index]) - LATER_FAINTER
+            )
+            limit = 2 * PART_LAG_SPREAD if middle > 0 and fainter else PART_LAG_SPREAD
+            if abs(middle) >= MAX_TICK_LENGTH or _robust_spread(lag) >= limit:
                 continue
             if k == 1:
                 if middle <= 0 or strength is None:
