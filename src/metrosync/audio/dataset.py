@@ -58,7 +58,7 @@ from .recovery import nearer_another, recover
 from .separation import separate, sureness, tick_length_words
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
-from .trains import Train, off_the_beat
+from .trains import Train, holders, off_the_beat
 
 #: Default refractory time, s: impacts closer than this are heard as one. The impacts of
 #: one tick are grouped afterwards, from the recording's own tick structure.
@@ -362,15 +362,9 @@ def _pendulum_phases(kept: list, dt: float) -> xr.Dataset:
 
 
 def _labels(k: int, trains: list[Train]) -> np.ndarray:
-    """(K,) the metronome of each tick: the one train that holds it (−1: none, or two
-    trains share it, their ticks fell together)."""
-    claims = np.zeros(k, dtype=np.int64)
-    for t in trains:
-        claims[t.index] += 1
-    out = np.full(k, -1, dtype=np.int8)
-    for m, t in enumerate(trains):
-        out[t.index[claims[t.index] == 1]] = m
-    return out
+    """(K,) the metronome of each tick: the train that holds it as its own
+    (`trains.holders`; −1: none, or two trains share it, their ticks fell together)."""
+    return holders(k, trains).astype(np.int8)
 
 
 def _on_ticks(train: Train, where: np.ndarray) -> Train:

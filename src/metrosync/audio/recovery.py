@@ -31,7 +31,10 @@ the other metronomes' sounds that overlap it) within `templates.SEARCH` of the
 prediction: a tick whose onset the detector timed too far off in another's ring, or
 never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`). The
 curve's highest point alone is not enough there: beyond a train's end it is as
-often the room's noise.
+often the room's noise. A heard tick found so keeps the detector's onset unless it
+lies in another's ring. Where the tracker gave up on a train before the file ended,
+the search walks on, `END_BEATS` at a time, while the train's sound is found there
+(at most `MAX_END_WALK` steps).
 
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
 tick lies nearer another train's beat than its own train's beat puts it, within the
@@ -58,8 +61,10 @@ PASSES = 3
 SIDE = 3
 #: How long after a tick its later impacts and ring can move another's onset, s.
 RING = 0.04
-#: Beats sought by their sound beyond each end of a train.
+#: Beats sought by their sound beyond each end of a train, a step of the walk.
 END_BEATS = 2
+#: Steps of that walk, at most.
+MAX_END_WALK = 64
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
 #: A tick in another's ring this many robust spreads off its beat is unattributed.
@@ -188,17 +193,28 @@ def recover(recording, scan, ticks, trains: list[Train]):
         recovered += added
         if added + taken == 0:
             break
-    ticks, trains, added = _by_sound(recording, scan, ticks, trains)
-    return ticks, trains, recovered + added
-
-
-def _by_sound(recording, scan, ticks, trains: list[Train]):
-    """(ticks, trains, ticks added): each beat still missed, and the `END_BEATS` beyond
-    each end of a train, sought by the train's own sound (`templates.fit`) within
-    `templates.SEARCH` of the prediction, beside the other trains' sounds: kept where
-    it sounds like the train (`FOUND_LIKENESS`) and no tick is within the detector's
-    resolution of it; a tick heard there that no train holds is the one found."""
     sounds = tp.learn(recording, scan, ticks.time, trains)
+    ticks, trains, added, _ = _by_sound(recording, scan, ticks, trains, sounds)
+    recovered += added
+    # a train the tracker gave up on before the file ended: walked on, `END_BEATS` at a
+    # time, while its beats are found where its sound is
+    for _ in range(MAX_END_WALK):
+        ticks, trains, added, joined = _by_sound(recording, scan, ticks, trains, sounds,
+                                                 gaps=False)  # fmt: skip
+        recovered += added
+        if added + joined == 0:
+            break
+    return ticks, trains, recovered
+
+
+def _by_sound(recording, scan, ticks, trains: list[Train], sounds, *, gaps: bool = True):
+    """(ticks, trains, ticks added, heard ticks joined): each beat still missed (with
+    ``gaps``), and the `END_BEATS` beyond each end of a train, sought by the train's own
+    sound (``sounds``, `templates.learn`) within `templates.SEARCH` of the prediction,
+    beside the other trains' sounds: kept where it sounds like the train
+    (`FOUND_LIKENESS`) and no tick is within the detector's resolution of it; a tick
+    heard there that no train holds is the one found, timed on the sounds only where it
+    lies in another's ring (`templates.retime`): elsewhere the detector is exact."""
     rate = recording.sample_rate
     lo, hi = tp.BEFORE + tp.MARGIN, recording.frames / rate - tp.AFTER - tp.MARGIN
     owner = tp.owners(ticks.time, trains)
@@ -210,14 +226,14 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     for m, train in enumerate(trains):
         if sounds[m] is None:
             continue
-        for beyond in (0, END_BEATS):
+        for beyond in (0, END_BEATS) if gaps else (END_BEATS,):
             n, p = _predictions(ticks.time, train, beyond)
             ok = (p > lo) & (p < hi)
             metronomes += [m] * int(ok.sum())
             beats.append(n[ok])
             times.append(p[ok])
     if not metronomes:
-        return ticks, trains, 0
+        return ticks, trains, 0, 0
     want_m, want_n, want_t = np.array(metronomes), np.concatenate(beats), np.concatenate(times)
     order = np.argsort(want_t)
     want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
@@ -237,10 +253,13 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
                                  return_counts=True)  # fmt: skip
     chosen = np.flatnonzero(keep)[first[counts == 1]]
     if chosen.size == 0:
-        return ticks, trains, 0
+        return ticks, trains, 0, 0
     reuse = chosen[close[chosen]]
     time = ticks.time.copy()
-    time[near[reuse]] = onset[reuse]  # heard, but timed on the other's ring
+    # heard, but in another's ring: timed on the sounds
+    k = np.searchsorted(h, ticks.time[near[reuse]], side="left")
+    ringing = (k > 0) & (ticks.time[near[reuse]] - h[np.maximum(k - 1, 0)] <= tp.AFTER)
+    time[near[reuse[ringing]]] = onset[reuse[ringing]]
     fresh = chosen[~close[chosen]]
     fields = det.Ticks.__dataclass_fields__
     # loudness and rise as the detector measures them; the time is the fitted onset
@@ -257,7 +276,7 @@ def _by_sound(recording, scan, ticks, trains: list[Train]):
     # a beat found before the first counts from 0 again
     new_ticks, out = _merged(merged, trains, index_of, want_m[chosen], want_n[chosen],
                              from_first=True)  # fmt: skip
-    return new_ticks, out, int(fresh.size)
+    return new_ticks, out, int(fresh.size), int(reuse.size)
 
 
 def _pass(recording, scan, ticks, trains: list[Train]):
@@ -347,9 +366,10 @@ def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
 
 def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) -> np.ndarray:
     """(K,) ``label`` (the metronome of each tick, −1 for none) with −1 for each tick
-    that lies nearer another train's beat (a tick it heard, or one it missed, where
-    predicted) than its own train's beat puts it, within the detector's resolution
-    (two metronomes ticked together there and the tick's onset may be either's); and
+    that lies nearer another train's beat (a tick it heard, or one it missed or took
+    from another, where predicted) than its own train's beat puts it, within the
+    detector's resolution (two metronomes ticked together there and the tick's onset
+    may be either's); and
     for each tick that falls within `RING` after another train's tick and lies off its
     own beat by more than `RING_OFF_BEAT` of its train's robust spread (at least a
     millisecond): its onset is timed by the other's later impacts and ring."""
@@ -358,9 +378,12 @@ def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) ->
         return out
     beats, heard = [], []
     for train in trains:
-        _, predicted = _predictions(times, train)
-        beats.append(np.sort(np.concatenate([times[train.index], predicted])))
-        heard.append(np.sort(times[train.index]))
+        # a masked tick is another's onset: its beat is where the train's beat puts it
+        own = train.masked == 0
+        unmasked = Train(train.index[own], train.beat[own], train.period, train.masked[own])
+        _, predicted = _predictions(times, unmasked)
+        beats.append(np.sort(np.concatenate([times[unmasked.index], predicted])))
+        heard.append(np.sort(times[unmasked.index]))
     for m, train in enumerate(trains):
         held = label[train.index] == m
         mine = train.index[held]

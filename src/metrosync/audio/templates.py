@@ -9,10 +9,13 @@ metronome's ring timed again, and how much each tick sounds like its train's sou
 A sound. The waveform the detector times (the channels' mix, band-passed forwards and
 backwards: no delay) from `BEFORE` before each onset to `AFTER` after it, averaged
 over the first `MAX_LEARNED` of the train's ticks that no other train's tick
-overlaps (none began in the `AFTER` before, nor in the `AFTER` after), apart for the
+overlaps (none began in the `HEAD` before, nor in the `HEAD` after), apart for the
 ticks and the tocks (a tock can sound different); both together where one kind has
-fewer than `MIN_CLEAR`.
-It holds the tick's later impacts and the loudest of its ring.
+fewer than `MIN_CLEAR`. It holds the tick's later impacts and its ring. The ring's
+tail, beyond `HEAD`, is averaged over the ticks no other overlaps for all of `AFTER`
+(fewer, with four metronomes ticking), or left silent where fewer than `MIN_CLEAR`
+were: a tick that begins late in another's ring is still timed a millisecond late by
+the detector.
 
 Timing in a ring. A tick that begins within `AFTER` after another train's tick has its
 onset timed on a sum of the two: the detector's onset rule reads the other's ring as
@@ -38,12 +41,15 @@ from numpy.lib.stride_tricks import sliding_window_view
 from scipy import signal
 
 from .detection import _segments
-from .trains import Train
+from .trains import Train, holders
 
 #: Sound kept before each onset, s (room for the search below).
 BEFORE = 8e-3
-#: Sound kept after each onset, s: its later impacts and the loudest of its ring.
-AFTER = 0.05
+#: Sound kept after each onset, s: its later impacts and its ring.
+AFTER = 0.1
+#: The start of it learned from ticks no other overlaps this long, s: its impacts and
+#: the loudest of its ring.
+HEAD = 0.07
 #: Ticks of one kind that sound alone, at least, for a sound of that kind.
 MIN_CLEAR = 4
 #: Ticks of one kind averaged, at most.
@@ -87,52 +93,59 @@ def _filtered(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
 
 
 def owners(times: np.ndarray, trains: list[Train]) -> np.ndarray:
-    """(K,) the train that alone holds each tick, −1 for none (or two)."""
-    owner = np.full(times.size, -1, dtype=np.int64)
-    claims = np.zeros(times.size, dtype=np.int64)
-    for t in trains:
-        claims[t.index] += 1
-    for m, t in enumerate(trains):
-        owner[t.index[claims[t.index] == 1]] = m
-    return owner
+    """(K,) the train that holds each tick as its own, −1 for none (or two)."""
+    return holders(times.size, trains)
 
 
 def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound | None]:
     """One `Sound` per train (see the module docstring)."""
     rate = recording.sample_rate
-    before, after = round(BEFORE * rate), round(AFTER * rate)
+    before, after, head = round(BEFORE * rate), round(AFTER * rate), round(HEAD * rate)
     held = np.sort(np.concatenate([times[t.index] for t in trains])) if trains else times
     out: list[Sound | None] = []
     for train in trains:
         heard = ~train.masked
         index, parity = train.index[heard], train.beat[heard] % 2
         t = times[index]
-        # alone: no tick of another train in the AFTER before or after (its own is held
+        # alone: no tick of another train in the HEAD before or after (its own is held
         # too, but never that close)
         j = np.searchsorted(held, t)
         prev = np.where(j > 0, t - held[np.maximum(j - 1, 0)], np.inf)
         nxt = np.where(j + 1 < held.size, held[np.minimum(j + 1, held.size - 1)] - t, np.inf)
-        alone = (prev > AFTER) & (nxt > AFTER)
+        alone = (prev > HEAD) & (nxt > HEAD)
         # a kind that is never alone (a tock that keeps falling just before another
         # metronome's tick) is learned where none follows within the fit window: the
         # start of its sound, which the fit reads, is its own
-        nearly = (prev > AFTER) & (nxt > FIT_AFTER + SEARCH)
+        nearly = (prev > HEAD) & (nxt > FIT_AFTER + SEARCH)
+        # the ring's tail from the ticks alone that long too
+        long = (prev > AFTER) & (nxt > AFTER)
         use = np.zeros(t.size, dtype=bool)
+        tail = np.zeros(t.size, dtype=bool)
         for kind in (0, 1):
             pick = alone if (alone & (parity == kind)).sum() >= MIN_CLEAR else nearly
             # the first few of each kind: the mean has settled by then
             use[np.flatnonzero(pick & (parity == kind))[:MAX_LEARNED]] = True
+            tail[np.flatnonzero(long & (parity == kind))[:MAX_LEARNED]] = True
         if use.sum() < MIN_CLEAR:
             out.append(None)
             continue
-        starts = np.round(t[use] * rate).astype(np.int64) - before
+        either = use | tail
+        starts = np.round(t[either] * rate).astype(np.int64) - before
         order = np.argsort(starts)
         waves = _filtered(recording, scan, starts[order], before + after)
-        kinds = parity[use][order]
-        learned = (bool((kinds == 0).sum() >= MIN_CLEAR), bool((kinds == 1).sum() >= MIN_CLEAR))
-        both = waves.mean(axis=0)
-        two = [waves[kinds == k].mean(axis=0) if learned[k] else both for k in (0, 1)]
-        out.append(Sound(np.array(two), before, learned))
+        kinds = parity[either][order]
+        use, tail = use[either][order], tail[either][order]
+        learned = tuple(bool((use & (kinds == k)).sum() >= MIN_CLEAR) for k in (0, 1))
+        both = waves[use].mean(axis=0)
+        two = np.array([waves[use & (kinds == k)].mean(axis=0) if learned[k] else both
+                        for k in (0, 1)])  # fmt: skip
+        # the tail: of each kind where heard alone often enough, else of both, else none
+        end = before + head
+        both_tail = waves[tail, end:].mean(axis=0) if tail.sum() >= MIN_CLEAR else 0.0
+        for k in (0, 1):
+            mine = tail & (kinds == k)
+            two[k, end:] = waves[mine, end:].mean(axis=0) if mine.sum() >= MIN_CLEAR else both_tail
+        out.append(Sound(two, before, (learned[0], learned[1])))
     return out
 
 
