@@ -3,8 +3,9 @@ is one tick, metronomes are told apart by their sound or their tempo, none is do
 
 Recall counts the ticks a single microphone can hear on their own: no other
 metronome's tick began in the 40 ms before (its impacts and the loudest of its ring)
-nor within the detector's resolution after. Precision counts every tick given to a
-metronome against all of that metronome's ticks.
+nor within the detector's resolution after, and the file had begun at least that long
+before (the detector reads a tick as a rise over what came before it). Precision
+counts every tick given to a metronome against all of that metronome's ticks.
 """
 
 from __future__ import annotations
@@ -28,13 +29,14 @@ HIDDEN_BEFORE = 0.04
 def hearable(truth: list[np.ndarray], k: int) -> np.ndarray:
     """(K,) True for the ticks of train k that no other train's tick hides."""
     mine = truth[k]
+    begun = mine > det.RESOLUTION
     if len(truth) == 1:
-        return np.ones(mine.size, dtype=bool)
+        return begun
     others = np.sort(np.concatenate([t for j, t in enumerate(truth) if j != k]))
     j = np.searchsorted(others, mine)
     before = np.where(j > 0, mine - others[np.maximum(j - 1, 0)], np.inf)
     after = np.where(j < others.size, others[np.minimum(j, others.size - 1)] - mine, np.inf)
-    return (before > HIDDEN_BEFORE) & (after > det.RESOLUTION)
+    return begun & (before > HIDDEN_BEFORE) & (after > det.RESOLUTION)
 
 
 def recording(tmp_path, n, seed, *, same_voice=False, bpms=None, duration=40.0, phone=True):
