@@ -56,6 +56,7 @@ from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
 from .recovery import nearer_another, recover
 from .separation import separate, sureness, tick_length_words
+from .subdivision import subdivided
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
 from .trains import Train, holders, off_the_beat
@@ -142,6 +143,7 @@ def analyze_audio(
     where = np.full(impacts.time.size, -1, dtype=np.int64)
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
+    trains = subdivided(ticks.time, trains)
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
     trains, behind = _told_apart(ticks, trains)

@@ -1,0 +1,125 @@
+"""A train that followed every k-th beat of its metronome, given the beats between.
+
+Contract: `subdivided(times, trains)` returns the trains, each that holds only every
+k-th beat of its metronome (k = 2 to `trains.MAX_FRAGMENT`) given the ticks that no
+train holds on the beats between, with its beat and period divided by k.
+
+Where several metronomes tick, a slow one's ticks are often the ones another's ring
+or ticks overlap: the tracker can lock on every second or third of them, a train of
+half or a third of the metronome's tempo, and leave the ticks between to no one. Such
+a train is told by those ticks: for each place j/k of the way from one of its beats to
+the next (between two of its ticks up to `MAX_STEP` beats apart), a tick no train
+holds lies near it (within `WINDOW` of a beat: a limp puts a tock off the middle) in
+at least `MIN_SHARE` of those places (the rest may be hidden by other ticks), at an
+offset from it that keeps still: robust spread under `MAX_SPREAD`, for each place and
+each kind of beat (tick or tock) apart, as a limp offsets the two kinds oppositely. A
+few milliseconds remain, as the places are interpolated between a tick and a tock;
+another metronome's ticks near those places drift through them and spread over tens.
+The ticks taken lie within `trains.OFF_BEAT` of their place's usual offset.
+The smallest k that fits is taken, and the search repeated on the divided train (a
+train of every fourth beat is halved twice), down to beats of `MIN_BEAT`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .trains import MAX_FRAGMENT, OFF_BEAT, Train, _robust_spread
+
+#: A tick between is sought this far (fraction of the divided beat) from its place.
+WINDOW = 0.15
+#: ... in at least this share of the places of one kind: the others may be hidden.
+MIN_SHARE = 0.3
+#: Places are sought between ticks of the train up to this many of its beats apart.
+MAX_STEP = 3
+#: Largest robust spread of its offsets from the places, s.
+MAX_SPREAD = 6e-3
+#: Pairs of ticks (up to `MAX_STEP` beats apart) a train needs before it is tried.
+MIN_PAIRS = 8
+#: Shortest beat a train is divided to, s (300 BPM).
+MIN_BEAT = 0.2
+
+
+def subdivided(times: np.ndarray, trains: list[Train]) -> list[Train]:
+    """The trains, each that followed every k-th beat of its metronome given the ticks
+    between (see the module docstring)."""
+    times = np.asarray(times, dtype=float)
+    out = list(trains)
+    for m in range(len(out)):
+        for _ in range(MAX_FRAGMENT):
+            held = np.zeros(times.size, dtype=bool)
+            for t in out:
+                held[t.index] = True
+            divided = _divided(times, out[m], np.flatnonzero(~held))
+            if divided is None:
+                break
+            out[m] = divided
+    return out
+
+
+def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
+    """``train`` with its beat divided by the smallest k that the ticks ``free`` (indices
+    no train holds) fit, or None."""
+    t, b = times[train.index], train.beat
+    step = np.diff(b)
+    pairs = np.flatnonzero((step <= MAX_STEP) & ~train.masked[:-1] & ~train.masked[1:])
+    if pairs.size < MIN_PAIRS or free.size == 0:
+        return None
+    free_t = times[free]
+    for k in range(2, MAX_FRAGMENT + 1):
+        beat = train.period / k
+        if beat < MIN_BEAT:
+            return None
+        # every place between two of the train's ticks a divided beat would fill:
+        # (time, beat number, place j of k, kind of the train's beat it follows)
+        rows = [
+            (t[p] + (t[p + 1] - t[p]) * i / (step[p] * k), b[p] * k + i, i % k, (b[p] + i // k) % 2)
+            for p in pairs
+            for i in range(1, step[p] * k)
+            if i % k
+        ]
+        where, number, place, kind = (np.array(c) for c in zip(*rows, strict=True))
+        at = _fitting(free_t, where, place, kind, beat)
+        if at is None:
+            continue
+        ok = at >= 0
+        index = np.concatenate([train.index, free[at[ok]]])
+        numbers = np.concatenate([b * k, number[ok]])
+        masked = np.concatenate([train.masked, np.zeros(int(ok.sum()), dtype=bool)])
+        order = np.argsort(numbers, kind="stable")
+        return Train(index[order], numbers[order], beat, masked[order])
+    return None
+
+
+def _fitting(free_t, where, place, kind, beat: float) -> np.ndarray | None:
+    """(P,) the free tick (index into ``free_t``) at each place ``where`` (−1: none), if
+    every kind of place passes the test of the module docstring; else None."""
+    near, offset = _nearest(free_t, where)
+    close = np.abs(offset) <= WINDOW * beat
+    usual = np.zeros(where.size)
+    for j in np.unique(place):
+        mine = place == j
+        if close[mine].mean() < MIN_SHARE:
+            return None
+        for parity in (0, 1):
+            sel = close & mine & (kind == parity)
+            if sel.sum() == 0:
+                continue
+            if sel.sum() < 3 or _robust_spread(offset[sel]) >= MAX_SPREAD:
+                return None
+            usual[mine & (kind == parity)] = np.median(offset[sel])
+    # each place's tick is the free one nearest its usual offset from it
+    near, offset = _nearest(free_t, where + usual)
+    keep = np.abs(offset) <= OFF_BEAT
+    # a tick taken for two places is neither's
+    unique, counts = np.unique(near[keep], return_counts=True)
+    keep &= np.isin(near, unique[counts == 1])
+    return np.where(keep, near, -1)
+
+
+def _nearest(sorted_t: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(index of the nearest of ``sorted_t`` to each of ``at``, its offset from it, s)."""
+    q = np.clip(np.searchsorted(sorted_t, at), 1, max(sorted_t.size - 1, 1))
+    left, right = q - 1, np.minimum(q, sorted_t.size - 1)
+    near = np.where(np.abs(sorted_t[left] - at) <= np.abs(sorted_t[right] - at), left, right)
+    return near, sorted_t[near] - at

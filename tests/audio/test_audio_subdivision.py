@@ -1,0 +1,98 @@
+"""A train that followed every k-th beat of its metronome is given the beats between."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from metrosync.audio.subdivision import subdivided
+from metrosync.audio.trains import Train, off_the_beat
+
+
+def beats(bpm, duration, *, limp=0.03, jitter=0.6e-3, start=0.1, seed=0):
+    """Tick times of one metronome: tock offset by ``limp`` of a beat, jittered."""
+    rng = np.random.default_rng(seed)
+    period = 60.0 / bpm
+    n = np.arange(int((duration - start) / period))
+    return start + n * period + np.where(n % 2, limp * period, 0.0) + rng.normal(0, jitter, n.size)
+
+
+def setting(k, *, hidden=0.4, other_bpm=131.0, seed=1):
+    """(all tick times, the train of every k-th beat of a 107 BPM metronome, the indices
+    of that metronome's ticks, of the other metronome's); ``hidden`` of the beats between
+    were never heard."""
+    rng = np.random.default_rng(seed)
+    mine = beats(107.0, 40.0, seed=seed)
+    number = np.arange(mine.size)
+    heard = (number % k == 0) | (rng.uniform(size=mine.size) > hidden)
+    mine, number = mine[heard], number[heard]
+    other = beats(other_bpm, 40.0, limp=0.0, start=0.23, seed=seed + 1)
+    times = np.concatenate([mine, other])
+    order = np.argsort(times)
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    own, others = where[: mine.size], where[mine.size :]
+    on = number % k == 0
+    train = Train(own[on], number[on] // k, k * 60.0 / 107.0, np.zeros(int(on.sum()), bool))
+    return times[order], train, own, others
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("k", [2, 3, 4])
+def test_a_train_of_every_kth_beat_gets_the_beats_between(k, seed):
+    times, train, own, others = setting(k, seed=seed)
+    (out,) = subdivided(times, [train])
+    assert out.period == pytest.approx(60.0 / 107.0)
+    # every heard tick of the metronome between the train's ends (beyond them, the
+    # recovery walks on); another's tick within 3 ms of a beat whose own tick was
+    # hidden cannot be told from it by its time
+    first, last = times[train.index[0]], times[train.index[-1]]
+    inside = own[(times[own] >= first) & (times[own] <= last)]
+    assert set(inside) <= set(out.index)
+    assert len(set(out.index) - set(own)) <= 1
+    assert np.all(np.diff(out.beat) >= 1)
+    # the beat numbers count the metronome's beats
+    assert np.allclose(np.diff(times[out.index]) / np.diff(out.beat), 60.0 / 107.0, rtol=0.05)
+
+
+def test_ticks_another_train_holds_are_not_taken():
+    times, train, own, others = setting(2)
+    between = np.setdiff1d(own, train.index)
+    holder = Train(np.sort(between), np.arange(between.size), 1.0, np.zeros(between.size, bool))
+    out = subdivided(times, [train, holder])
+    assert out[0].period == train.period and np.array_equal(out[0].index, train.index)
+
+
+@pytest.mark.parametrize(
+    ("other_bpm", "unheld"), [(131.0, 0.2), (131.0, 1.0), (160.5, 0.2), (214.0, 0.2), (214.0, 1.0)]
+)
+def test_a_slow_metronome_beside_another_is_left_as_it_is(other_bpm, unheld):
+    """Only another metronome's ticks lie between the train's, ``unheld`` of them held
+    by no train: they drift through the places a divided beat would fill and are not
+    taken; 214 BPM is twice 107, but off its beat. (160.5 BPM is locked at 3:2 with
+    perfect timing: every third of its ticks keeps one place between the slow one's;
+    beyond timing alone, it is tried with its own train holding all but a fifth.)"""
+    times, _, own, others = setting(1, other_bpm=other_bpm, hidden=0.0)
+    slow = Train(own, np.arange(own.size), 60.0 / 107.0, np.zeros(own.size, bool))
+    rng = np.random.default_rng(3)
+    held = np.sort(others[rng.uniform(size=others.size) >= unheld])
+    trains = [slow, Train(held, np.arange(held.size), 60.0 / other_bpm, held < 0)]
+    assert subdivided(times, trains)[0] is slow
+
+
+def test_a_train_too_short_is_left_as_it_is():
+    times, train, _, _ = setting(2)
+    short = Train(train.index[:5], train.beat[:5], train.period, train.masked[:5])
+    assert subdivided(times, [short])[0] is short
+
+
+def test_later_impacts_taken_for_a_quarter_of_the_tocks_are_off_the_beat():
+    """A train that took a tock's later impact, 31.5 ms after its hidden first one, for
+    a quarter of its tocks (corpus: three metronomes, seed 35): each is off the beat,
+    though they bend a first fit of the beat and widen its spread."""
+    rng = np.random.default_rng(35)
+    n = np.arange(0, 88)
+    times = 0.1 + n * 0.4483 + np.where(n % 2, 0.012, 0.0) + rng.normal(0, 0.6e-3, n.size)
+    late = (n % 2 == 1) & (rng.uniform(size=n.size) < 0.25)
+    times[late] += 0.0315
+    assert np.array_equal(off_the_beat(times, n), late)
