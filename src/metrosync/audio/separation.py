@@ -8,11 +8,11 @@ impacts), or none with the reason.
 Steps: the impacts are grouped into voices by their sound (`voices`: the grouping with
 the most voices in which every voice carries tick trains of its own; where none does
 and tempo alone would make more metronomes than the first grouping whose trains each
-hold `trains.MIN_COVERAGE` of their beats, that grouping); within each
-voice the impacts of one tick become one tick, timed at its first impact, and the
-voice's ticks are followed as trains, one per metronome that sounds like it, told
-apart by tempo (`trains`); a tick and a tock that sound different are joined into
-one metronome. An impact that sounds like no voice and that no train took is an
+hold `trains.MIN_COVERAGE` of their beats (else `LAST_COVERAGE`), that grouping);
+within each voice the impacts of one tick become one tick, timed at its first
+impact, and the voice's ticks are followed as trains, one per metronome that sounds
+like it, told apart by tempo (`trains`); a tick and a tock that sound different are
+joined into one metronome. An impact that sounds like no voice and that no train took is an
 odd sound, not a tick. Metronomes are numbered by loudness, the loudest first.
 
 How sure. `confidence` in [0, 1] is the product of the share of ticks placed in a
@@ -37,6 +37,9 @@ CARRIED = 0.5
 MOST_BORROWED = 0.25
 #: Smallest share of its beats a metronome's train holds.
 MIN_JOINED_COVERAGE = 0.55
+#: ... in the last grouping tried before tempo alone: four metronomes can hide most
+#: of one's beats before its beats are sought again (`recovery`).
+LAST_COVERAGE = 0.3
 
 
 @dataclass(frozen=True)
@@ -94,17 +97,19 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
     beat_range = tr.BEAT_RANGE if bpm is None else (0.85 * 60 / bpm, 2.3 * 60 / bpm)
     times = impacts.time
     features = impact_features(recording, times)
-    weak = None
+    weak = {}  # coverage: the first grouping whose trains each hold that much
     for voices in cluster_voices(features, seed=seed):
         head, gaps, found, groups = _trains(times, impacts.strength, voices, beat_range)
         if voices.count == 1 or _all_voices_carry(head, voices, found, groups):
             break
-        if weak is None and _all_voices_carry(head, voices, found, groups, tr.MIN_COVERAGE):
-            weak = voices, head, gaps, found, groups
-    if voices.count == 1 and weak is not None and len(found) > len(weak[3]):
+        for least in (tr.MIN_COVERAGE, LAST_COVERAGE):
+            if least not in weak and _all_voices_carry(head, voices, found, groups, least):
+                weak[least] = voices, head, gaps, found, groups
+    fallback = weak.get(tr.MIN_COVERAGE, weak.get(LAST_COVERAGE))
+    if voices.count == 1 and fallback is not None and len(found) > len(fallback[3]):
         # tempo alone would make more metronomes than the sounds: a faint metronome,
         # a third of its beats unheard, is one metronome, not pieces of several
-        voices, head, gaps, found, groups = weak
+        voices, head, gaps, found, groups = fallback
     if not found:
         return Separation(head, voices, gaps=gaps, note="no steady tick train was found")
     loud = [float(np.mean(impacts.strength[t.index])) for t in found]
