@@ -87,6 +87,8 @@ LATER_FAINTER = 3.0
 OFF_BEAT = 3e-3
 #: Ticks of one kind on each side that put a tick where its beat is.
 NEIGHBOURS = 3
+#: Fits of a train's beat to the half of its ticks nearest it, at most (`off_the_beat`).
+REFITS = 5
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
 
@@ -475,7 +477,8 @@ def first_impacts(
 def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
     """(M,) True for the ticks of one train that lie off its beat: more than `OFF_BEAT`
     (and 5 robust spreads) from a quadratic in the beat number (a steady drift) fitted
-    to each kind of beat (tick, tock: a limp) apart, or from where its `NEIGHBOURS` of
+    to each kind of beat (tick, tock: a limp) apart, to the half of them nearest it
+    (again, up to `REFITS` times), or from where its `NEIGHBOURS` of
     the same kind put it; a later impact taken for a tick
     where the first was hidden, at the ends of a train, would bias its tempo."""
     times = np.asarray(times, dtype=float)
@@ -485,10 +488,19 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
         if sel.size < 6:
             continue
         n = beat[sel].astype(float)
-        fit = np.polyval(np.polyfit(n, times[sel], 2), n)
-        residual = times[sel] - fit
-        limit = max(OFF_BEAT, 5 * _robust_spread(residual))
-        out[sel] = np.abs(residual - np.median(residual)) > limit
+        # fitted to the half of the ticks nearest the fit, again until that half keeps:
+        # later impacts taken for a third of the ticks bend a fit to all of them and
+        # widen the spread that would hide them
+        core = np.ones(sel.size, dtype=bool)
+        for _ in range(REFITS):
+            residual = times[sel] - np.polyval(np.polyfit(n[core], times[sel][core], 2), n)
+            deviation = np.abs(residual - np.median(residual[core]))
+            nearest = deviation <= np.median(deviation)
+            if np.array_equal(nearest, core):
+                break
+            core = nearest
+        limit = max(OFF_BEAT, 5 * 1.4826 * float(np.median(deviation)))
+        out[sel] = deviation > limit
         # and from its neighbours: where two metronomes of nearly one tempo drift
         # through each other, a train that took some of the other's ticks bends away
         # from any quadratic, which then hides a tick 10 ms off
