@@ -34,7 +34,8 @@ curve's highest point alone is not enough there: beyond a train's end it is as
 often the room's noise. A heard tick found so keeps the detector's onset unless it
 lies in another's ring. Where the tracker gave up on a train before the file ended,
 the search walks on, `END_BEATS` at a time, while the train's sound is found there
-(at most `MAX_END_WALK` steps).
+(at most `MAX_END_WALK` steps). Up to `ROUNDS` rounds of all this: a beat found by its
+sound lets the next round predict the beats beside it.
 
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
 tick lies nearer another train's beat than its own train's beat puts it, within the
@@ -57,8 +58,13 @@ TOLERANCE = 1.5e-3
 REACH = 16
 #: Passes of `recover`: each predicts from the ticks the last one added.
 PASSES = 3
+#: Rounds of passes and the search by sound, at most: beats the sound found let the
+#: next round predict the beats between.
+ROUNDS = 3
 #: Heard beats of a kind on each side a missed beat's time is fitted to.
 SIDE = 3
+#: Beats of a kind heard with both beside them that measure the train's limp, at least.
+MIN_LIMP_SAMPLES = 4
 #: How long after a tick its later impacts and ring can move another's onset, s.
 RING = 0.04
 #: Beats sought by their sound beyond each end of a train, a step of the walk.
@@ -74,12 +80,19 @@ RING_OFF_BEAT = 1.0
 def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(beats missed, their predicted times) of one train: from the nearest heard beats
     of the same kind (tick or tock) before and after (not a masked tick: the tick that
-    hid it timed it), at most `REACH` beats away, on a line fitted to up to `SIDE` on
-    each side (`_fit_between`); from one side only, on the beat of the two nearest
-    heard beats of the kind there (within 5 % of the train's mean beat, else the
-    mean). With ``beyond``, only the ``beyond`` beats before the train's first tick
+    hid it timed it; but where most of a kind is masked, its tock sounds like another
+    voice and those are its own), at most `REACH` beats away, on a line fitted to up to `SIDE` on
+    each side (`_fit_between`); from one side only, midway between the beats beside it
+    where both were heard, moved by the train's limp (`_between`), else on the beat of
+    the two nearest heard beats of the kind there (within 5 % of the train's mean beat,
+    else the mean). With ``beyond``, only the ``beyond`` beats before the train's first tick
     and as many after its last."""
     heard = ~train.masked  # a masked tick is timed by the tick that hid it
+    for parity in (0, 1):
+        # ... unless most of a kind is: those are the metronome's own, in another voice
+        kind = train.beat % 2 == parity
+        if (heard & kind).sum() < 0.5 * kind.sum():
+            heard |= kind
     beat, t = train.beat[heard], times[train.index[heard]]
     if beat.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
@@ -116,6 +129,12 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
         p[only_lo] = (tb[lo] + (want - b[lo]) * step_lo)[only_lo]
         only_hi = has_hi & ~has_lo
         p[only_hi] = (tb[hi] - (b[hi] - want) * step_hi)[only_hi]
+        # where the kind was heard on one side only, but both beats beside were: midway
+        # between them, moved by the train's limp
+        one_sided = ~both
+        if one_sided.any():
+            between = _between(beat, t, want[one_sided])
+            p[one_sided] = np.where(np.isfinite(between), between, p[one_sided])
         ok = np.isfinite(p)
         out_n.append(want[ok])
         out_t.append(p[ok])
@@ -124,6 +143,25 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
     n, p = np.concatenate(out_n), np.concatenate(out_t)
     order = np.argsort(n)
     return n[order].astype(np.int64), p[order]
+
+
+def _between(beat: np.ndarray, t: np.ndarray, want: np.ndarray) -> np.ndarray:
+    """(W,) the time of each beat ``want`` midway between the heard beats before and
+    after it (``beat``, ``t``: the train's heard beats, sorted), moved by how far its
+    kind's beats lie from that midpoint where all three were heard (the limp, at least
+    `MIN_LIMP_SAMPLES` of them); NaN where a neighbour is missing."""
+    out = np.full(want.size, np.nan)
+    at = {int(n): x for n, x in zip(beat, t, strict=True)}
+    inner = np.array([n - 1 in at and n + 1 in at for n in beat.tolist()], dtype=bool)
+    if inner.sum() == 0:
+        return out
+    offset = t[inner] - np.array([(at[n - 1] + at[n + 1]) / 2 for n in beat[inner].tolist()])
+    kind = beat[inner] % 2
+    for w, n in enumerate(want.tolist()):
+        mine = offset[kind == n % 2]
+        if n - 1 in at and n + 1 in at and mine.size >= MIN_LIMP_SAMPLES:
+            out[w] = (at[n - 1] + at[n + 1]) / 2 + float(np.median(mine))
+    return out
 
 
 def _fit_between(b: np.ndarray, tb: np.ndarray, lo: int, hi: int, want: int) -> float:
@@ -188,21 +226,26 @@ def recover(recording, scan, ticks, trains: list[Train]):
     """(ticks, trains, recovered): see the module docstring."""
     trains = [_on_beat(ticks.time, t) for t in trains]
     recovered = 0
-    for _ in range(PASSES):
-        ticks, trains, added, taken = _pass(recording, scan, ticks, trains)
+    for _ in range(ROUNDS):
+        for _ in range(PASSES):
+            ticks, trains, added, taken = _pass(recording, scan, ticks, trains)
+            recovered += added
+            if added + taken == 0:
+                break
+        sounds = tp.learn(recording, scan, ticks.time, trains)
+        ticks, trains, added, joined = _by_sound(recording, scan, ticks, trains, sounds)
         recovered += added
-        if added + taken == 0:
-            break
-    sounds = tp.learn(recording, scan, ticks.time, trains)
-    ticks, trains, added, _ = _by_sound(recording, scan, ticks, trains, sounds)
-    recovered += added
-    # a train the tracker gave up on before the file ended: walked on, `END_BEATS` at a
-    # time, while its beats are found where its sound is
-    for _ in range(MAX_END_WALK):
-        ticks, trains, added, joined = _by_sound(recording, scan, ticks, trains, sounds,
-                                                 gaps=False)  # fmt: skip
-        recovered += added
-        if added + joined == 0:
+        found = added + joined
+        # a train the tracker gave up on before the file ended: walked on, `END_BEATS`
+        # at a time, while its beats are found where its sound is
+        for _ in range(MAX_END_WALK):
+            ticks, trains, added, joined = _by_sound(recording, scan, ticks, trains, sounds,
+                                                     gaps=False)  # fmt: skip
+            recovered += added
+            found += added + joined
+            if added + joined == 0:
+                break
+        if found == 0:
             break
     return ticks, trains, recovered
 
