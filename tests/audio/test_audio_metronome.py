@@ -92,3 +92,11 @@ def test_simulated_escapement_offset_is_heard_as_its_asymmetry(tmp_path):
     out = analyze_audio(tmp_path / "offset.wav")
     expected = asymmetry_from_offset(offset, amplitude)
     assert abs(float(out.asymmetry[0]) - expected) <= 0.5
+
+
+def test_a_train_with_no_single_beat_of_one_kind_has_no_asymmetry_error():
+    """Every other beat missed: each gap spans two beats but one, so one kind of single
+    beat is never heard; the statistics say so instead of dividing by zero."""
+    times = np.array([0.0, 1.0, 2.0, 3.0, 4.0, 4.5, 6.5, 8.5, 10.5])
+    stats = beat_statistics(times, 0.5)
+    assert np.isnan(stats.asymmetry_error) and np.isfinite(stats.bpm)

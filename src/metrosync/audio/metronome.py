@@ -118,7 +118,12 @@ def beat_statistics(
     counts = [int(np.sum(kind == p)) for p in (0, 1)]
     mean_beat = 0.5 * (means[0] + means[1])
     asym = 100 * abs(means[0] - means[1]) / mean_beat
-    asym_err = 100 * math.sqrt(varis[0] / counts[0] + varis[1] / counts[1]) / mean_beat
+    # a kind heard in one beat or none (a train of a few scattered ticks) has no spread
+    asym_err = (
+        100 * math.sqrt(varis[0] / counts[0] + varis[1] / counts[1]) / mean_beat
+        if min(counts) > 1
+        else math.nan
+    )
     tick_parity = 1 - tock_parity
     long_kind = 0 if means[0] > means[1] else 1
     long_beat = "tick→tock" if long_kind == tick_parity else "tock→tick"
