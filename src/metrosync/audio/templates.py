@@ -49,7 +49,7 @@ BEFORE = 8e-3
 AFTER = 0.1
 #: The start of it learned from ticks no other overlaps this long, s: its impacts and
 #: the loudest of its ring.
-HEAD = 0.07
+HEAD = 0.05
 #: Ticks of one kind that sound alone, at least, for a sound of that kind.
 MIN_CLEAR = 4
 #: Ticks of one kind averaged, at most.
