@@ -164,7 +164,7 @@ def loop(st, c, settings, rec, begin, impulse, impulsive):
                             group_start,
                         )
                         n_up -= 1
-                    if event & KICK:
+                    if impulsive and event & KICK:  # never for a scheme without impulses
                         last_kick[b, i] = t_new
                         kick, after, dv, dnum, dforce, jrest, jnum = impulse(
                             c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt
@@ -303,11 +303,11 @@ def _first_pass(c, b, rows, last_kick, scratch, now, begin, impulsive, trig):
     n_far = 0
     for i in range(theta.shape[0]):  # vectorized
         th = theta[i]
-        tn, vp, fires, torque, _ = begin(c, (b, i), th, theta_dot[i], acc[i], dt, dt2)
-        up = upward(th, tn)
-        kicked = impulsive and fires != 0.0  # a constant False for a scheme without impulses
+        tn, vp, fires, torque, kick = begin(c, (b, i), th, theta_dot[i], acc[i], dt, dt2)
         if not impulsive:  # every branch on ``impulsive`` is folded where it is compiled
             last_kick[i] = t_new if fires != 0.0 else last_kick[i]  # a select: it vectorizes
+        up = upward(th, tn)
+        kicked = (fires != 0.0) if impulsive else (kick != 0.0)  # constant False for verlet
         n_up += 1 if up else 0
         n_imp += 1 if kicked else 0
         # Stored, not recomputed in the scalar pass, which visits only the metronomes
