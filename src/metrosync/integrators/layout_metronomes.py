@@ -61,9 +61,9 @@ def arrange(constants):
 
 
 @nb.njit(inline="always")
-def loop(st, c, settings, rec, begin, impulse):
+def loop(st, c, settings, rec, begin, impulse, impulsive):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place,
-    with the scheme's hooks ``begin`` and ``impulse``."""
+    with the scheme's hooks ``begin`` and ``impulse`` and its constant ``impulsive``."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     (
         theta,
@@ -117,9 +117,11 @@ def loop(st, c, settings, rec, begin, impulse):
             t_old = s * dt
             t_new = (s + 1) * dt
             now = (t_new, dt, overturn_angle)
-            sums = _first_pass(c, b, rows, last_kick[b], scratch, now, begin, sincos)
+            sums = _first_pass(c, b, rows, last_kick[b], scratch, now, begin, impulsive, sincos)
             if sums[6] > 0:  # rare: far-wound angles, or inf (then φ̈ is NaN)
-                sums = _first_pass(c, b, rows, last_kick[b], scratch, now, begin, libm_sincos)
+                sums = _first_pass(
+                    c, b, rows, last_kick[b], scratch, now, begin, impulsive, libm_sincos
+                )
             sum_num, sum_den, sum_kick, n_up, n_imp, n_over, _ = sums
             if n_over > 0:
                 status[b] |= STATUS_OVERTURNED
@@ -133,12 +135,14 @@ def loop(st, c, settings, rec, begin, impulse):
                 force = others + friction
             phdd = 0.0 if held else disk_acceleration(c, b, sum_num, sum_den, force)
             if not math.isfinite(phdd):
+                if impulsive:  # the escapements fired all the same
+                    kick_times(last_kick[b], events, t_new)
                 status[b] |= STATUS_DIVERGED
                 break
             # The scalar pass: crossings to book, impulses to apply (summed as the disk's
             # jumps are linear in them: `schemes`).
             jumps = (0.0, 0.0, 0.0, 0.0, 0.0)
-            impulses = n_imp > 0
+            impulses = False
             if n_up > 0 or n_imp > 0:
                 for i in range(n):  # stops after the last crossing and impulse
                     event = events[i]
@@ -160,7 +164,8 @@ def loop(st, c, settings, rec, begin, impulse):
                             group_start,
                         )
                         n_up -= 1
-                    if event & KICK:
+                    if impulsive and event & KICK:  # never for a scheme without impulses
+                        last_kick[b, i] = t_new
                         kick, after, dv, dnum, dforce, jrest, jnum = impulse(
                             c, (b, i), b, theta[b, i], th_new[i], theta_dot[b, i], dt
                         )
@@ -171,7 +176,8 @@ def loop(st, c, settings, rec, begin, impulse):
                                 theta_dot[b, i], th_new[i], rest[i], after, half, dv, jrest
                             )
                             jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                            n_imp -= 1
+                            impulses = True
+                        n_imp -= 1
                     if n_up == 0 and n_imp == 0:
                         break
             sum_p = 0.0
@@ -250,6 +256,16 @@ def _record(b, k, omega_row, out, trajectories):
     )
 
 
+@nb.njit(cache=True)
+def kick_times(last_kick, events, t_new):
+    """``t_new`` into ``last_kick`` (a run's row) for each metronome with a `KICK` event
+    in ``events``: the escapements of a scheme with impulses, in a step whose scalar pass
+    does not run (the run diverged). Called, not inlined: it is rare."""
+    for i in range(events.shape[0]):
+        if events[i] & KICK:
+            last_kick[i] = t_new
+
+
 @nb.njit(inline="always")
 def add_jump(jumps, after, half, dnum, dforce, jnum):
     """Add one impulse to the step's sums: (Σ dnum + (τ − dt/2) jnum, Σ dforce,
@@ -265,12 +281,15 @@ def add_jump(jumps, after, half, dnum, dforce, jnum):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, b, rows, last_kick, scratch, now, begin, trig):
+def _first_pass(c, b, rows, last_kick, scratch, now, begin, impulsive, trig):
     """New angles, the escapement and the sums of eqs. (eqm1)–(eqm2) over run ``b``'s
-    metronomes (``rows`` = its θ, θ̇, θ̈), with ``trig`` = the vectorizable `sincos` or,
-    for far-wound angles, libm's; ``now`` = (t_new, dt, overturn angle): ``t_new`` into
-    ``last_kick`` (the run's row) where an escapement fires. Returns the three sums and
-    the counts of upward crossings, impulses, overturned and far-wound angles."""
+    metronomes (``rows`` = its θ, θ̇, θ̈), with the scheme's ``begin`` and
+    ``impulsive``, and ``trig`` = the vectorizable `sincos` or, for far-wound angles,
+    libm's; ``now`` = (t_new, dt, overturn angle). Where an escapement fires: without
+    impulses, ``t_new`` into ``last_kick`` (the run's row) and its torque into the
+    sums; with them, a `KICK` event (the scalar pass books both). Returns the three
+    sums and the counts of upward crossings, escapements to visit in the scalar pass,
+    overturned and far-wound angles."""
     theta, theta_dot, acc = rows
     th_new, rest, q, events = scratch
     t_new, dt, overturn_angle = now
@@ -285,9 +304,10 @@ def _first_pass(c, b, rows, last_kick, scratch, now, begin, trig):
     for i in range(theta.shape[0]):  # vectorized
         th = theta[i]
         tn, vp, fires, torque, kick = begin(c, (b, i), th, theta_dot[i], acc[i], dt, dt2)
-        last_kick[i] = t_new if fires != 0.0 else last_kick[i]  # a select: it vectorizes
+        if not impulsive:  # every branch on ``impulsive`` is folded where it is compiled
+            last_kick[i] = t_new if fires != 0.0 else last_kick[i]  # a select: it vectorizes
         up = upward(th, tn)
-        kicked = kick != 0.0  # a constant False for a scheme without impulses
+        kicked = (fires != 0.0) if impulsive else (kick != 0.0)  # constant False for verlet
         n_up += 1 if up else 0
         n_imp += 1 if kicked else 0
         # Stored, not recomputed in the scalar pass, which visits only the metronomes
@@ -299,7 +319,8 @@ def _first_pass(c, b, rows, last_kick, scratch, now, begin, trig):
         res, qi, num, den = pendulum_terms(c, (b, i), torque, sn, cs, vp)
         sum_num += num
         sum_den += den
-        sum_kick += torque
+        if not impulsive:  # a scheme with impulses gives no torque
+            sum_kick += torque
         th_new[i] = tn
         rest[i] = res
         q[i] = qi

@@ -46,7 +46,7 @@ from ._physics import (
     pendulum_terms,
     theta_ddot,
 )
-from .layout_metronomes import add_jump
+from .layout_metronomes import KICK, UP, add_jump, kick_times
 from .trig import REDUCTION_LIMIT, libm_sincos, sincos
 
 #: Runs per block: 8 doubles fill an AVX-512 register (two AVX2 registers).
@@ -72,10 +72,11 @@ def arrange(constants):
 
 
 @nb.njit(inline="always")
-def loop(st, c, settings, rec, begin, impulse):
+def loop(st, c, settings, rec, begin, impulse, impulsive):
     """Advance every run from step ``settings.step0`` by ``settings.n_steps``, in place,
-    with the scheme's hooks; the state uses the usual (B, N) layout and is transposed
-    into blocks here, once per call; ``c`` comes from `arrange`."""
+    with the scheme's hooks and its constant ``impulsive`` (`layouts`); the state uses
+    the usual (B, N) layout and is transposed into blocks here, once per call; ``c``
+    comes from `arrange`."""
     # Unpacked before the parallel loop: numba may lose writes through a tuple field there.
     (
         theta,
@@ -122,7 +123,7 @@ def loop(st, c, settings, rec, begin, impulse):
         th, thd, acc = swing
         ph, phd, aph, pp, fph = disk
         step, sums, stick = _scratch(n)
-        tn_s, rest, q = step
+        tn_s, rest, q, events = step
         s_num, s_den, s_kick, s_p = sums
         dry_lane, others, friction, held = stick
         ph_new = np.empty(LANES)
@@ -154,9 +155,13 @@ def loop(st, c, settings, rec, begin, impulse):
             t_old = s * dt
             t_new = (s + 1) * dt
             now = (t_new, dt, overturn_angle)
-            n_far = _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, sincos)
+            n_far = _first_pass(
+                c, blk, swing, step, sums, counts, lk, alive, now, begin, impulsive, sincos
+            )
             if n_far > 0:  # rare: redo the pass with libm trig
-                _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, libm_sincos)
+                _first_pass(
+                    c, blk, swing, step, sums, counts, lk, alive, now, begin, impulsive, libm_sincos
+                )
             if block_forced:  # a sine per lane: kept out of the vectorized loop below
                 for w in range(LANES):
                     tau[w] = applied_torque(c, (blk, w), t_new)
@@ -174,19 +179,24 @@ def loop(st, c, settings, rec, begin, impulse):
                 if overs[w] > 0:
                     status[b0 + w] |= STATUS_OVERTURNED
                 if not math.isfinite(phdd[w]):
+                    if impulsive:  # the escapements fired all the same
+                        kick_times(lk[:, w], events[:, w], t_new)
                     status[b0 + w] |= STATUS_DIVERGED
                     alive[w] = 0.0
                     continue
                 if ups[w] == 0 and imps[w] == 0:
                     continue
-                # The scalar pass: crossings to book, impulses to apply (`layout_metronomes`).
-                impulses = imps[w] > 0
-                any_impulse |= impulses
+                # The scalar pass: crossings to book, impulses to apply (`layout_metronomes`),
+                # at the metronomes the first pass marked.
+                impulses = False
                 jumps = (0.0, 0.0, 0.0, 0.0, 0.0)
                 for i in range(n):
                     t0 = th[i, w]
                     tn = tn_s[i, w]
-                    if upward(t0, tn):
+                    event = events[i, w] if impulsive else (UP if upward(t0, tn) else 0)
+                    if event == 0:
+                        continue
+                    if event & UP:
                         t_cross = t_old + dt * t0 / (t0 - tn)
                         upward_crossing(
                             last_up,
@@ -201,7 +211,8 @@ def loop(st, c, settings, rec, begin, impulse):
                             group_start,
                         )
                         ups[w] -= 1
-                    if imps[w] > 0:
+                    if event & KICK:
+                        lk[i, w] = t_new
                         kick, after, dv, dnum, dforce, jrest, jnum = impulse(
                             c, (blk, i, w), (blk, w), t0, tn, thd[i, w], dt
                         )
@@ -210,9 +221,11 @@ def loop(st, c, settings, rec, begin, impulse):
                                 thd[i, w], tn_s[i, w], rest[i, w], after, half, dv, jrest
                             )
                             jumps = add_jump(jumps, after, half, dnum, dforce, jnum)
-                            imps[w] -= 1
+                            impulses = True
+                        imps[w] -= 1
                     if ups[w] == 0 and imps[w] == 0:
                         break
+                any_impulse |= impulses
                 if impulses:
                     jump[w], shift[w], change = disk_jumps(c, (blk, w), jumps, s_den[w])
                     phdd[w] += change
@@ -282,11 +295,17 @@ def loop(st, c, settings, rec, begin, impulse):
 
 @nb.njit(inline="always")
 def _scratch(n):
-    """A block's scratch bundles, runs innermost: the step's new angles, ρ_i and q_i,
-    (n, LANES) each; the per-lane sums of eqs. (eqm1)–(eqm2), Σ num, Σ den, Σ torque,
-    and Σ q θ̇ after the step; and for the disk's dry friction (`_dry_friction`), the
-    lanes that have it, the torque without it, the friction and whether it holds."""
-    step = (np.empty((n, LANES)), np.empty((n, LANES)), np.empty((n, LANES)))
+    """A block's scratch bundles, runs innermost: the step's new angles, ρ_i, q_i and
+    events (`layout_metronomes.UP` | ``KICK`` bits), (n, LANES) each; the per-lane sums
+    of eqs. (eqm1)–(eqm2), Σ num, Σ den, Σ torque, and Σ q θ̇ after the step; and for
+    the disk's dry friction (`_dry_friction`), the lanes that have it, the torque
+    without it, the friction and whether it holds."""
+    step = (
+        np.empty((n, LANES)),
+        np.empty((n, LANES)),
+        np.empty((n, LANES)),
+        np.empty((n, LANES), dtype=np.uint8),
+    )
     sums = (np.empty(LANES), np.empty(LANES), np.empty(LANES), np.empty(LANES))
     stick = (
         np.empty(LANES, dtype=np.bool_),
@@ -298,15 +317,17 @@ def _scratch(n):
 
 
 @nb.njit(inline="always")
-def _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, trig):
+def _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, impulsive, trig):
     """New angles, the escapement and the per-lane sums of eqs. (eqm1)–(eqm2) for block
-    ``blk`` (the bundles of `load_block` and `_scratch`), with ``trig`` = the
-    vectorizable `sincos` or, for far-wound angles, libm's; ``now`` = (t_new, dt,
-    overturn angle): ``t_new`` into ``lk`` where a live lane's escapement fires. Fills
-    the per-lane counts of upward crossings, impulses and overturns (``counts``' rows);
-    returns the number of far-wound angles."""
+    ``blk`` (the bundles of `load_block` and `_scratch`), with the scheme's ``begin``
+    and ``impulsive``, and ``trig`` = the vectorizable `sincos` or, for far-wound angles,
+    libm's; ``now`` = (t_new, dt, overturn angle). Fills the per-lane counts of upward
+    crossings, escapements to visit in the scalar pass and overturns (``counts``' rows);
+    returns the number of far-wound angles. Where an escapement fires: without
+    impulses, ``t_new`` into ``lk`` (for a live lane) and its torque into the sums;
+    with them, a `KICK` event (the scalar pass books both)."""
     th, thd, acc = swing
-    tn_s, rest, q = step
+    tn_s, rest, q, events = step
     s_num, s_den, s_kick, _ = sums
     ups, imps, overs = counts[0], counts[1], counts[2]
     t_new, dt, overturn_angle = now
@@ -322,18 +343,24 @@ def _first_pass(c, blk, swing, step, sums, counts, lk, alive, now, begin, trig):
     for i in range(th.shape[0]):
         for w in range(th.shape[1]):  # vectorized across runs
             t0 = th[i, w]
-            tn, vp, fires, torque, kick = begin(c, (blk, i, w), t0, thd[i, w], acc[i, w], dt, dt2)
-            ups[w] += 1 if upward(t0, tn) else 0
-            imps[w] += 1 if kick != 0.0 else 0
-            fired = (fires != 0.0) & (alive[w] > 0.0)
-            lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
+            tn, vp, fires, torque, _ = begin(c, (blk, i, w), t0, thd[i, w], acc[i, w], dt, dt2)
+            up = upward(t0, tn)
+            ups[w] += 1 if up else 0
+            if impulsive:  # every branch on ``impulsive`` is folded where it is compiled
+                fired = fires != 0.0
+                imps[w] += 1 if fired else 0
+                events[i, w] = (UP if up else 0) | (KICK if fired else 0)
+            else:
+                fired = (fires != 0.0) & (alive[w] > 0.0)
+                lk[i, w] = t_new if fired else lk[i, w]  # a select: it vectorizes
             overs[w] += 1 if abs(tn) > overturn_angle else 0
             n_far += 1 if abs(tn) > REDUCTION_LIMIT else 0
             sn, cs = trig(tn)
             res, qi, num, den = pendulum_terms(c, (blk, i, w), torque, sn, cs, vp)
             s_num[w] += num
             s_den[w] += den
-            s_kick[w] += torque
+            if not impulsive:  # a scheme with impulses gives no torque
+                s_kick[w] += torque
             tn_s[i, w] = tn
             rest[i, w] = res
             q[i, w] = qi
@@ -390,7 +417,7 @@ def _settle_disk(c, blk, w, swing, disk, step, sums, stick, dt):
     it ends the step held at rest."""
     _, thd, acc = swing
     _, phd, aph, pp, fph = disk
-    _, rest, q = step
+    _, rest, q, _ = step
     s_num, s_den, s_p = sums[0][w], sums[1][w], sums[3][w]
     others, friction, held = stick[1][w], stick[2][w], stick[3][w]
     if not held and friction * phd[w] >= 0.0:  # rare: φ̇ reached 0 within the step

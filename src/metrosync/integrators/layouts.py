@@ -16,8 +16,15 @@ A fixed-step scheme is two hooks, compiled functions that every layout's loop ca
     pendulum's velocity jump, its share of φ̈'s numerator and of the disk's torque, and
     what the jump changes in ρ_i and in φ̈'s numerator per unit time
     (`_located_parts.kick`). The loop applies them and the disk's jumps they imply.
-    Nothing of the impulses is stored in the first pass: a scheme without them pays
-    nothing for them.
+``IMPULSIVE``
+    a constant of the scheme module, passed to the loops with the hooks: whether the
+    escapement is an impulse (``begin`` gives no torque) or a torque (no impulses).
+    The loops branch on it where a scheme pays for what it does not use, and numba
+    folds those branches: without impulses, the first pass sets the last kick's time
+    by a vectorized select and nothing of the impulses is stored; with them, it marks
+    each firing escapement as an event, and the scalar pass, which visits those
+    anyway, sets the time and applies the impulse, while the escapement torques are
+    not summed.
 
 The layouts (`layout_runs`, `layout_metronomes`) own the loops, the memory order, the
 crossing and record bookkeeping, the disk's update and its dry friction; the forces

@@ -62,6 +62,9 @@ from ._physics import escapement
 from ._state import StepState
 from .layouts import advance_in_layout
 
+#: No impulses inside the step: the escapement is a torque (`layouts`).
+IMPULSIVE = False
+
 
 @nb.njit(cache=True, inline="always")
 def begin(c, m, theta, theta_dot, acc, dt, dt2):
@@ -81,13 +84,13 @@ def impulse(c, m, r, theta, theta_next, theta_dot, dt):
 @nb.njit(parallel=True, cache=True)
 def advance_runs(st, c, settings, rec):
     """The scheme in the runs-innermost loop (`layout_runs`)."""
-    layout_runs.loop(st, c, settings, rec, begin, impulse)
+    layout_runs.loop(st, c, settings, rec, begin, impulse, IMPULSIVE)
 
 
 @nb.njit(parallel=True, cache=True, fastmath=layout_metronomes.FASTMATH)
 def advance_metronomes(st, c, settings, rec):
     """The scheme in the metronomes-innermost loop (`layout_metronomes`)."""
-    layout_metronomes.loop(st, c, settings, rec, begin, impulse)
+    layout_metronomes.loop(st, c, settings, rec, begin, impulse, IMPULSIVE)
 
 
 #: The compiled kernel of each memory layout.
