@@ -154,16 +154,13 @@ def test_two_metronomes_on_recordings_the_analysis_was_not_tuned_on(tmp_path):
 
 @pytest.mark.slow
 def test_three_and_four_metronomes_on_recordings_the_analysis_was_not_tuned_on(tmp_path):
-    """Seeds 6-11, three and four metronomes: the number right in every one; each
-    metronome timed within 1 ms and its tempo within 0.1 BPM; recall and precision
-    >= 99 % for at least 90 % of them (two fall short by one tick each, a tick at the
-    very start of the file, or one whose first impact another's ring hid)."""
+    """Seeds 6-11, three and four metronomes: the number right in every one, and every
+    metronome heard tick by tick as the issue asks (two fell short by one tick each:
+    one in another's ring, timed late, until the ring's tail was learned with each
+    sound (`templates`); one at the very start of the file, now not counted as heard)."""
     right, table, hearable_ones = _corpus_scores(tmp_path, (3, 4), range(6, 12))
     assert hearable_ones == 12 and right.all()
-    recall, precision, timing, bpm = table.T
-    assert np.mean((recall >= 0.99) & (precision >= 0.99)) >= 0.9
-    assert np.all(recall >= 0.98) and np.all(precision >= 0.99)
-    assert np.all(timing <= 1e-3) and np.all(bpm <= 0.1)
+    _assert_each_metronome_meets_the_issue(table)
 
 
 @pytest.mark.slow
