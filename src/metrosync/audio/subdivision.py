@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .trains import MAX_FRAGMENT, OFF_BEAT, Train, _robust_spread
+from .trains import MAX_FRAGMENT, OFF_BEAT, Train, robust_spread
 
 #: A tick between is sought this far (fraction of the divided beat) from its place.
 WINDOW = 0.15
@@ -105,7 +105,7 @@ def _fitting(free_t, where, place, kind, beat: float) -> np.ndarray | None:
             sel = close & mine & (kind == parity)
             if sel.sum() == 0:
                 continue
-            if sel.sum() < 3 or _robust_spread(offset[sel]) >= MAX_SPREAD:
+            if sel.sum() < 3 or robust_spread(offset[sel]) >= MAX_SPREAD:
                 return None
             usual[mine & (kind == parity)] = np.median(offset[sel])
     # each place's tick is the free one nearest its usual offset from it

@@ -399,7 +399,7 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
                 and np.mean(strength[tb.index]) < np.mean(strength[ta.index]) - LATER_FAINTER
             )
             limit = 2 * PART_LAG_SPREAD if middle > 0 and fainter else PART_LAG_SPREAD
-            if abs(middle) >= MAX_TICK_LENGTH or _robust_spread(lag) >= limit:
+            if abs(middle) >= MAX_TICK_LENGTH or robust_spread(lag) >= limit:
                 continue
             if k == 1:
                 if middle <= 0 or strength is None:
@@ -454,7 +454,7 @@ def first_impacts(
             if len(set(np.asarray(owner)[near])) < 0.5 * sel.size:
                 continue
             lag = float(np.median(lags_a[near]))
-            if _robust_spread(lags_a[near]) >= PART_LAG_SPREAD:
+            if robust_spread(lags_a[near]) >= PART_LAG_SPREAD:
                 continue
             moves = {}
             for s, x in zip(np.asarray(owner)[near], mine[np.asarray(owner)[near]] - lags_a[near],
@@ -507,7 +507,7 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
         local = times[sel] - _from_neighbours(n, times[sel])
         inner = np.isfinite(local)
         if inner.sum() >= 4:
-            limit = max(OFF_BEAT, 5 * _robust_spread(local[inner]))
+            limit = max(OFF_BEAT, 5 * robust_spread(local[inner]))
             out[sel[inner]] |= np.abs(local[inner] - np.median(local[inner])) > limit
     return out
 
@@ -529,7 +529,7 @@ def _from_neighbours(n: np.ndarray, t: np.ndarray, side: int = NEIGHBOURS) -> np
     return out
 
 
-def _robust_spread(x: np.ndarray) -> float:
+def robust_spread(x: np.ndarray) -> float:
     """1.4826 × the median absolute deviation: a standard deviation that a few odd
     values (a masked tick) do not inflate."""
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
