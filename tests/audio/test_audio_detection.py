@@ -8,6 +8,7 @@ import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio import detection as det
+from metrosync.audio.reader import BLOCK_FRAMES as BLOCK
 from metrosync.audio.reader import open_recording
 
 
@@ -71,3 +72,22 @@ def test_white_noise_alone_gives_no_ticks(tmp_path, rng):
     path = synth.write(tmp_path / "noise.wav", rng.normal(0, 0.05, (44100 * 60, 1)))
     scan = det.scan(open_recording(path))
     assert det.pick_ticks(scan, 20).size <= 1  # fewer than one false tick a minute
+
+
+def test_segments_read_once_hold_the_file_and_zeros_beyond(tmp_path, rng):
+    """Segments anywhere in the file, even only a few near its end (the blocks before
+    them are skipped, not buffered), hold its frames: zeros before the first and past
+    the last."""
+    import soundfile as sf
+
+    frames = 3 * BLOCK + 123
+    x = rng.normal(0, 0.1, (frames, 2)).astype(np.float32)
+    path = tmp_path / "noise.wav"
+    sf.write(path, x, 8000, subtype="FLOAT")
+    recording = open_recording(path)
+    padded = np.concatenate([np.zeros((50, 2), np.float32), x, np.zeros((50, 2), np.float32)])
+    for starts in ([frames - 40, frames - 10], [-30, 5, BLOCK - 3, 2 * BLOCK + 7, frames - 20]):
+        starts = np.array(starts)
+        out = np.concatenate([seg for _, seg in det._segments(recording, starts, 60, 2)])
+        for row, s in zip(out, starts, strict=True):
+            assert np.array_equal(row, padded[s + 50 : s + 110])

@@ -331,7 +331,9 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
 
 def _segments(recording: Recording, starts: np.ndarray, length: int, chunk: int):
     """Yield (index of the first, (n, length, C) segments) in order of ``starts`` (sorted),
-    reading the file once; frames outside the file are zeros."""
+    reading the file once and keeping only the blocks a segment needs (a few segments
+    near the end of an hour's file do not hold it all); frames outside the file are
+    zeros."""
     n = starts.size
     done = 0
     buffer = np.zeros((0, recording.channels), dtype=np.float32)
@@ -347,6 +349,11 @@ def _segments(recording: Recording, starts: np.ndarray, length: int, chunk: int)
                 exhausted = True
                 block = (0, np.zeros((need - buffer_start - buffer.shape[0], recording.channels),
                                      dtype=np.float32))  # fmt: skip
+            end = buffer_start + buffer.shape[0] + block[1].shape[0]
+            if end <= starts[done]:  # all before the next segment: not kept
+                buffer = buffer[:0]
+                buffer_start = end
+                continue
             buffer = np.concatenate([buffer, block[1]])
         end = buffer_start + buffer.shape[0]
         stop = done + int(np.searchsorted(starts[done:] + length, end, side="right"))
