@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from metrosync.audio.subdivision import subdivided
-from metrosync.audio.trains import Train, off_the_beat
+from metrosync.audio.trains import Train, fold_parts, off_the_beat
 
 
 def beats(bpm, duration, *, limp=0.03, jitter=0.6e-3, start=0.1, seed=0):
@@ -96,3 +96,23 @@ def test_later_impacts_taken_for_a_quarter_of_the_tocks_are_off_the_beat():
     late = (n % 2 == 1) & (rng.uniform(size=n.size) < 0.25)
     times[late] += 0.0315
     assert np.array_equal(off_the_beat(times, n), late)
+
+
+@pytest.mark.parametrize(("drop_db", "folded"), [(35.0, True), (2.0, False)])
+def test_a_faint_train_at_a_fixed_lag_beyond_a_tick_is_its_echo(drop_db, folded):
+    """One metronome (corpus, seed 117): a sound 115 ms after every second tick of one
+    voice, 35 dB fainter, was a train of its own, a second metronome. Far fainter, at
+    a fixed lag within the beat, it is the first train's echo; as loud, it is not."""
+    rng = np.random.default_rng(117)
+    first = 0.1 + np.arange(60) * 0.64 + rng.normal(0, 0.5e-3, 60)
+    echo = first[::2] + 0.115 + rng.normal(0, 0.02e-3, 30)
+    times = np.concatenate([first, echo])
+    order = np.argsort(times)
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    strength = np.where(np.arange(times.size) < first.size, -3.0, -3.0 - drop_db)[order]
+    a = Train(where[:60], np.arange(60), 0.64, np.zeros(60, bool))
+    b = Train(where[60:], np.arange(30), 1.28, np.zeros(30, bool))
+    kept, _, parts = fold_parts(times[order], [a, b], [0, 1], strength)
+    assert (len(kept) == 1) == folded
+    assert (len(parts) == 1 and set(parts[0]) == set(b.index)) == folded

@@ -83,6 +83,9 @@ PART_LAG_SPREAD = 0.3e-3
 #: ... and of one that comes after it and is this much fainter (dB): a later impact,
 #: timed in the first one's ring, less precisely (twice the spread allowed).
 LATER_FAINTER = 3.0
+#: A train this much fainter (dB) than another, at a fixed lag after it, is its echo
+#: or a last faint impact, however long the lag (within the other's beat).
+ECHO_FAINTER = 12.0
 #: A tick farther than this from its train's beat is not its metronome's, s.
 OFF_BEAT = 3e-3
 #: Ticks of one kind on each side that put a tick where its beat is.
@@ -375,9 +378,11 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
     pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
     A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
     different from the first. A later impact at least `LATER_FAINTER` dB fainter is
-    timed in the first one's ring: its lag may spread twice as much. Two metronomes
-    locked a few milliseconds apart keep a lag that wanders by more than that, as each
-    one's beat jitters.
+    timed in the first one's ring: its lag may spread twice as much. One at least
+    `ECHO_FAINTER` dB fainter is part of A at any lag within A's beat (a room's echo, a
+    last faint impact beyond `MAX_TICK_LENGTH`). Two metronomes locked a few
+    milliseconds apart keep a lag that wanders by more than that, as each one's beat
+    jitters.
     """
     keep = [True] * len(trains)
     folded = []
@@ -394,12 +399,14 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
                            t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
             middle = float(np.median(lag))
-            fainter = (
-                strength is not None
-                and np.mean(strength[tb.index]) < np.mean(strength[ta.index]) - LATER_FAINTER
+            drop = (
+                float(np.mean(strength[ta.index]) - np.mean(strength[tb.index]))
+                if strength is not None
+                else 0.0
             )
-            limit = 2 * PART_LAG_SPREAD if middle > 0 and fainter else PART_LAG_SPREAD
-            if abs(middle) >= MAX_TICK_LENGTH or robust_spread(lag) >= limit:
+            limit = 2 * PART_LAG_SPREAD if middle > 0 and drop > LATER_FAINTER else PART_LAG_SPREAD
+            echo = middle > 0 and drop >= ECHO_FAINTER
+            if (abs(middle) >= MAX_TICK_LENGTH and not echo) or robust_spread(lag) >= limit:
                 continue
             if k == 1:
                 if middle <= 0 or strength is None:
