@@ -4,7 +4,8 @@ One entry point, `analyze_audio(path)`; the steps are modules of their own:
 `reader` (files, in blocks), `detection` (tick onsets), `tempo` (the beat period),
 `voices` (each impact's sound, clustered), `trains` (impacts grouped into ticks,
 ticks followed as one train per metronome), `separation` (the two together: the
-metronomes told apart), `recovery` (ticks another hid, found again), `templates`
+metronomes told apart), `subdivision` (a train on every k-th beat of its metronome
+given the beats between), `recovery` (ticks another hid, found again), `templates`
 (each metronome's learned sound: ticks in another's ring timed on it), `together`
 (several microphones aligned), `metronome` (one metronome's tempo, jitter and beat),
 `order` (the acoustic order parameter and clusters), `attribution` (the phase of one
