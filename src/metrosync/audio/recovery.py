@@ -49,7 +49,7 @@ import numpy as np
 
 from . import detection as det
 from . import templates as tp
-from .trains import Train, off_the_beat
+from .trains import Train, holders, off_the_beat
 
 WINDOW = 3e-3
 MIN_RISE = 1.0
@@ -81,12 +81,12 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
     """(beats missed, their predicted times) of one train: from the nearest heard beats
     of the same kind (tick or tock) before and after (not a masked tick: the tick that
     hid it timed it; but where most of a kind is masked, its tock sounds like another
-    voice and those are its own), at most `REACH` beats away, on a line fitted to up to `SIDE` on
-    each side (`_fit_between`); from one side only, midway between the beats beside it
-    where both were heard, moved by the train's limp (`_between`), else on the beat of
-    the two nearest heard beats of the kind there (within 5 % of the train's mean beat,
-    else the mean). With ``beyond``, only the ``beyond`` beats before the train's first tick
-    and as many after its last."""
+    voice and those are its own), at most `REACH` beats away, on a line fitted to up to
+    `SIDE` on each side (`_fit_between`); from one side only, midway between the beats
+    beside it where both were heard, moved by the train's limp (`_midway`, `_limps`),
+    else on the beat of the two nearest heard beats of the kind there (within 5 % of the
+    train's mean beat, else the mean). With ``beyond``, only the ``beyond`` beats before
+    the train's first tick and as many after its last."""
     heard = ~train.masked  # a masked tick is timed by the tick that hid it
     for parity in (0, 1):
         # ... unless most of a kind is: those are the metronome's own, in another voice
@@ -102,6 +102,7 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
     else:
         missing = np.setdiff1d(np.arange(train.beat[0], train.beat[-1] + 1), train.beat)
     swing = 2 * train.period
+    limps = _limps(beat, t)
     out_n, out_t = [], []
     for parity in (0, 1):
         mine = beat % 2 == parity
@@ -133,7 +134,7 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
         # between them, moved by the train's limp
         one_sided = ~both
         if one_sided.any():
-            between = _between(beat, t, want[one_sided])
+            between = _midway(beat, t, want[one_sided]) + limps[parity]
             p[one_sided] = np.where(np.isfinite(between), between, p[one_sided])
         ok = np.isfinite(p)
         out_n.append(want[ok])
@@ -145,23 +146,28 @@ def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.n
     return n[order].astype(np.int64), p[order]
 
 
-def _between(beat: np.ndarray, t: np.ndarray, want: np.ndarray) -> np.ndarray:
-    """(W,) the time of each beat ``want`` midway between the heard beats before and
-    after it (``beat``, ``t``: the train's heard beats, sorted), moved by how far its
-    kind's beats lie from that midpoint where all three were heard (the limp, at least
-    `MIN_LIMP_SAMPLES` of them); NaN where a neighbour is missing."""
-    out = np.full(want.size, np.nan)
-    at = {int(n): x for n, x in zip(beat, t, strict=True)}
-    inner = np.array([n - 1 in at and n + 1 in at for n in beat.tolist()], dtype=bool)
-    if inner.sum() == 0:
+def _midway(beat: np.ndarray, t: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """(len(n),) the time midway between the heard beats n − 1 and n + 1 (``beat``,
+    ``t``: the train's heard beats, sorted); NaN where either was not heard."""
+    out = np.full(n.size, np.nan)
+    if beat.size == 0:
         return out
-    offset = t[inner] - np.array([(at[n - 1] + at[n + 1]) / 2 for n in beat[inner].tolist()])
-    kind = beat[inner] % 2
-    for w, n in enumerate(want.tolist()):
-        mine = offset[kind == n % 2]
-        if n - 1 in at and n + 1 in at and mine.size >= MIN_LIMP_SAMPLES:
-            out[w] = (at[n - 1] + at[n + 1]) / 2 + float(np.median(mine))
+    lo = np.minimum(np.searchsorted(beat, n - 1), beat.size - 1)
+    hi = np.minimum(np.searchsorted(beat, n + 1), beat.size - 1)
+    both = (beat[lo] == n - 1) & (beat[hi] == n + 1)
+    out[both] = (t[lo[both]] + t[hi[both]]) / 2
     return out
+
+
+def _limps(beat: np.ndarray, t: np.ndarray) -> tuple[float, float]:
+    """How far each kind's heard beats lie from midway between the beats beside them
+    (median, s), NaN for a kind with fewer than `MIN_LIMP_SAMPLES` such beats."""
+    offset = t - _midway(beat, t, beat)
+    out = []
+    for parity in (0, 1):
+        mine = offset[np.isfinite(offset) & (beat % 2 == parity)]
+        out.append(float(np.median(mine)) if mine.size >= MIN_LIMP_SAMPLES else np.nan)
+    return out[0], out[1]
 
 
 def _fit_between(b: np.ndarray, tb: np.ndarray, lo: int, hi: int, want: int) -> float:
@@ -260,7 +266,7 @@ def _by_sound(recording, scan, ticks, trains: list[Train], sounds, *, gaps: bool
     lies in another's ring (`templates.retime`): elsewhere the detector is exact."""
     rate = recording.sample_rate
     lo, hi = tp.BEFORE + tp.MARGIN, recording.frames / rate - tp.AFTER - tp.MARGIN
-    owner = tp.owners(ticks.time, trains)
+    owner = holders(ticks.time.size, trains)
     held = np.flatnonzero(owner >= 0)
     held = held[[sounds[owner[i]] is not None for i in held]]
     metronomes: list[int] = []
@@ -412,17 +418,17 @@ def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) ->
     that lies nearer another train's beat (a tick it heard, or one it missed or took
     from another, where predicted) than its own train's beat puts it, within the
     detector's resolution (two metronomes ticked together there and the tick's onset
-    may be either's); and
-    for each tick that falls within `RING` after another train's tick and lies off its
-    own beat by more than `RING_OFF_BEAT` of its train's robust spread (at least a
-    millisecond): its onset is timed by the other's later impacts and ring."""
+    may be either's); and for each tick that falls within `RING` after another train's
+    tick and lies off its own beat by more than `RING_OFF_BEAT` of its train's robust
+    spread (at least a millisecond): its onset is timed by the other's later impacts
+    and ring."""
     out = label.copy()
     if len(trains) < 2:
         return out
     beats, heard = [], []
     for train in trains:
         # a masked tick is another's onset: its beat is where the train's beat puts it
-        own = train.masked == 0
+        own = ~train.masked
         unmasked = Train(train.index[own], train.beat[own], train.period, train.masked[own])
         _, predicted = _predictions(times, unmasked)
         beats.append(np.sort(np.concatenate([times[unmasked.index], predicted])))

@@ -12,8 +12,9 @@ hold `trains.MIN_COVERAGE` of their beats (else `LAST_COVERAGE`), that grouping)
 within each voice the impacts of one tick become one tick, timed at its first
 impact, and the voice's ticks are followed as trains, one per metronome that sounds
 like it, told apart by tempo (`trains`); a tick and a tock that sound different are
-joined into one metronome. An impact that sounds like no voice and that no train took is an
-odd sound, not a tick. Metronomes are numbered by loudness, the loudest first.
+joined into one metronome. An impact that sounds like no voice and that no train
+took is an odd sound, not a tick. Metronomes are numbered by loudness, the loudest
+first.
 
 How sure. `confidence` in [0, 1] is the product of the share of ticks placed in a
 train, the smallest coverage (share of a train's beats heard) and, when voices were

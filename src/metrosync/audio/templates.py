@@ -92,11 +92,6 @@ def _filtered(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
     return out
 
 
-def owners(times: np.ndarray, trains: list[Train]) -> np.ndarray:
-    """(K,) the train that holds each tick as its own, −1 for none (or two)."""
-    return holders(times.size, trains)
-
-
 def learn(recording, scan, times: np.ndarray, trains: list[Train]) -> list[Sound | None]:
     """One `Sound` per train (see the module docstring)."""
     rate = recording.sample_rate
@@ -235,7 +230,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     times = np.asarray(times, dtype=float)
     out = times.copy()
     likeness = np.full(times.size, np.nan)
-    owner = owners(times, trains)
+    owner = holders(times.size, trains)
     masked = np.zeros(times.size, dtype=bool)
     for t in trains:
         masked[t.index[t.masked]] = True

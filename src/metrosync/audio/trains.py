@@ -408,11 +408,8 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             echo = middle > 0 and drop >= ECHO_FAINTER
             if (abs(middle) >= MAX_TICK_LENGTH and not echo) or robust_spread(lag) >= limit:
                 continue
-            if k == 1:
-                if middle <= 0 or strength is None:
-                    continue
-                if np.mean(strength[tb.index]) >= np.mean(strength[ta.index]) - 1.0:
-                    continue
+            if k == 1 and (middle <= 0 or strength is None or drop <= 1.0):
+                continue
             keep[b] = False
             folded.append(tb.index[~tb.masked])
             break
