@@ -51,6 +51,7 @@ from . import detection as det
 from . import templates
 from .attribution import phase_difference
 from .hidden import hidden_count, hidden_trains
+from .interleaved import join_interleaved
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
 from .reader import open_recording
@@ -144,6 +145,7 @@ def analyze_audio(
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
     trains = subdivided(ticks.time, trains)
+    trains = join_interleaved(ticks.time, ticks.strength, trains)
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
     trains, behind = _told_apart(ticks, trains)

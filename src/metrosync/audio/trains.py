@@ -45,7 +45,9 @@ are whole multiples (up to `MAX_FRAGMENT`) of one beat T ≥ 0.2 s (within 1 %),
 the second's ticks fall on the first's grid of beats T (circular spread below
 2 × `LOCKED_SPREAD` of a beat, within 15 % of a beat of the grid: a limp, drifting on
 it by under `MAX_DRIFT` of a beat over their shared time: two metronomes of nearly
-one tempo drift by more), almost never (10 %) within 0.3 T of the first's own ticks;
+one tempo drift by more), almost never (10 %) within 0.3 T of the first's own ticks
+(a tick both hold is one tick, heard on both grids: every 2nd beat and every 3rd
+meet on every 6th; but at most half of the second's ticks);
 or when one takes up the other's beat (the same period, or a whole multiple of it,
 within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
 15 %, after the other's last). (Two metronomes locked a whole
@@ -570,8 +572,11 @@ def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
     `MAX_FRAGMENT`) and on whose grid, laid from train a, b's ticks fall at a fixed
     place between a's ticks; None if there is none."""
     t_a, t_b = times[ta.index], times[tb.index]
-    inside = (t_b > t_a[0]) & (t_b < t_a[-1])
-    if inside.sum() < 4:
+    # a tick both trains hold is one tick of the metronome, heard on both grids (every
+    # 2nd and every 3rd beat meet on every 6th)
+    shared = np.isin(tb.index, ta.index)
+    inside = (t_b > t_a[0]) & (t_b < t_a[-1]) & ~shared
+    if inside.sum() < 4 or shared.sum() > inside.sum():
         return None
     for ka in range(1, MAX_FRAGMENT + 1):
         beat = ta.period / ka
@@ -628,8 +633,10 @@ def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
 
 
 def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
-    index = np.concatenate([ta.index, tb.index])
-    masked = np.concatenate([ta.masked, tb.masked])
+    index, first = np.unique(np.concatenate([ta.index, tb.index]), return_index=True)
+    masked = np.concatenate([ta.masked, tb.masked])[first]
+    # a tick both hold is masked only if both took it from another metronome
+    masked &= ~np.isin(index, np.concatenate([ta.index[~ta.masked], tb.index[~tb.masked]]))
     order = np.argsort(times[index], kind="stable")
     index, masked = index[order], masked[order]
     t = times[index]

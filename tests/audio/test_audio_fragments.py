@@ -1,0 +1,137 @@
+"""Pieces of one metronome's ticks, followed as several trains, are one metronome."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from metrosync.audio.interleaved import join_interleaved
+from metrosync.audio.trains import Train, join_fragments
+
+BEAT = 60.0 / 141.33
+
+
+def ticks(n, *, beat=BEAT, limp=0.03, start=0.3, jitter=0.4e-3, seed=0):
+    rng = np.random.default_rng(seed)
+    k = np.arange(n)
+    return start + k * beat + np.where(k % 2, limp * beat, 0.0) + rng.normal(0, jitter, n)
+
+
+def indexed(*groups):
+    """All times sorted, and each group's indices into them."""
+    times = np.concatenate(groups)
+    order = np.argsort(times, kind="stable")
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    bounds = np.cumsum([0] + [g.size for g in groups])
+    return times[order], [where[a:b] for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def train(index, times, period):
+    index = np.sort(index)
+    beat = np.rint((times[index] - times[index[0]]) / period).astype(np.int64)
+    return Train(index, beat, period, np.zeros(index.size, bool))
+
+
+def test_every_second_and_every_third_beat_that_share_ticks_are_one_metronome():
+    """Corpus seed 143: one metronome's ticks were held by a train of every 4th beat
+    and one of every 3rd; they meet on every 12th, both holding that tick, and were
+    counted as two metronomes."""
+    mine = ticks(90)
+    other = ticks(110, beat=60 / 197.7, start=0.12, seed=1)
+    times, (own, _) = indexed(mine, other)
+    k = np.arange(mine.size)
+    fours = train(own[k % 4 == 2], times, 4 * BEAT)
+    threes = train(own[k % 3 == 1], times, 3 * BEAT)
+    assert np.intersect1d(fours.index, threes.index).size >= 7
+    joined, groups = join_fragments(times, [fours, threes], [0, 1])
+    assert len(joined) == 1 and groups == [(0, 1)]
+    one = joined[0]
+    assert set(one.index) == set(fours.index) | set(threes.index)
+    assert one.index.size == np.unique(one.index).size
+    assert abs(one.period / BEAT - 1) < 1e-3
+    # each tick on its own beat of the metronome
+    assert np.array_equal(one.beat, k[(k % 4 == 2) | (k % 3 == 1)] - 1)
+
+
+def test_a_train_whose_ticks_the_other_holds_is_not_a_piece_of_it():
+    """A train of every second beat that holds only ticks of another train adds no beat."""
+    mine = ticks(90)
+    times, (own,) = indexed(mine)
+    whole = train(own, times, BEAT)
+    half = train(own[::2], times, 2 * BEAT)
+    joined, _ = join_fragments(times, [whole, half], [0, 0])
+    assert len(joined) == 2
+
+
+def halves(*, lag=0.026, fainter=6.0, both=True, seed=0):
+    """One limping metronome's ticks, each with a later impact ``lag`` after it and
+    ``fainter`` dB below; train A: the ticks (even beats) and the tocks' later impacts,
+    train B: the tocks and (``both``) the ticks' later impacts. (times, strength, A, B,
+    indices of the true ticks)."""
+    rng = np.random.default_rng(seed)
+    first = ticks(94, seed=seed)
+    later = first + lag + rng.normal(0, 0.05e-3, first.size)
+    times, (true, echo) = indexed(first, later)
+    strength = np.zeros(times.size)
+    strength[echo] = -fainter
+    k = np.arange(first.size)
+    a_index = np.concatenate([true[k % 2 == 0], echo[k % 2 == 1]])
+    a = train(a_index, times, BEAT)
+    if both:
+        b = train(np.concatenate([true[k % 2 == 1], echo[k % 2 == 0]]), times, BEAT)
+    else:
+        b = train(true[k % 2 == 1], times, 2 * BEAT)
+    return times, strength, a, b, true
+
+
+@pytest.mark.parametrize("both", [True, False])
+def test_two_halves_of_one_metronome_each_with_later_impacts_are_one(both):
+    """Corpus seeds 100 (both trains at full tempo, each taking the other kind's later
+    impacts) and 78 (the tocks alone at half the tempo, the other train the ticks and
+    the tocks' later impacts): one metronome counted as two."""
+    times, strength, a, b, true = halves(both=both)
+    joined = join_interleaved(times, strength, [a, b])
+    assert len(joined) == 1
+    one = joined[0]
+    assert np.array_equal(one.index, np.sort(true))
+    assert np.array_equal(one.beat, np.arange(true.size))
+    assert abs(one.period / BEAT - 1) < 1e-3
+
+
+def test_later_impacts_at_two_lags_are_one_metronome():
+    """Corpus seed 65: a tick's second and third impacts, 24 and 34 ms on, taken by turns."""
+    times, strength, a, b, true = halves()
+    late = np.isin(np.arange(times.size), true, invert=True)
+    shift = np.where(late & (np.arange(times.size) % 3 == 0), 0.010, 0.0)
+    moved = times + shift
+    order = np.argsort(moved, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(order.size)
+    a, b = (train(rank[t.index], moved[order], t.period) for t in (a, b))
+    joined = join_interleaved(moved[order], strength[order], [a, b])
+    assert len(joined) == 1 and np.array_equal(joined[0].index, np.sort(rank[true]))
+
+
+@pytest.mark.parametrize(
+    ("case", "kwargs"),
+    [
+        ("as loud", {"fainter": 0.0}),
+        ("lag wanders", {"wander": 2e-3}),
+    ],
+)
+def test_two_metronomes_locked_a_few_milliseconds_apart_stay_two(case, kwargs):
+    """Two metronomes locked 20 ms apart at one tempo, the second's tock 20 ms ahead
+    of the first's: as loud, or with a lag that wanders as real beats jitter, they are
+    two."""
+    rng = np.random.default_rng(5)
+    first = ticks(94)
+    k = np.arange(first.size)
+    second = first + np.where(k % 2, -0.02, 0.02) + rng.normal(0, kwargs.get("wander", 0.0), k.size)
+    times, (i1, i2) = indexed(first, second)
+    strength = np.zeros(times.size)
+    fainter = kwargs.get("fainter", 6.0)
+    strength[i2[k % 2 == 0]] = -fainter  # the later one on ticks ...
+    strength[i1[k % 2 == 1]] = -fainter  # ... and on tocks
+    a, b = train(i1, times, BEAT), train(i2, times, BEAT)
+    assert len(join_interleaved(times, strength, [a, b])) == 2, case
