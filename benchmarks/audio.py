@@ -57,26 +57,14 @@ def simulated(n, duration, folder, seed=4):
 
 
 def speed(folder: Path) -> None:
-    # Simulate in a child process: Linux carries a parent's peak memory into the
-    # children it forks, so this process must stay small for the measurement below.
     subprocess.run([sys.executable, __file__, "--make", str(folder)], check=True)
     path = folder / "sim7_600.wav"
     info = sf.info(str(path))
     print(f"recording: {info.duration:.0f} s, {info.samplerate} Hz, {info.channels} channels")
-    # the peak memory of the command itself, measured inside the fresh process
-    probe = (
-        "import resource, sys; from metrosync.cli import main; code = main(sys.argv[1:]); "
-        "print('maxrss', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr); "
-        "sys.exit(code)"
-    )
-    command = [sys.executable, "-c", probe, "analyze", str(path),
-               "--out", str(folder / "a.nc"), "--plot", str(folder / "a.png")]  # fmt: skip
-    t0 = time.perf_counter()
-    done = subprocess.run(command, check=True, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    peak = int(done.stderr.split("maxrss")[-1].split()[0])
+    wall, _, peak, _ = measured_command(["analyze", str(path), "--out", str(folder / "a.nc"),
+                                         "--plot", str(folder / "a.png")])  # fmt: skip
     print(f"metrosync analyze (fresh process, with --out and --plot): {wall:.2f} s wall, "
-          f"peak memory {peak / 1024:.0f} MiB")  # fmt: skip
+          f"peak memory {peak:.0f} MiB")  # fmt: skip
     times = []
     for _ in range(3):
         t0 = time.perf_counter()
@@ -143,32 +131,39 @@ def corpus_recording(n, seed, folder, duration=40.0, bpms=None, drift=0.1):
     return rec.write(folder / f"corpus{n}_{seed}.wav"), [t.times for t in rec.truth]
 
 
-def timed_analysis(folder: Path) -> None:
-    """Ten minutes of four metronomes through a phone, analysed in a fresh process: wall
-    time, CPU time (user + system of the child) and peak memory."""
+def measured_command(args: list[str]) -> tuple[float, float, float, str]:
+    """``metrosync ARGS`` in a fresh process: (wall s, CPU s, peak memory MiB, stdout).
+
+    The peak is the process's own high-water mark (VmHWM), read inside it at the end.
+    Not `getrusage`'s ru_maxrss: Linux carries the peak of the process that spawned it
+    across exec into that figure, and this benchmark's own process is large by then."""
     import resource
 
-    # made in a child process: Linux carries a parent's peak memory into the children it
-    # forks, and the command's own peak memory is measured below
-    subprocess.run([sys.executable, __file__, "--make-corpus", str(folder)], check=True)
-    path = folder / "corpus4_7.wav"
     probe = (
-        "import resource, sys; from metrosync.cli import main; code = main(sys.argv[1:]); "
-        "print('maxrss', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr); "
-        "sys.exit(code)"
+        "import sys; from metrosync.cli import main; code = main(sys.argv[1:]); "
+        "hwm = [l for l in open('/proc/self/status') if l.startswith('VmHWM')][0]; "
+        "print('peak_kib', hwm.split()[1], file=sys.stderr); sys.exit(code)"
     )
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", probe, "analyze", str(path)], check=True,
+    done = subprocess.run([sys.executable, "-c", probe, *args], check=True,
                           capture_output=True, text=True)  # fmt: skip
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    peak = int(done.stderr.split("maxrss")[-1].split()[0])
-    found = [line.strip() for line in done.stdout.splitlines() if "metronome" in line][:6]
+    peak = int(done.stderr.split("peak_kib")[-1].split()[0]) / 1024
+    return wall, cpu, peak, done.stdout
+
+
+def timed_analysis(folder: Path) -> None:
+    """Ten minutes of four metronomes through a phone, analysed in a fresh process: wall
+    time, CPU time (user + system of the child) and peak memory."""
+    subprocess.run([sys.executable, __file__, "--make-corpus", str(folder)], check=True)
+    wall, cpu, peak, stdout = measured_command(["analyze", str(folder / "corpus4_7.wav")])
+    found = [line.strip() for line in stdout.splitlines() if "metronome" in line][:6]
     print(f"10 min, 4 real-sounding metronomes through a phone: metrosync analyze "
           f"{wall:.1f} s wall, {cpu:.1f} s CPU (fresh process), peak memory "
-          f"{peak / 1024:.0f} MiB")  # fmt: skip
+          f"{peak:.0f} MiB")  # fmt: skip
     print("  " + "\n  ".join(found))
 
 
@@ -215,7 +210,18 @@ def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
         )
 
 
+OPTIONS = ("--accuracy", "--corpus", "--seeds", "--make", "--make-corpus")
+
+
 def main() -> None:
+    if "-h" in sys.argv or "--help" in sys.argv:
+        print(__doc__)
+        return
+    unknown = [a for a in sys.argv[1:] if a.startswith("-") and a not in OPTIONS]
+    if unknown:
+        sys.exit(
+            f"unknown option {unknown[0]!r}; the options are {', '.join(OPTIONS[:3])} (see --help)"
+        )
     if sys.argv[1:2] == ["--make"]:
         simulated(7, 600.0, Path(sys.argv[2]))
         return
