@@ -135,3 +135,49 @@ def test_two_metronomes_locked_a_few_milliseconds_apart_stay_two(case, kwargs):
     strength[i1[k % 2 == 1]] = -fainter  # ... and on tocks
     a, b = train(i1, times, BEAT), train(i2, times, BEAT)
     assert len(join_interleaved(times, strength, [a, b])) == 2, case
+
+
+def test_a_quarter_tempo_train_of_tocks_and_a_train_of_the_rest_are_one():
+    """Corpus seed 165: one metronome's every other tock (others hid the rest from the
+    tracker) at a quarter of its tempo, and a train of its ticks, the tocks between and
+    the later impacts of the quarter train's tocks: counted as two metronomes."""
+    times, strength, a, _, true = halves()
+    k = np.arange(true.size)
+    # the later impacts of the tocks of beats 4j + 1 that a took; a keeps its ticks and
+    # takes the tocks of beats 4j + 3 as they are
+    echo_of = {
+        int(i): int(e)
+        for i, e in zip(true, np.sort(np.setdiff1d(np.arange(times.size), true)), strict=True)
+    }
+    quarter = true[k % 4 == 1]
+    rest = np.concatenate([true[k % 4 != 1], [echo_of[int(i)] for i in quarter]])
+    joined = join_interleaved(
+        times, strength, [train(rest, times, BEAT), train(quarter, times, 4 * BEAT)]
+    )
+    assert len(joined) == 1
+    assert np.array_equal(joined[0].index, np.sort(true))
+    assert np.array_equal(joined[0].beat, np.arange(true.size))
+
+
+def test_a_train_of_later_impacts_seen_once_its_metronome_is_complete_is_no_ticks():
+    """Corpus seed 151: a train of the later impact (30 ms on) of every other tick of one
+    metronome, found only after recovery completed that metronome's train, was a
+    metronome of half its tempo. It is folded, and its sounds are not ticks."""
+    from metrosync.audio.dataset import _later_impacts_folded
+    from metrosync.audio.detection import Ticks
+
+    rng = np.random.default_rng(151)
+    first = ticks(90, seed=151)
+    later = first[::2] + 0.030 + rng.normal(0, 0.05e-3, first[::2].size)
+    other = ticks(100, beat=60 / 149.2, start=0.28, seed=152)
+    times, (own, echo, theirs) = indexed(first, later, other)
+    strength = np.full(times.size, -10.0)
+    strength[echo] = -20.0
+    heard = Ticks(times, strength, strength[:, None], np.full(times.size, 12.0))
+    trains = [train(own, times, BEAT), train(echo, times, 2 * BEAT),
+              train(theirs, times, 60 / 149.2)]  # fmt: skip
+    kept_ticks, kept = _later_impacts_folded(heard, trains)
+    assert len(kept) == 2
+    assert kept_ticks.time.size == times.size - echo.size
+    assert np.array_equal(kept_ticks.time[kept[0].index], times[np.sort(own)])
+    assert np.array_equal(kept_ticks.time[kept[1].index], times[np.sort(theirs)])

@@ -60,7 +60,7 @@ from .separation import separate, sureness, tick_length_words
 from .subdivision import subdivided
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
-from .trains import Train, holders, off_the_beat
+from .trains import Train, fold_parts, holders, off_the_beat
 
 #: Default refractory time, s: impacts closer than this are heard as one. The impacts of
 #: one tick are grouped afterwards, from the recording's own tick structure.
@@ -147,6 +147,7 @@ def analyze_audio(
     trains = subdivided(ticks.time, trains)
     trains = join_interleaved(ticks.time, ticks.strength, trains)
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
+    ticks, trains = _later_impacts_folded(ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
     trains, behind = _told_apart(ticks, trains)
     if trains and not behind:
@@ -323,6 +324,23 @@ def _told_apart(ticks, trains: list[Train]) -> tuple[list[Train], dict]:
     behind = {"metronomes": count, "bpm": 60.0 / period, "clusters": clusters, "r": r,
               "ticks": int(rest.size), "per_beat": per_beat}  # fmt: skip
     return kept, behind
+
+
+def _later_impacts_folded(ticks, trains: list[Train]):
+    """(ticks, trains) less each train of another's later impacts (`trains.fold_parts`)
+    that only shows as one once recovery has completed the train it follows (pieces
+    of it, at a quarter of the tempo, were joined after the parts were folded): its
+    ticks are not ticks."""
+    kept, _, folded = fold_parts(ticks.time, trains, [0] * len(trains), ticks.strength)
+    if not folded:
+        return ticks, trains
+    keep = np.ones(ticks.time.size, dtype=bool)
+    keep[np.concatenate(folded)] = False
+    for t in kept:
+        keep[t.index] = True  # a tick a metronome holds stays
+    where = np.cumsum(keep) - 1
+    ticks = det.Ticks(*(getattr(ticks, f)[keep] for f in det.Ticks.__dataclass_fields__))
+    return ticks, [replace(t, index=where[t.index]) for t in kept]
 
 
 def _retimed(recording, scan, ticks, trains: list[Train]):

@@ -7,14 +7,15 @@ pair joined.
 A tick is several impacts: the first and, 15–35 ms later, fainter ones (`trains`). The
 tracker can follow a metronome's ticks and take, on the beats between, the later
 impact of each tock: a train at the metronome's own tempo with a steady limp. A second
-train then holds the tocks, alone (at half the tempo) or with the ticks' later
-impacts. Neither is wrong to the tracker; together they are one metronome counted as
-two, each half followed on the wrong impact.
+train then holds the tocks, alone (at half the tempo, or a quarter where others hid
+every other one) or with the ticks' later impacts. Neither is wrong to the tracker;
+together they are one metronome counted as two, each half followed on the wrong
+impact.
 
 Two trains A and B are joined when, on their common beat (the shorter period; the
-other within 1 % of it or of twice it), their ticks put together make pairs closer
-than `trains.MAX_TICK_LENGTH`, each a tick of one train followed by one of the other,
-and
+other within 1 % of it or of a whole multiple of it up to `MAX_MULTIPLE`), their
+ticks put together make pairs closer than `trains.MAX_TICK_LENGTH`, each a tick of one
+train followed by one of the other, and
 
 * there are pairs for at least `MIN_PAIRED` of the smaller train's ticks;
 * the later tick of a pair is `trains.LATER_FAINTER` dB fainter (median over pairs);
@@ -37,6 +38,9 @@ import numpy as np
 
 from .trains import LATER_FAINTER, MAX_TICK_LENGTH, PART_LAG_SPREAD, Train, robust_spread
 
+#: Largest multiple of the common beat a train's period may be: a train of every 4th
+#: beat holds ticks of one kind only, like one of every 2nd.
+MAX_MULTIPLE = 4
 #: Least share of the smaller train's ticks paired with a later impact in the other.
 MIN_PAIRED = 0.25
 #: Least share of the pairs whose lags keep still (in one or two modes).
@@ -73,7 +77,7 @@ def _interleaved(times, strength, ta: Train, tb: Train) -> Train | None:
     beat = min(ta.period, tb.period)
     for period in (ta.period, tb.period):
         k = round(period / beat)
-        if k not in (1, 2) or abs(period / (k * beat) - 1) > 0.01:
+        if not 1 <= k <= MAX_MULTIPLE or abs(period / (k * beat) - 1) > 0.01:
             return None
     index = np.union1d(ta.index, tb.index)  # the ticks are sorted by time
     in_a, in_b = np.isin(index, ta.index), np.isin(index, tb.index)
