@@ -235,3 +235,25 @@ def test_dry_friction_on_a_platform_of_several_coordinates_is_refused(rng, rando
     sys = with_coordinates(random_system(), rng, 2)
     with pytest.raises(ParameterError, match="dry_friction"):
         replace(sys, dry_friction=np.full(sys.shape[0], 0.01))
+
+
+def test_one_coordinate_with_levers_that_differ_obeys_the_coulomb_law(rng, random_system):
+    """The P × P solve of one coordinate takes φ̇ per run too, and dry friction."""
+    for _ in range(10):
+        sys = with_features(random_system(), rng)
+        lever = sys.lever * rng.uniform(0.5, 1.5, sys.lever.shape)
+        sys = replace(sys, lever=lever)
+        assert sys.one_coordinate() is None
+        theta = rng.uniform(-np.pi, np.pi, sys.shape)
+        theta_dot = rng.normal(0, 5, sys.shape)
+        phi_dot = np.where(rng.random(4) < 0.5, 0.0, rng.normal(0, 1, 4))
+        kick = rng.choice([-1.0, 0.0, 1.0], sys.shape) * sys.drive / 0.01
+        phi_ddot, theta_ddot = accelerations(sys, theta, theta_dot, phi_dot, kick, 1.0)
+        assert phi_ddot.shape == phi_dot.shape
+        again = accelerations(sys, theta, theta_dot, phi_dot[:, None], kick, 1.0)[0]
+        np.testing.assert_array_equal(again[:, 0], phi_ddot)
+        disk, pendulum = residuals(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, 1.0)
+        assert disk.shape == phi_dot.shape
+        scale = np.abs(kick).max() + 1.0
+        np.testing.assert_allclose(disk, 0, atol=1e-12 * scale)
+        np.testing.assert_allclose(pendulum, 0, atol=1e-12 * scale)

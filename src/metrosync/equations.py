@@ -109,7 +109,11 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, 
     D(θ) φ̈ = rhs (`_coordinates`)."""
     flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
     if flat is None:
-        return _coordinates(sys, theta, theta_dot, _with_axis(phi_dot, per_run), kick, t, friction)
+        if friction is not None:
+            friction = _with_axis(friction, per_run)
+        phi_dot = _with_axis(phi_dot, per_run)
+        phi_ddot, theta_ddot = _coordinates(sys, theta, theta_dot, phi_dot, kick, t, friction)
+        return (phi_ddot[..., 0] if per_run else phi_ddot), theta_ddot
     phi_dot = phi_dot if per_run else phi_dot[..., 0]
     if friction is not None and not per_run:
         friction = friction[..., 0]
@@ -151,7 +155,8 @@ def holding_torque(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
     minus everything else in the numerator of eq. (eqm1), N m, shaped as ``phi_dot``."""
     flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
     if flat is None:
-        return -_platform_equation(sys, theta, theta_dot, _with_axis(phi_dot, per_run), kick, t)[0]
+        rhs = _platform_equation(sys, theta, theta_dot, _with_axis(phi_dot, per_run), kick, t)[0]
+        return -(rhs[..., 0] if per_run else rhs)
     phi_dot = phi_dot if per_run else phi_dot[..., 0]
     holding = -_disk_equation(flat, theta, theta_dot, phi_dot, kick, t)[0]
     return holding if per_run else holding[..., None]
@@ -217,7 +222,7 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     """
     flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
     if flat is None:
-        return _coordinate_residuals(
+        disk, pendulum = _coordinate_residuals(
             sys,
             theta,
             theta_dot,
@@ -227,6 +232,7 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
             theta_ddot,
             t,
         )
+        return (disk[..., 0] if per_run else disk), pendulum
     if not per_run:
         phi_dot, phi_ddot = phi_dot[..., 0], phi_ddot[..., 0]
     disk, pendulum = _one_residuals(flat, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t)
