@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._words import plural
+from .equations import effective_inertia
 from .errors import ParameterError, describe
 from .groups import Group, as_groups, group_bounds
 from .model import (
@@ -291,11 +292,16 @@ def damping_rate(system) -> float:
     """The fastest viscous damping rate c/D₀ of a platform in ``system`` (`SystemArrays`),
     1/s, D₀ the coefficient of φ̈ in eq. (eqm1) with the pendulums hanging; 0 when
     every platform is held."""
-    free = ~np.isinf(system.total_inertia)
+    flat = system.one_coordinate()
+    if flat is None:  # several coordinates: each coordinate's damping by its D₀'s diagonal
+        d0 = np.diagonal(effective_inertia(system, np.zeros(system.shape)), axis1=1, axis2=2)
+        free = ~np.isinf(d0)
+        return float(np.max(system.c_phi[free] / d0[free])) if free.any() else 0.0
+    free = ~np.isinf(flat.total_inertia)
     if not free.any():
         return 0.0
-    d0 = system.total_inertia - system.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
-    return float(np.max(system.c_phi[free] / d0[free]))
+    d0 = flat.total_inertia - flat.lever**2 * np.sum(system.mh**2 / system.inertia, axis=-1)
+    return float(np.max(flat.c_phi[free] / d0[free]))
 
 
 def check_damping_step(dt: float, ensemble: Ensemble) -> None:

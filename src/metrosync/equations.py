@@ -29,6 +29,22 @@ T = 0 every result is the frictionless one, bit for bit. `accelerations` applies
 law at the given φ̇ unless it is handed the friction torque (``friction=``), as a
 time-stepping scheme or an event-driven integrator does; `effective_inertia` is the
 denominator D, by which an extra torque on the disk divides into φ̈.
+
+A platform of P coordinates. The platform is P generalized coordinates φ (P = 1 for
+the disk and the board); metronome i's pivot moves by ℓ_i·φ along its swing (the
+lever ℓ_i, a P-vector). The equations are then
+
+    I_i θ̈_i = 𝕄_i − m_i h_i cos θ_i (ℓ_i·φ̈) − m_i g h_i sin θ_i − c_θ θ̇_i
+    M φ̈ + Σ_i m_i h_i ℓ_i (cos θ_i θ̈_i − sin θ_i θ̇_i²) = F
+
+with M = J_p + Σ_i m_i ℓ_i ℓ_iᵀ (``total_inertia``) and F the generalized forces from
+outside the pendulums (`disk_torque`: damping, the escapement's reaction and the
+applied drive on each coordinate). Eliminating θ̈ gives D(θ) φ̈ = rhs with
+D = M − Σ_i (m_i h_i cos θ_i)²/I_i ℓ_i ℓ_iᵀ (`effective_inertia`), solved as a P × P
+system; for one coordinate with one lever for every metronome it is eq. (eqm1),
+evaluated by the paper's division with the operations in the same order as ever.
+φ̇ and φ̈ are (B, P); a one-coordinate φ̇ may also be given per run, (B,), and φ̈
+comes back so. Dry friction is a law of one coordinate.
 """
 
 from __future__ import annotations
@@ -51,15 +67,24 @@ __all__ = [
 
 
 def applied_torque(sys: SystemArrays, t) -> np.ndarray:
-    """External torque τ(t) = A sin(Ω t) on the disk (N m), (B,); 0 where A = 0."""
-    return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)
+    """External torque τ(t) = A sin(Ω t) on the disk (N m), on each of the platform's
+    coordinates, (B, P); 0 where A = 0."""
+    if np.ndim(sys.forcing_amplitude) == 1:  # one coordinate, per run
+        return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)
+    return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)[..., None]
 
 
 def disk_torque(sys: SystemArrays, phi_dot, kick, t=0.0):
-    """Torque on the disk from outside the pendulums' swing, (B,): bearing friction,
-    the escapement's reaction (times ``escapement_reaction``, 1 or 0) and the applied
+    """Torque on the disk from outside the pendulums' swing, shaped as ``phi_dot``
+    ((B, P), or (B,) for one coordinate given per run): bearing friction, the
+    escapement's reaction (times ``escapement_reaction``, 1 or 0) and the applied
     torque, −c_φ φ̇ − Σ𝕄_i + τ(t)."""
-    reaction = sys.escapement_reaction * np.sum(kick, axis=-1)
+    if np.ndim(sys.lever) == 1:  # constants per run (`SystemArrays.one_coordinate`)
+        reaction = sys.escapement_reaction * np.sum(kick, axis=-1)
+        return -sys.c_phi * phi_dot - reaction + applied_torque(sys, t)
+    if _per_run(kick, phi_dot):
+        return disk_torque(sys, np.asarray(phi_dot)[..., None], kick, t)[..., 0]
+    reaction = sys.escapement_reaction * np.sum(kick, axis=-1)[..., None]
     return -sys.c_phi * phi_dot - reaction + applied_torque(sys, t)
 
 
@@ -76,7 +101,28 @@ def escapement(sys: SystemArrays, theta, theta_next) -> np.ndarray:
 
 
 def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, friction=None):
-    """Solved equations of motion, eqs. (eqm1)–(eqm2).
+    """Solved equations of motion, eqs. (eqm1)–(eqm2), for a platform of P coordinates.
+
+    ``phi_dot`` is (B, P), or (B,) for a one-coordinate platform given per run; φ̈ and
+    ``friction`` have its shape. A one-coordinate platform whose metronomes share one
+    lever is solved by the paper's division (`_one_coordinate`); any other by solving
+    D(θ) φ̈ = rhs (`_coordinates`)."""
+    flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
+    if flat is None:
+        if friction is not None:
+            friction = _with_axis(friction, per_run)
+        phi_dot = _with_axis(phi_dot, per_run)
+        phi_ddot, theta_ddot = _coordinates(sys, theta, theta_dot, phi_dot, kick, t, friction)
+        return (phi_ddot[..., 0] if per_run else phi_ddot), theta_ddot
+    phi_dot = phi_dot if per_run else phi_dot[..., 0]
+    if friction is not None and not per_run:
+        friction = friction[..., 0]
+    phi_ddot, theta_ddot = _one_coordinate(flat, theta, theta_dot, phi_dot, kick, t, friction)
+    return (phi_ddot if per_run else phi_ddot[..., None]), theta_ddot
+
+
+def _one_coordinate(sys, theta, theta_dot, phi_dot, kick, t=0.0, friction=None):
+    """Solved equations of motion, eqs. (eqm1)–(eqm2), one coordinate (constants per run).
 
     Parameters
     ----------
@@ -93,7 +139,7 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, 
     """
     numerator, denominator, sin_t, cos_t = _disk_equation(sys, theta, theta_dot, phi_dot, kick, t)
     if friction is None:
-        friction = dry_friction(sys, phi_dot, -numerator)
+        friction = _coulomb(sys.dry_friction, phi_dot, -numerator)
     phi_ddot = (numerator + friction) / denominator
     theta_ddot = (
         kick
@@ -106,8 +152,14 @@ def accelerations(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0, *, 
 
 def holding_torque(sys: SystemArrays, theta, theta_dot, phi_dot, kick, t=0.0):
     """The dry-friction torque that would keep the disk from accelerating (φ̈ = 0):
-    minus everything else in the numerator of eq. (eqm1), (B,) N m."""
-    return -_disk_equation(sys, theta, theta_dot, phi_dot, kick, t)[0]
+    minus everything else in the numerator of eq. (eqm1), N m, shaped as ``phi_dot``."""
+    flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
+    if flat is None:
+        rhs = _platform_equation(sys, theta, theta_dot, _with_axis(phi_dot, per_run), kick, t)[0]
+        return -(rhs[..., 0] if per_run else rhs)
+    phi_dot = phi_dot if per_run else phi_dot[..., 0]
+    holding = -_disk_equation(flat, theta, theta_dot, phi_dot, kick, t)[0]
+    return holding if per_run else holding[..., None]
 
 
 def dry_friction(sys: SystemArrays, phi_dot, holding):
@@ -118,12 +170,27 @@ def dry_friction(sys: SystemArrays, phi_dot, holding):
     starts to slip the way the other torques push it, against a friction of T.
     """
     limit = sys.dry_friction
+    if np.ndim(phi_dot) > np.ndim(limit):  # per coordinate: the one coordinate's
+        limit = limit[..., None]
+    return _coulomb(limit, phi_dot, holding)
+
+
+def _coulomb(limit, phi_dot, holding):
     return np.where(phi_dot != 0, -limit * np.sign(phi_dot), np.clip(holding, -limit, limit))
 
 
 def effective_inertia(sys: SystemArrays, theta):
-    """D of eq. (eqm1), (B,) kg m²: J + R²Σm − R² Σ_i (m_i h_i cos θ_i)² / I_i. An extra
-    torque ΔF on the disk changes φ̈ by ΔF/D (and each θ̈_i by −R m_i h_i cos θ_i ΔF/(D I_i))."""
+    """D of eq. (eqm1), (B, P, P) kg m²: M − Σ_i (m_i h_i cos θ_i)² / I_i ℓ_i ℓ_iᵀ, for
+    one coordinate J + R²Σm − R² Σ_i (m_i h_i cos θ_i)² / I_i, and (B,) when the
+    constants are given per run (`SystemArrays.one_coordinate`). An extra torque ΔF on
+    the disk changes φ̈ by D⁻¹ΔF (and each θ̈_i by −m_i h_i cos θ_i ℓ_i·D⁻¹ΔF / I_i)."""
+    if isinstance(sys, SystemArrays):
+        flat = sys.one_coordinate()
+        if flat is None:
+            q = sys.mh * np.cos(theta)
+            outer = np.einsum("...n,...np,...nq->...pq", q * q / sys.inertia, sys.lever, sys.lever)
+            return sys.total_inertia - outer
+        return effective_inertia(flat, theta)[..., None, None]
     d_sum = (sys.lever[:, None] * sys.mh) ** 2 / sys.inertia * np.cos(theta) ** 2
     return sys.total_inertia - np.sum(d_sum, axis=-1)
 
@@ -150,9 +217,29 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     with the Coulomb law of its dry friction (`dry_friction`): −T sign φ̇ when it
     moves, −T sign φ̈ when it starts from rest, anything within ±T when it stays at rest.
 
-    Returns (disk residual (B,), pendulum residuals (B, N)); both vanish for
-    accelerations that solve the system.
+    Returns (disk residual shaped as ``phi_dot``, pendulum residuals (B, N)); both
+    vanish for accelerations that solve the system.
     """
+    flat, per_run = _as_flat(sys), _per_run(theta, phi_dot)
+    if flat is None:
+        disk, pendulum = _coordinate_residuals(
+            sys,
+            theta,
+            theta_dot,
+            _with_axis(phi_dot, per_run),
+            kick,
+            _with_axis(phi_ddot, per_run),
+            theta_ddot,
+            t,
+        )
+        return (disk[..., 0] if per_run else disk), pendulum
+    if not per_run:
+        phi_dot, phi_ddot = phi_dot[..., 0], phi_ddot[..., 0]
+    disk, pendulum = _one_residuals(flat, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t)
+    return (disk if per_run else disk[..., None]), pendulum
+
+
+def _one_residuals(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t):
     sin_t = np.sin(theta)
     cos_t = np.cos(theta)
     lever = sys.lever[:, None]
@@ -170,6 +257,83 @@ def residuals(sys: SystemArrays, theta, theta_dot, phi_dot, kick, phi_ddot, thet
     pendulum = (
         sys.inertia * theta_ddot
         + lever * sys.mh * phi_ddot[:, None] * cos_t
+        + sys.mgh * sin_t
+        + sys.c_theta * theta_dot
+        - kick
+    )
+    return needed - allowed, pendulum
+
+
+def _as_flat(sys):
+    """The constants per run of a one-coordinate platform with one lever (they may be
+    given so already), else None."""
+    if np.ndim(sys.lever) == 1:
+        return sys
+    return sys.one_coordinate()
+
+
+def _per_run(theta, phi_dot) -> bool:
+    """Whether ``phi_dot`` is given per run, without the coordinate axis."""
+    return np.ndim(phi_dot) == np.ndim(theta) - 1
+
+
+def _with_axis(value, per_run):
+    return np.asarray(value)[..., None] if per_run else np.asarray(value)
+
+
+def _platform_equation(sys, theta, theta_dot, phi_dot, kick, t):
+    """Right-hand side (without dry friction) and D of D(θ) φ̈ = rhs, P coordinates:
+    rhs = F + Σ_i ℓ_i [m_i h_i θ̇_i² sin θ_i + q_i/I_i (m_i g h_i sin θ_i + c_θ θ̇_i − 𝕄_i)],
+    q_i = m_i h_i cos θ_i, F the torque from outside the pendulums (`disk_torque`)."""
+    sin_t = np.sin(theta)
+    cos_t = np.cos(theta)
+    q = sys.mh * cos_t
+    swing = sys.mh * theta_dot**2 * sin_t + q / sys.inertia * (
+        sys.mgh * sin_t + sys.c_theta * theta_dot - kick
+    )
+    rhs = disk_torque(sys, phi_dot, kick, t) + np.einsum("...np,...n->...p", sys.lever, swing)
+    return rhs, effective_inertia(sys, theta), sin_t, q
+
+
+def _coordinates(sys, theta, theta_dot, phi_dot, kick, t, friction):
+    """φ̈ (B, P) from D(θ) φ̈ = rhs + friction, and θ̈ (B, N); a pinned platform
+    (an infinite inertia) stays still."""
+    rhs, d, sin_t, q = _platform_equation(sys, theta, theta_dot, phi_dot, kick, t)
+    if friction is None:
+        friction = dry_friction(sys, phi_dot, -rhs)
+    rigid = np.any(np.isinf(d), axis=(-2, -1))
+    p = d.shape[-1]
+    solvable = np.where(rigid[..., None, None], np.eye(p), d)
+    solvable = np.where(np.isfinite(solvable), solvable, 1.0)  # a diverged run stays NaN
+    phi_ddot = np.linalg.solve(solvable, (rhs + friction)[..., None])[..., 0]
+    finite = np.all(np.isfinite(d), axis=(-2, -1)) | rigid
+    phi_ddot = np.where(rigid[..., None], 0.0, np.where(finite[..., None], phi_ddot, np.nan))
+    along = np.einsum("...np,...p->...n", sys.lever, phi_ddot)
+    theta_ddot = (kick - q * along - sys.mgh * sin_t - sys.c_theta * theta_dot) / sys.inertia
+    return phi_ddot, theta_ddot
+
+
+def _coordinate_residuals(sys, theta, theta_dot, phi_dot, kick, phi_ddot, theta_ddot, t):
+    """`residuals` for P coordinates: M φ̈ + Σ_i ℓ_i m_i h_i (θ̈_i cos θ_i − θ̇_i² sin θ_i)
+    − F, less the friction the Coulomb law allows, and the pendulums' residuals."""
+    sin_t = np.sin(theta)
+    cos_t = np.cos(theta)
+    swing = sys.mh * (theta_ddot * cos_t - theta_dot**2 * sin_t)
+    needed = (
+        np.einsum("...pq,...q->...p", sys.total_inertia, phi_ddot)
+        + np.einsum("...np,...n->...p", sys.lever, swing)
+        - disk_torque(sys, phi_dot, kick, t)
+    )
+    limit = sys.dry_friction[..., None]
+    allowed = np.where(
+        phi_dot != 0,
+        -limit * np.sign(phi_dot),
+        np.where(phi_ddot != 0, -limit * np.sign(phi_ddot), np.clip(needed, -limit, limit)),
+    )
+    along = np.einsum("...np,...p->...n", sys.lever, phi_ddot)
+    pendulum = (
+        sys.inertia * theta_ddot
+        + sys.mh * along * cos_t
         + sys.mgh * sin_t
         + sys.c_theta * theta_dot
         - kick

@@ -28,7 +28,7 @@ def run(advance, ens, steps, dt=DT):
     )  # fmt: skip
     advance(state, ens.system, dt=dt, step0=0, n_steps=steps, record_every=1,
             overturn_angle=math.pi / 2)  # fmt: skip
-    return state
+    return state.one_coordinate()  # the disk's state per run
 
 
 def ensemble(changes, runs=3, n=3, seed=5):
@@ -46,7 +46,9 @@ def test_below_the_threshold_the_disk_does_not_move(backend):
     assert np.all(got.traj_phi_dot == 0.0) and np.all(got.traj_phi == 0.0)
     assert np.all(got.phi_dot == 0.0) and np.all(got.acc_phi == 0.0)
     # The disk's angular momentum is that of a disk at rest, R Σ m h cos θ θ̇.
-    coupling = held.system.lever * np.sum(held.system.mh * np.cos(got.theta) * got.theta_dot, 1)
+    coupling = held.system.one_coordinate().lever * np.sum(
+        held.system.mh * np.cos(got.theta) * got.theta_dot, 1
+    )
     np.testing.assert_allclose(got.p_phi, coupling, rtol=1e-13, atol=1e-18)
     # The pendulums move exactly as on a rigid support.
     rigid = run(BACKENDS[backend], pinned, 2000)
@@ -139,7 +141,7 @@ def test_scalar_friction_law_equals_the_vectorised_one(rng, random_system):
                            theta_dot[b, i])[2]
             for i in range(3)
         )  # fmt: skip
-        others = -sys.c_phi[b] * phi_dot[b] - kick[b].sum()
+        others = -sys.one_coordinate().c_phi[b] * phi_dot[b] - kick[b].sum()
         got, held = disk_friction(c, b, phi_dot[b], sum_num, others)
         assert got == pytest.approx(want[b], rel=1e-10, abs=1e-16)
         assert held == (phi_dot[b] == 0 and abs(holding[b]) <= sys.dry_friction[b])
@@ -160,12 +162,14 @@ def test_friction_at_a_stop_brings_the_step_to_rest(rng, random_system):
     p_phi, force_prev = rng.normal(0, 1e-3, 6), rng.normal(0, 1e-3, 6)
     acc = rng.normal(0, 1, sys.shape)
 
+    flat = sys.one_coordinate()  # the disk's constants per run
+
     def end_velocity(friction):
         _, thdd = accelerations(sys, theta, theta_dot, phi_dot, no_kick, friction=friction)
         new_theta_dot = theta_dot + 0.5 * (acc + thdd) * DT
-        p = p_phi + 0.5 * (force_prev - sys.c_phi * phi_dot + friction) * DT
-        coupling = sys.lever * np.sum(sys.mh * np.cos(theta) * new_theta_dot, axis=1)
-        return (p - coupling) / sys.total_inertia
+        p = p_phi + 0.5 * (force_prev - flat.c_phi * phi_dot + friction) * DT
+        coupling = flat.lever * np.sum(sys.mh * np.cos(theta) * new_theta_dot, axis=1)
+        return (p - coupling) / flat.total_inertia
 
     start = -1e-3 * np.sign(phi_dot)
     c = constants_of(sys)

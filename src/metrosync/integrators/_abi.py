@@ -4,12 +4,15 @@ Every CPU layout and the GPU kernel is called as ``advance(state, constants, set
 recording)``; numba compiles a NamedTuple of arrays as a plain struct, so this costs
 nothing over positional arguments.
 
-``State``      what a step changes, (B, N) and (B,) arrays, updated in place.
+``State``      what a step changes, (B, N) and (B,) arrays, updated in place: the
+               platform's (B, P) state seen as its one coordinate (views, so that the
+               kernels' writes land in `StepState`; `StepState.kernel_state`).
 ``Constants``  every field of `SystemArrays` (so a new model constant reaches the
                kernels without touching this file), plus what each step reuses:
                ``inv_inertia`` = 1/(m h² + J_i). Nothing here depends on the step:
                a scheme makes its own use of ``drive`` (`layouts`). Per-metronome
-               fields are (B, N), per-run fields (B,); a layout may rearrange them
+               fields are (B, N), per-run fields (B,), the platform's too (the kernels
+               run one coordinate, `one_coordinate`); a layout may rearrange them
                (`layout_runs.arrange`), never rename them.
 ``Settings``   the scalars of one call: step, first step, step count, record spacing,
                overturn angle.
@@ -33,6 +36,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..capabilities import UnsupportedFeature
 from ..model.system import SystemArrays
 
 
@@ -84,11 +88,32 @@ class Recording(NamedTuple):
 
 
 def constants_of(sys: SystemArrays):
-    """The kernels' `Constants`: C-contiguous float arrays."""
-    arrays = {f.name: np.ascontiguousarray(getattr(sys, f.name), dtype=float) for f in fields(sys)}
+    """The kernels' `Constants`: C-contiguous float arrays, the platform's per run (the
+    kernels run a platform of one coordinate, `SystemArrays.one_coordinate`)."""
+    flat = one_coordinate(sys)
+    arrays = {
+        f.name: np.ascontiguousarray(getattr(flat, f.name), dtype=float)
+        for f in fields(SystemArrays)
+    }
     # The same expression as the NumPy twin (1/I is exact to rounding).
     arrays["inv_inertia"] = 1.0 / arrays["inertia"]
     return Constants(**arrays)
+
+
+def one_coordinate(sys: SystemArrays):
+    """``sys`` with the platform's constants per run (`SystemArrays.one_coordinate`);
+    `UnsupportedFeature` for a platform the kernels do not run: one of more than one
+    coordinate, or whose metronomes' levers differ."""
+    flat = sys.one_coordinate()
+    if flat is None:
+        raise UnsupportedFeature(
+            f"`platform` with {sys.coordinates} coordinates: the compiled kernels have "
+            "a platform of one coordinate only (the disk, the board); use backend='numpy' "
+            "or integrator='exact'.",
+            feature="platform-coordinates",
+            consumer="compiled kernels",
+        )
+    return flat
 
 
 def settings_of(*, dt, step0, n_steps, record_every, overturn_angle) -> Settings:

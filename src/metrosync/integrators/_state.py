@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..capabilities import UnsupportedFeature
 from ..equations import SystemArrays, accelerations, disk_torque, dry_friction, holding_torque
 from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
@@ -25,10 +26,12 @@ class StepState:
     (``step_state.theta`` is ``step_state.state.theta``).
 
     theta, theta_dot, acc_theta : (B, N)
-    phi, phi_dot, acc_phi : (B,)
-    p_phi : (B,) the disk's angular momentum (J + R²Σm) φ̇ + R Σ m h cos θ θ̇, carried as
-        state so that it changes only by the external torque impulse.
-    force_phi : (B,) torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄 + τ(t)
+    phi, phi_dot, acc_phi : (B, P), the platform's P coordinates (P = 1: the disk, the
+        board).
+    p_phi : (B, P) the platform's momentum M φ̇ + Σ_i ℓ_i m_i h_i cos θ_i θ̇_i (for the
+        disk (J + R²Σm) φ̇ + R Σ m h cos θ θ̇), carried as state so that it changes only
+        by the external torque impulse.
+    force_phi : (B, P) torque on the disk at the last evaluation, −c_φ φ̇ − Σ𝕄 + τ(t)
         (`equations.disk_torque`) plus the dry friction (`equations.dry_friction`).
     last_up : (B, N) time of the last upward zero crossing, −1 before the first.
     status : (B,) int8 bit flags.
@@ -39,7 +42,8 @@ class StepState:
     r : (B, n_rec) analytic-phase order parameter at each record.
     cross_re, cross_im, cross_count : (B, n_rec, G) running sums of e^{iΦ} over each
         group's metronomes whose crossing-interpolated phase Φ is known at each record.
-    traj_* : trajectories (B, n_rec, N) and (B, n_rec), or (0, 0, 0) placeholders.
+    traj_* : trajectories (B, n_rec, N) and, of the platform, (B, n_rec, P), or
+        (0, 0, 0) placeholders.
     r_group : (B, n_rec, G) each group's analytic-phase r, or a (0, 0, 0) placeholder
         for a single group (its r is ``r``).
     group_start : (G + 1,) group g is metronomes group_start[g] .. group_start[g+1]-1.
@@ -70,16 +74,18 @@ class StepState:
         group_start: np.ndarray | None = None,
     ) -> StepState:
         """The state at t = 0 and empty records; ``group_start`` bounds the groups
-        (default: all N metronomes one group)."""
+        (default: all N metronomes one group). ``phi0`` and ``phi_dot0`` are (B, P), or
+        (B,) for every coordinate alike."""
         b, n = theta0.shape
+        p = sys.coordinates
         bounds = np.array([0, n] if group_start is None else group_start, dtype=np.int64)
         if bounds[0] != 0 or bounds[-1] != n or np.any(np.diff(bounds) < 1):
             raise ValueError(f"group_start {bounds} does not split {n} metronomes into groups")
         n_groups = bounds.size - 1
         theta = np.array(theta0, dtype=float, order="C")
         theta_dot = np.array(theta_dot0, dtype=float, order="C")
-        phi_dot = np.array(phi_dot0, dtype=float)
-        rigid = np.isinf(sys.total_inertia)
+        phi_dot = _coordinates(phi_dot0, b, p)
+        rigid = np.any(np.isinf(sys.total_inertia), axis=(1, 2))
         phi_dot[rigid] = 0.0
         no_kick = np.zeros_like(theta)
         # A run may diverge from its very start; it is flagged, not raised.
@@ -87,13 +93,14 @@ class StepState:
             acc_phi, acc_theta = accelerations(sys, theta, theta_dot, phi_dot, no_kick)
             p_phi = platform_momentum(sys, theta, theta_dot, phi_dot)
             holding = holding_torque(sys, theta, theta_dot, phi_dot, no_kick)
-            friction = np.where(rigid, 0.0, dry_friction(sys, phi_dot, holding))
-        finite = np.isfinite(acc_phi) & np.all(np.isfinite(acc_theta), axis=1)
+            friction = np.where(rigid[:, None], 0.0, dry_friction(sys, phi_dot, holding))
+        finite = np.all(np.isfinite(acc_phi), axis=1) & np.all(np.isfinite(acc_theta), axis=1)
         traj_shape = (b, n_records, n) if trajectories else (0, 0, 0)
+        platform_shape = (b, n_records, p) if trajectories else (0, 0, p)
         state = State(
             theta=theta,
             theta_dot=theta_dot,
-            phi=np.array(phi0, dtype=float),
+            phi=_coordinates(phi0, b, p),
             phi_dot=phi_dot,
             acc_theta=np.ascontiguousarray(acc_theta),
             acc_phi=np.ascontiguousarray(acc_phi),
@@ -111,20 +118,47 @@ class StepState:
             cross_count=np.zeros((b, n_records, n_groups), dtype=np.int32),
             traj_theta=np.full(traj_shape, np.nan),
             traj_theta_dot=np.full(traj_shape, np.nan),
-            traj_phi=np.full(traj_shape[:2], np.nan),
-            traj_phi_dot=np.full(traj_shape[:2], np.nan),
+            traj_phi=np.full(platform_shape, np.nan),
+            traj_phi_dot=np.full(platform_shape, np.nan),
             r_group=np.full((b, n_records, n_groups) if n_groups > 1 else (0, 0, 0), np.nan),
             group_start=bounds,
         )
         return cls(state, recording)
 
+    @property
+    def coordinates(self) -> int:
+        """P, the number of the platform's coordinates."""
+        return self.state.phi.shape[1]
+
     def kernel_state(self) -> State:
-        """The state arrays as the kernels take them (the same arrays, not copies)."""
-        return self.state
+        """The state arrays as the kernels take them: the same arrays, not copies, the
+        platform's seen as its one coordinate, (B,) views of the (B, 1) arrays.
+        `UnsupportedFeature` for a platform of more than one coordinate."""
+        self._one_coordinate()
+        s = self.state
+        return s._replace(**{name: getattr(s, name)[:, 0] for name in PLATFORM_STATE})
 
     def kernel_recording(self) -> Recording:
-        """The record buffers as the kernels take them (the same arrays)."""
-        return self.recording
+        """The record buffers as the kernels take them (the same arrays; the platform's
+        trajectories (B, n_rec) views)."""
+        self._one_coordinate()
+        r = self.recording
+        return r._replace(traj_phi=r.traj_phi[:, :, 0], traj_phi_dot=r.traj_phi_dot[:, :, 0])
+
+    def one_coordinate(self) -> StepState:
+        """This state as the kernels see it (`kernel_state`, `kernel_recording`), for a
+        scheme written for one coordinate: the same arrays."""
+        return StepState(self.kernel_state(), self.kernel_recording())
+
+    def _one_coordinate(self) -> None:
+        if self.coordinates != 1:
+            raise UnsupportedFeature(
+                f"`platform` with {self.coordinates} coordinates: the compiled kernels "
+                "have a platform of one coordinate only (the disk, the board); use "
+                "backend='numpy' or integrator='exact'.",
+                feature="platform-coordinates",
+                consumer="compiled kernels",
+            )
 
     def crossing_order(self) -> np.ndarray:
         """r from crossing-interpolated phases, (B, n_rec); NaN where some metronome
@@ -156,6 +190,7 @@ class Records:
     status: np.ndarray
     theta: np.ndarray | None = None
     theta_dot: np.ndarray | None = None
+    #: (B, n_rec) for a platform of one coordinate, (B, n_rec, P) for more.
     phi: np.ndarray | None = None
     phi_dot: np.ndarray | None = None
     #: per run, N lists of upward-crossing times (integrators that keep them all).
@@ -169,6 +204,26 @@ class Records:
     rest_time: np.ndarray | None = None
 
 
+#: The platform's fields of `State`, (B, P).
+PLATFORM_STATE = ("phi", "phi_dot", "acc_phi", "p_phi", "force_phi")
+
+
+def _coordinates(value, runs: int, p: int) -> np.ndarray:
+    """A (B, P) float array (a copy) of ``value``, (B, P) or (B,) for every coordinate."""
+    value = np.asarray(value, dtype=float)
+    if value.ndim == 1:
+        value = value[:, None]
+    return np.array(np.broadcast_to(value, (runs, p)), dtype=float)
+
+
+def platform_records(value: np.ndarray | None) -> np.ndarray | None:
+    """The platform's trajectory as records keep it: (B, n_rec) for one coordinate
+    (as it always was), (B, n_rec, P) for more."""
+    if value is None or value.shape[-1] > 1:
+        return value
+    return value[..., 0]
+
+
 def records_of(state: StepState) -> Records:
     traj = state.traj_theta.shape[0] > 0
     r_crossing = state.crossing_order()
@@ -179,8 +234,8 @@ def records_of(state: StepState) -> Records:
         status=state.status,
         theta=state.traj_theta if traj else None,
         theta_dot=state.traj_theta_dot if traj else None,
-        phi=state.traj_phi if traj else None,
-        phi_dot=state.traj_phi_dot if traj else None,
+        phi=platform_records(state.traj_phi) if traj else None,
+        phi_dot=platform_records(state.traj_phi_dot) if traj else None,
         # One group: views of the global records, no copies.
         r_group=state.group_order(),
         r_crossing_group=state.group_crossing_order() if grouped else r_crossing[:, :, None],

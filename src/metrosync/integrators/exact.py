@@ -61,8 +61,13 @@ def integrate(
     ``group_start`` bounds the groups of metronomes (default: one group). The records'
     ``rest_time`` is the time the disk was stuck from ``rest_since`` to the end."""
     runs, n = theta0.shape
+    p = sys.coordinates
     grid = np.arange(n_records) * grid_dt
     shape = (runs, n_records)
+    platform = shape if p == 1 else shape + (p,)  # as `_state.platform_records`
+    phi_dot0 = np.asarray(phi_dot0, dtype=float)
+    if phi_dot0.ndim == 1:
+        phi_dot0 = np.broadcast_to(phi_dot0[:, None], (runs, p))
     bounds = [0, n] if group_start is None else [int(k) for k in group_start]
     groups = list(zip(bounds[:-1], bounds[1:], strict=True))
     out = Records(
@@ -71,8 +76,8 @@ def integrate(
         status=np.zeros(runs, dtype=np.int8),
         theta=np.full(shape + (n,), np.nan) if trajectories else None,
         theta_dot=np.full(shape + (n,), np.nan) if trajectories else None,
-        phi=np.full(shape, np.nan) if trajectories else None,
-        phi_dot=np.full(shape, np.nan) if trajectories else None,
+        phi=np.full(platform, np.nan) if trajectories else None,
+        phi_dot=np.full(platform, np.nan) if trajectories else None,
         crossings=[],
         r_group=np.full(shape + (len(groups),), np.nan),
         r_crossing_group=np.full(shape + (len(groups),), np.nan),
@@ -92,7 +97,7 @@ def integrate(
         )
         out.status[b] = status
         out.crossings.append(upcrossings)
-        th, thd = samples[:, 1 : n + 1], samples[:, n + 2 :]
+        th, thd = samples[:, p : n + p], samples[:, n + 2 * p :]
         phase = analytic_phase(th, thd, sys.omega[b])
         out.r[b] = order_parameter(phase)
         out.r_crossing[b] = crossing_order(upcrossings, grid)
@@ -101,26 +106,30 @@ def integrate(
             out.r_crossing_group[b, :, g] = crossing_order(upcrossings[lo:hi], grid)
         if trajectories:
             out.theta[b], out.theta_dot[b] = th, thd
-            out.phi[b], out.phi_dot[b] = samples[:, 0], samples[:, n + 1]
+            phi, phi_dot = samples[:, :p], samples[:, n + p : n + 2 * p]
+            out.phi[b], out.phi_dot[b] = (phi[:, 0], phi_dot[:, 0]) if p == 1 else (phi, phi_dot)
         if on_run_done is not None:
             on_run_done()
     return out
 
 
 def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_angle, rest_since):
-    """One run. Returns grid samples (T, 2N+2) of [φ, θ, φ̇, θ̇], upward-crossing times
+    """One run. Returns grid samples (T, 2N+2P) of [φ, θ, φ̇, θ̇], upward-crossing times
     per metronome, the status bits, each metronome's last impulse time (−1 if none) and
     the time the disk was stuck after ``rest_since``."""
     n = theta0.size
+    p = sys.coordinates
     offset = sys.escapement_offset[0]
     off_zero = np.nonzero(offset != 0.0)[0]  # their zero crossings are not events
     zero_kick = np.zeros((1, n))
-    rigid = bool(np.isinf(sys.total_inertia[0]))
+    rigid = bool(np.any(np.isinf(sys.total_inertia[0])))
     limit = 0.0 if rigid else float(sys.dry_friction[0])
     period = 2 * np.pi / sys.omega.max()
 
     def split(y):
-        return y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
+        # One coordinate: φ̇ per run, (1,), as ever; more: (1, P).
+        phi_dot = y[n + 1 : n + 2] if p == 1 else y[None, n + p : n + 2 * p]
+        return y[None, p : n + p], y[None, n + 2 * p :], phi_dot
 
     def holding(t, y):
         return holding_torque(sys, *split(y), zero_kick, t)
@@ -134,10 +143,11 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     def rhs(t, y, mode):
         th, thd, phd = split(y)
         phdd, thdd = accelerations(sys, th, thd, phd, zero_kick, t, friction=friction(t, y, mode))
-        return np.concatenate(([y[n + 1]], y[n + 2 :], phdd, thdd[0]))
+        return np.concatenate((y[n + p : n + 2 * p], y[n + 2 * p :], np.ravel(phdd), thdd[0]))
 
-    y = np.concatenate(([0.0], theta0, [0.0 if rigid else phi_dot0], theta_dot0))
-    mode = _disk_mode(limit, y[n + 1], holding(0.0, y))
+    still = np.zeros(p)
+    y = np.concatenate((still, theta0, still if rigid else phi_dot0, theta_dot0))
+    mode = _disk_mode(limit, y[n + p], holding(0.0, y))
     samples = np.full((grid.size, y.size), np.nan)
     samples[0] = y
     next_sample = 1
@@ -171,22 +181,22 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
             if solver.status == "failed" or not np.all(np.isfinite(solver.y)):
                 return result(status | STATUS_DIVERGED)
             dense = solver.dense_output()
-            events = _crossings(dense, y_old, solver.y, offset, n)
+            events = _crossings(dense, y_old, solver.y, offset, n, p)
             if limit > 0.0:
-                events += _disk_events(dense, mode, limit, n, holding)
+                events += _disk_events(dense, mode, limit, n + p - 1, holding)
             t_end = solver.t
             event = None
             if events:
                 t_end, event = min(events, key=lambda e: e[0])
             if off_zero.size:  # upward zero crossings that are not events
-                th_old = y_old[1 : n + 1]
-                th_end = solver.y[1 : n + 1] if event is None else dense(t_end)[1 : n + 1]
+                th_old = y_old[p : n + p]
+                th_end = solver.y[p : n + p] if event is None else dense(t_end)[p : n + p]
                 for i in off_zero[(th_old[off_zero] < 0) & (th_end[off_zero] > 0)]:
-                    upcrossings[i].append(_crossing(dense, 1 + i, 0.0, t_end))
+                    upcrossings[i].append(_crossing(dense, p + i, 0.0, t_end))
             while next_sample < grid.size and grid[next_sample] <= t_end:
                 samples[next_sample] = dense(grid[next_sample])
                 next_sample += 1
-            if np.any(np.abs(solver.y[1 : n + 1]) > overturn_angle):
+            if np.any(np.abs(solver.y[p : n + p]) > overturn_angle):
                 status |= STATUS_OVERTURNED
             if event is not None:
                 rest += stuck_for(t, t_end)
@@ -194,16 +204,16 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
                 if event == "break":  # |holding torque| reached T: slip against it
                     mode = -int(np.sign(holding(t_end, y)[0]))
                 elif event == "stop":  # φ̇ reached 0: stick, or slip the other way
-                    y[n + 1] = 0.0
+                    y[n + p] = 0.0
                     mode = _disk_mode(limit, 0.0, holding(t_end, y))
                 else:
-                    y[1 + event] = offset[event]
-                    direction = np.sign(y[n + 2 + event])
+                    y[p + event] = offset[event]
+                    direction = np.sign(y[n + 2 * p + event])
                     if direction > 0 and offset[event] == 0.0:
                         upcrossings[event].append(t_end)
                     y = _apply_impulse(sys, y, n, event, direction, rigid)
                     last_kick[event] = t_end
-                    mode = _disk_mode(limit, y[n + 1], holding(t_end, y))
+                    mode = _disk_mode(limit, y[n + p], holding(t_end, y))
                 t = t_end
                 restarted = True
                 break
@@ -213,11 +223,11 @@ def _integrate_run(sys, theta0, theta_dot0, phi_dot0, grid, duration, overturn_a
     return result(status)
 
 
-def _crossings(dense, y_old, y_new, offset, n):
+def _crossings(dense, y_old, y_new, offset, n, p):
     """(time, pendulum) of each strict crossing of a pendulum's escapement angle in the step."""
-    th_old, th_new = y_old[1 : n + 1] - offset, y_new[1 : n + 1] - offset
+    th_old, th_new = y_old[p : n + p] - offset, y_new[p : n + p] - offset
     return [
-        (_crossing(dense, 1 + i, offset[i], dense.t), int(i))
+        (_crossing(dense, p + i, offset[i], dense.t), int(i))
         for i in np.nonzero(th_old * th_new < 0)[0]
     ]
 
@@ -229,7 +239,8 @@ def _crossing(dense, k, level, t_end):
 
 def _disk_events(dense, mode, limit, n, holding):
     """A dry-friction event in the step, as [(time, "stop" or "break")], or []: a
-    slipping disk's φ̇ reaching 0, a stuck disk's |holding torque| reaching T."""
+    slipping disk's φ̇ reaching 0, a stuck disk's |holding torque| reaching T (φ̇ is
+    component n + 1 of the state: one coordinate)."""
     if mode == 0:
 
         def margin(s):
@@ -262,14 +273,16 @@ def _disk_mode(limit, phi_dot, holding):
 def _apply_impulse(sys, y, n, event, direction, rigid):
     """Jump of the velocities under an impulse M·direction on pendulum ``event``: the
     kick-linear part of eqs. (eqm1)–(eqm2), which is exact for a delta-function torque."""
+    p = sys.coordinates
     impulse = np.zeros((1, n))
     impulse[0, event] = direction * sys.drive[0, event]
-    th, thd, phd = y[None, 1 : n + 1], y[None, n + 2 :], y[n + 1 : n + 2]
+    phd = y[n + 1 : n + 2] if p == 1 else y[None, n + p : n + 2 * p]
+    th, thd = y[None, p : n + p], y[None, n + 2 * p :]
     # Dry friction is bounded, so it takes no part in an impulse.
     no_friction = np.zeros(1)
     with_kick = accelerations(sys, th, thd, phd, impulse, friction=no_friction)
     without = accelerations(sys, th, thd, phd, np.zeros((1, n)), friction=no_friction)
     y = y.copy()
-    y[n + 1] += 0.0 if rigid else (with_kick[0] - without[0])[0]
-    y[n + 2 :] += (with_kick[1] - without[1])[0]
+    y[n + p : n + 2 * p] += 0.0 if rigid else np.ravel(with_kick[0] - without[0])
+    y[n + 2 * p :] += (with_kick[1] - without[1])[0]
     return y

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..capabilities import require
+from ..capabilities import UnsupportedFeature, require
 from ..equations import (
     SystemArrays,
     accelerations,
@@ -66,7 +66,13 @@ class TwinScheme:
     ) -> None:
         """Advance every run by ``n_steps`` steps from step ``step0``, in place."""
         require(f"{self.name}/numpy", sys)
-        step = _Step(sys, self, dt, record_every, overturn_angle, state.r.shape[1])
+        flat = sys.one_coordinate()
+        n_rec = state.r.shape[1]
+        if flat is None:  # a platform of several coordinates
+            step = _CoordinatesStep(sys, self, dt, record_every, overturn_angle, n_rec)
+        else:  # one coordinate: the scheme as the kernels run it, on the same arrays
+            step = _Step(flat, self, dt, record_every, overturn_angle, n_rec, constants_of(sys))
+            state = state.one_coordinate()
         if step0 == 0:
             _record(state, 0, sys.omega, (state.status & STATUS_DIVERGED) == 0)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -77,8 +83,9 @@ class TwinScheme:
 
 @dataclass
 class _Step:
-    """One step of ``scheme`` for every run; what does not change between steps is
-    computed once."""
+    """One step of ``scheme`` for every run, a platform of one coordinate with its
+    constants per run (`SystemArrays.one_coordinate`, the state's `StepState.one_coordinate`);
+    what does not change between steps is computed once."""
 
     sys: SystemArrays
     scheme: TwinScheme
@@ -86,12 +93,12 @@ class _Step:
     record_every: int
     overturn_angle: float
     n_rec: int
+    constants: tuple
 
     def __post_init__(self) -> None:
         sys = self.sys
         self.rigid = np.isinf(sys.total_inertia)
         self.dry = (sys.dry_friction > 0) & ~self.rigid
-        self.constants = constants_of(sys)
         self.grid_dt = self.record_every * self.dt
 
     def __call__(self, state: StepState, s: int) -> bool:
@@ -225,6 +232,79 @@ class _Step:
             shift[b] = disk_acceleration(c, b, sums[b, 2], den[b], sums[b, 3])
             change[b] = disk_acceleration(c, b, sums[b, 4], den[b], 0.0)
         return own, own_change, after, jump, shift, change, np.where(self.rigid, 0.0, sums[:, 1])
+
+
+@dataclass
+class _CoordinatesStep:
+    """One step of ``scheme`` for a platform of P coordinates (`equations`): the same
+    scheme as `_Step` (positions by Taylor, the platform's momentum by the trapezoid
+    of its forces, φ̇ from it), for the escapement as a torque over the step; no dry
+    friction (a law of one coordinate)."""
+
+    sys: SystemArrays
+    scheme: TwinScheme
+    dt: float
+    record_every: int
+    overturn_angle: float
+    n_rec: int
+
+    def __post_init__(self) -> None:
+        if self.scheme.impulsive:
+            raise UnsupportedFeature(
+                f"`platform` with {self.sys.coordinates} coordinates: integrator "
+                f"{self.scheme.name!r} has a platform of one coordinate only; use "
+                "integrator='verlet' (backend='numpy') or integrator='exact'.",
+                feature="platform-coordinates",
+                consumer=f"{self.scheme.name}/numpy",
+            )
+        self.rigid = np.any(np.isinf(self.sys.total_inertia), axis=(1, 2))
+        self.grid_dt = self.record_every * self.dt
+
+    _book_crossings = _Step._book_crossings
+
+    def __call__(self, state: StepState, s: int) -> bool:
+        sys, dt = self.sys, self.dt
+        alive = (state.status & STATUS_DIVERGED) == 0
+        if not alive.any():
+            return False
+        t_old, t_new = s * dt, (s + 1) * dt
+        th, thd, acc = state.theta, state.theta_dot, state.acc_theta
+        th_new = th + thd * dt + 0.5 * acc * (dt * dt)
+        vel_pred = thd + acc * dt
+        phd_pred = state.phi_dot + state.acc_phi * dt
+        phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * (dt * dt)
+        fires = np.where(alive[:, None], escapement(sys, th, th_new), 0.0)
+        torque, _ = self.scheme.begin(sys, fires, dt)
+        state.last_kick[fires != 0.0] = t_new
+        overturned = np.any(np.abs(th_new) > self.overturn_angle, axis=1) & alive
+        state.status[overturned] |= STATUS_OVERTURNED
+        phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, torque, t_new)
+        force = disk_torque(sys, phd_pred, torque, t_new)
+        diverged = ~np.all(np.isfinite(phdd), axis=1) & alive
+        state.status[diverged] |= STATUS_DIVERGED
+        ok = alive & ~diverged
+        self._book_crossings(state, th, th_new, ok, t_old)
+        new_theta_dot = thd + 0.5 * (acc + thdd) * dt
+        new_p = state.p_phi + 0.5 * (state.force_phi + force) * dt
+        q = sys.mh * np.cos(th_new) * new_theta_dot
+        coupling = np.einsum("bnp,bn->bp", sys.lever, q)
+        inertia = np.where(self.rigid[:, None, None], np.eye(sys.coordinates), sys.total_inertia)
+        inertia = np.where(np.isfinite(inertia), inertia, 1.0)
+        new_phi_dot = np.linalg.solve(inertia, (new_p - coupling)[..., None])[..., 0]
+        new_phi_dot[self.rigid] = 0.0
+
+        ok2 = ok[:, None]
+        state.phi[...] = np.where(ok2, phi_new, state.phi)
+        state.theta[...] = np.where(ok2, th_new, th)
+        state.theta_dot[...] = np.where(ok2, new_theta_dot, thd)
+        state.acc_theta[...] = np.where(ok2, thdd, acc)
+        state.p_phi[...] = np.where(ok2 & ~self.rigid[:, None], new_p, state.p_phi)
+        state.phi_dot[...] = np.where(ok2, new_phi_dot, state.phi_dot)
+        state.force_phi[...] = np.where(ok2, force, state.force_phi)
+        state.acc_phi[...] = np.where(ok2, phdd, state.acc_phi)
+        if (s + 1) % self.record_every == 0:
+            _record(state, (s + 1) // self.record_every, sys.omega, ok)
+        return True
 
 
 #: The twins of the two fixed-step schemes.

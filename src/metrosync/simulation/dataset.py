@@ -18,7 +18,9 @@
                                           held at rest by dry friction, only when
                                           ``disk_dry_friction`` is on
     theta, theta_dot (time, run, metronome), phi, phi_dot (time, run)
-                                          trajectories, only when asked for
+                                          trajectories, only when asked for; phi and
+                                          phi_dot (time, run, platform_coordinate) for
+                                          a platform of more than one coordinate
 
 With ``groups`` (`metrosync.groups`), also each group's order parameters, taken over
 its own metronomes only:
@@ -165,7 +167,7 @@ def _add_when_present(data, ensemble: Ensemble, rec: Records, window: float, dur
                 "two periods (metronome death; see metrosync.observables.death)"
             },
         )
-    if np.any((system.dry_friction > 0) & ~np.isinf(system.total_inertia)):
+    if np.any((system.dry_friction > 0) & ~np.any(np.isinf(system.total_inertia), axis=(1, 2))):
         data["disk_at_rest"] = (
             ("run",),
             np.minimum(rec.rest_time / window, 1.0),
@@ -199,10 +201,13 @@ def _add_when_present(data, ensemble: Ensemble, rec: Records, window: float, dur
         # φ is the platform's coordinate: the disk's angle, or the board's position.
         board = ensemble.params.platform.platform == "board"
         what, unit = ("board position", "m") if board else ("disk angle", "rad")
-        data["phi"] = (("time", "run"), rec.phi.T, {"units": unit, "long_name": what})
+        # One coordinate: (time, run), as ever; more: a `platform_coordinate` axis.
+        dims = ("time", "run") if rec.phi.ndim == 2 else ("time", "run", "platform_coordinate")
+        order = (1, 0, 2)[: rec.phi.ndim]
+        data["phi"] = (dims, rec.phi.transpose(order), {"units": unit, "long_name": what})
         data["phi_dot"] = (
-            ("time", "run"),
-            rec.phi_dot.T,
+            dims,
+            rec.phi_dot.transpose(order),
             {"units": f"{unit}/s", "long_name": f"rate of the {what}"},
         )
 
