@@ -98,14 +98,17 @@ def test_later_impacts_taken_for_a_quarter_of_the_tocks_are_off_the_beat():
     assert np.array_equal(off_the_beat(times, n), late)
 
 
+@pytest.mark.parametrize("lag", [0.115, 0.34])
 @pytest.mark.parametrize(("drop_db", "folded"), [(35.0, True), (2.0, False)])
-def test_a_faint_train_at_a_fixed_lag_beyond_a_tick_is_its_echo(drop_db, folded):
+def test_a_faint_train_at_a_fixed_lag_beyond_a_tick_is_its_echo(drop_db, folded, lag):
     """One metronome (corpus, seed 117): a sound 115 ms after every second tick of one
     voice, 35 dB fainter, was a train of its own, a second metronome. Far fainter, at
-    a fixed lag within the beat, it is the first train's echo; as loud, it is not."""
+    a fixed lag within the beat, it is the first train's echo; as loud, it is not. Seed
+    201: an echo more than half a beat on (159 ms at 199 BPM) lies nearer the next
+    tick; it is still the tick before it's."""
     rng = np.random.default_rng(117)
     first = 0.1 + np.arange(60) * 0.64 + rng.normal(0, 0.5e-3, 60)
-    echo = first[::2] + 0.115 + rng.normal(0, 0.02e-3, 30)
+    echo = first[::2] + lag + rng.normal(0, 0.02e-3, 30)
     times = np.concatenate([first, echo])
     order = np.argsort(times)
     where = np.empty(times.size, dtype=np.int64)
@@ -116,3 +119,22 @@ def test_a_faint_train_at_a_fixed_lag_beyond_a_tick_is_its_echo(drop_db, folded)
     kept, _, parts = fold_parts(times[order], [a, b], [0, 1], strength)
     assert (len(kept) == 1) == folded
     assert (len(parts) == 1 and set(parts[0]) == set(b.index)) == folded
+
+
+def test_a_tock_far_fainter_than_its_tick_is_not_its_echo():
+    """Corpus seed 72: a metronome's tocks, 18.6 dB fainter than its ticks, half a beat
+    on. Their lag from the tick before moves with the metronome's beat (its jitter),
+    an echo's does not: they stay the metronome's other beat, not an echo."""
+    rng = np.random.default_rng(72)
+    swing = 60 / 91.9
+    ticks_ = 0.08 + np.arange(60) * swing + rng.normal(0, 0.35e-3, 60)
+    tocks = 0.08 + (np.arange(60) + 0.5) * swing + 0.03 * swing + rng.normal(0, 0.35e-3, 60)
+    times = np.concatenate([ticks_, tocks])
+    order = np.argsort(times)
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    strength = np.where(np.arange(times.size) < 60, -3.0, -21.6)[order]
+    a = Train(where[:60], np.arange(60), swing, np.zeros(60, bool))
+    b = Train(where[60:], np.arange(60), swing, np.zeros(60, bool))
+    kept, _, parts = fold_parts(times[order], [a, b], [0, 1], strength)
+    assert len(kept) == 2 and not parts

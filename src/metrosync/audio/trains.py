@@ -380,9 +380,12 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
     pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
     A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
     different from the first. A later impact at least `LATER_FAINTER` dB fainter is
-    timed in the first one's ring: its lag may spread twice as much. One at least
+    timed in the first one's ring: its lag may spread twice as much (an echo beyond
+    the ring keeps the room's one delay, as a tock far fainter than its tick does not:
+    it moves with the metronome's beat). One at least
     `ECHO_FAINTER` dB fainter is part of A at any lag within A's beat (a room's echo, a
-    last faint impact beyond `MAX_TICK_LENGTH`). Two metronomes locked a few
+    last faint impact beyond `MAX_TICK_LENGTH`), its lag taken from A's tick before it
+    (more than half a beat on, it lies nearer A's next tick). Two metronomes locked a few
     milliseconds apart keep a lag that wanders by more than that, as each one's beat
     jitters.
     """
@@ -400,13 +403,22 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             j = np.clip(np.searchsorted(t_a, t_b), 1, t_a.size - 1)
             lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
                            t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
-            middle = float(np.median(lag))
             drop = (
                 float(np.mean(strength[ta.index]) - np.mean(strength[tb.index]))
                 if strength is not None
                 else 0.0
             )
-            limit = 2 * PART_LAG_SPREAD if middle > 0 and drop > LATER_FAINTER else PART_LAG_SPREAD
+            if drop >= ECHO_FAINTER:
+                # an echo follows its tick, maybe by more than half a beat: its lag is
+                # from the tick before it, not the nearest
+                before = np.searchsorted(t_a, t_b, side="right") - 1
+                lag = np.where(before >= 0, t_b - t_a[np.maximum(before, 0)], lag)
+            middle = float(np.median(lag))
+            # a later impact in the ring is timed less precisely; an echo beyond it keeps
+            # the room's one delay, where a tock far fainter than its tick moves with the
+            # metronome's beat
+            ring = 0 < middle < MAX_TICK_LENGTH and drop > LATER_FAINTER
+            limit = 2 * PART_LAG_SPREAD if ring else PART_LAG_SPREAD
             echo = middle > 0 and drop >= ECHO_FAINTER
             if (abs(middle) >= MAX_TICK_LENGTH and not echo) or robust_spread(lag) >= limit:
                 continue
