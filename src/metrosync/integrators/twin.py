@@ -82,10 +82,9 @@ class TwinScheme:
 
 
 @dataclass
-class _Step:
-    """One step of ``scheme`` for every run, a platform of one coordinate with its
-    constants per run (`SystemArrays.one_coordinate`, the state's `StepState.one_coordinate`);
-    what does not change between steps is computed once."""
+class _StepSettings:
+    """What a step of either kind is told: the model, the scheme and the step's
+    settings."""
 
     sys: SystemArrays
     scheme: TwinScheme
@@ -93,6 +92,14 @@ class _Step:
     record_every: int
     overturn_angle: float
     n_rec: int
+
+
+@dataclass
+class _Step(_StepSettings):
+    """One step of ``scheme`` for every run, a platform of one coordinate with its
+    constants per run (`SystemArrays.one_coordinate`, the state's `StepState.one_coordinate`);
+    what does not change between steps is computed once."""
+
     constants: tuple
 
     def __post_init__(self) -> None:
@@ -107,17 +114,9 @@ class _Step:
         if not alive.any():
             return False
         half = 0.5 * dt
-        t_old, t_new = s * dt, (s + 1) * dt
-        th, thd, acc = state.theta, state.theta_dot, state.acc_theta
-        th_new = th + thd * dt + 0.5 * acc * (dt * dt)
-        vel_pred = thd + acc * dt
-        phd_pred = state.phi_dot + state.acc_phi * dt
-        phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * (dt * dt)
-        fires = np.where(alive[:, None], escapement(sys, th, th_new), 0.0)
-        torque, kicks = self.scheme.begin(sys, fires, dt)
-        state.last_kick[fires != 0.0] = t_new
-        overturned = np.any(np.abs(th_new) > self.overturn_angle, axis=1) & alive
-        state.status[overturned] |= STATUS_OVERTURNED
+        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, kicks = _predicted(
+            self, state, s, alive
+        )
 
         forces = (sys, th_new, vel_pred, phd_pred, torque, t_new)
         others = disk_torque(sys, phd_pred, torque, t_new)
@@ -235,18 +234,11 @@ class _Step:
 
 
 @dataclass
-class _CoordinatesStep:
+class _CoordinatesStep(_StepSettings):
     """One step of ``scheme`` for a platform of P coordinates (`equations`): the same
     scheme as `_Step` (positions by Taylor, the platform's momentum by the trapezoid
     of its forces, φ̇ from it), for the escapement as a torque over the step; no dry
     friction (a law of one coordinate)."""
-
-    sys: SystemArrays
-    scheme: TwinScheme
-    dt: float
-    record_every: int
-    overturn_angle: float
-    n_rec: int
 
     def __post_init__(self) -> None:
         if self.scheme.impulsive:
@@ -267,17 +259,9 @@ class _CoordinatesStep:
         alive = (state.status & STATUS_DIVERGED) == 0
         if not alive.any():
             return False
-        t_old, t_new = s * dt, (s + 1) * dt
-        th, thd, acc = state.theta, state.theta_dot, state.acc_theta
-        th_new = th + thd * dt + 0.5 * acc * (dt * dt)
-        vel_pred = thd + acc * dt
-        phd_pred = state.phi_dot + state.acc_phi * dt
-        phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * (dt * dt)
-        fires = np.where(alive[:, None], escapement(sys, th, th_new), 0.0)
-        torque, _ = self.scheme.begin(sys, fires, dt)
-        state.last_kick[fires != 0.0] = t_new
-        overturned = np.any(np.abs(th_new) > self.overturn_angle, axis=1) & alive
-        state.status[overturned] |= STATUS_OVERTURNED
+        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, _ = _predicted(
+            self, state, s, alive
+        )
         phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, torque, t_new)
         force = disk_torque(sys, phd_pred, torque, t_new)
         diverged = ~np.all(np.isfinite(phdd), axis=1) & alive
@@ -310,6 +294,25 @@ class _CoordinatesStep:
 #: The twins of the two fixed-step schemes.
 VERLET = TwinScheme("verlet", impulsive=False)
 LOCATED = TwinScheme("located", impulsive=True)
+
+
+def _predicted(step, state: StepState, s: int, alive: np.ndarray) -> tuple:
+    """The first pass of step ``s``, shared by both steps: (t_old, t_new, θ, θ̇, θ̈, θ
+    new, θ̇ and φ̇ predicted, φ new, the escapement's torque and kicks); marks the
+    escapements that fired and the runs that overturned."""
+    sys, dt = step.sys, step.dt
+    t_old, t_new = s * dt, (s + 1) * dt
+    th, thd, acc = state.theta, state.theta_dot, state.acc_theta
+    th_new = th + thd * dt + 0.5 * acc * (dt * dt)
+    vel_pred = thd + acc * dt
+    phd_pred = state.phi_dot + state.acc_phi * dt
+    phi_new = state.phi + state.phi_dot * dt + 0.5 * state.acc_phi * (dt * dt)
+    fires = np.where(alive[:, None], escapement(sys, th, th_new), 0.0)
+    torque, kicks = step.scheme.begin(sys, fires, dt)
+    state.last_kick[fires != 0.0] = t_new
+    overturned = np.any(np.abs(th_new) > step.overturn_angle, axis=1) & alive
+    state.status[overturned] |= STATUS_OVERTURNED
+    return t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, kicks
 
 
 def _disk_velocity(sys, p_phi, theta, theta_dot):
