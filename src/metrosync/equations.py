@@ -69,9 +69,10 @@ __all__ = [
 def applied_torque(sys: SystemArrays, t) -> np.ndarray:
     """External torque τ(t) = A sin(Ω t) on the disk (N m), on each of the platform's
     coordinates, (B, P); 0 where A = 0."""
-    if np.ndim(sys.forcing_amplitude) == 1:  # one coordinate, per run
-        return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)
-    return sys.forcing_amplitude * np.sin(sys.forcing_omega * t)[..., None]
+    amplitude = np.asarray(sys.forcing_amplitude)
+    if amplitude.ndim == 1:  # one coordinate, per run
+        return amplitude * np.sin(sys.forcing_omega * t)
+    return amplitude * np.sin(sys.forcing_omega * t)[..., None]
 
 
 def disk_torque(sys: SystemArrays, phi_dot, kick, t=0.0):
@@ -169,8 +170,8 @@ def dry_friction(sys: SystemArrays, phi_dot, holding):
     `holding_torque`) clipped to ±T: it stays at rest when |holding| ≤ T, else it
     starts to slip the way the other torques push it, against a friction of T.
     """
-    limit = sys.dry_friction
-    if np.ndim(phi_dot) > np.ndim(limit):  # per coordinate: the one coordinate's
+    limit = np.asarray(sys.dry_friction)
+    if np.ndim(phi_dot) > limit.ndim:  # per coordinate: the one coordinate's
         limit = limit[..., None]
     return _coulomb(limit, phi_dot, holding)
 

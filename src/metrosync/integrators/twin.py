@@ -16,7 +16,7 @@ tests/integrators/test_located.py). `VERLET` and `LOCATED` are the two.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -68,6 +68,7 @@ class TwinScheme:
         require(f"{self.name}/numpy", sys)
         flat = sys.one_coordinate()
         n_rec = state.r.shape[1]
+        step: _Step | _CoordinatesStep
         if flat is None:  # a platform of several coordinates
             step = _CoordinatesStep(sys, self, dt, record_every, overturn_angle, n_rec)
         else:  # one coordinate: the scheme as the kernels run it, on the same arrays
@@ -92,6 +93,20 @@ class _StepSettings:
     record_every: int
     overturn_angle: float
     n_rec: int
+    #: the records' spacing, s (set by each step's `__post_init__`)
+    grid_dt: float = field(init=False)
+
+    def _book_crossings(self, state, th, th_new, ok, t_old) -> None:
+        """The phase's upward zero crossings in the step, at their linear instants."""
+        up = (th < 0) & (th_new > 0) & ok[:, None]
+        for b, i in zip(*np.nonzero(up), strict=True):
+            t_cross = t_old + self.dt * th[b, i] / (th[b, i] - th_new[b, i])
+            if state.last_up[b, i] >= 0:
+                grp = np.searchsorted(state.group_start, i, side="right") - 1
+                _add_crossing_phase(
+                    state, b, grp, state.last_up[b, i], t_cross, self.grid_dt, self.n_rec
+                )
+            state.last_up[b, i] = t_cross
 
 
 @dataclass
@@ -190,18 +205,6 @@ class _Step(_StepSettings):
         friction = np.where(dry, dry_friction(sys, phi_dot, holding), 0.0)
         return friction, dry & (phi_dot == 0) & (np.abs(holding) <= sys.dry_friction)
 
-    def _book_crossings(self, state, th, th_new, ok, t_old) -> None:
-        """The phase's upward zero crossings in the step, at their linear instants."""
-        up = (th < 0) & (th_new > 0) & ok[:, None]
-        for b, i in zip(*np.nonzero(up), strict=True):
-            t_cross = t_old + self.dt * th[b, i] / (th[b, i] - th_new[b, i])
-            if state.last_up[b, i] >= 0:
-                grp = np.searchsorted(state.group_start, i, side="right") - 1
-                _add_crossing_phase(
-                    state, b, grp, state.last_up[b, i], t_cross, self.grid_dt, self.n_rec
-                )
-            state.last_up[b, i] = t_cross
-
     def _impulses(self, state, kicks, th, th_new, ok, q_new):
         """Each impulse at its instant (`_located_parts.kick` gives its pieces, summed
         as the compiled loops sum them) and the disk's jumps that follow from the sums:
@@ -251,8 +254,6 @@ class _CoordinatesStep(_StepSettings):
             )
         self.rigid = np.any(np.isinf(self.sys.total_inertia), axis=(1, 2))
         self.grid_dt = self.record_every * self.dt
-
-    _book_crossings = _Step._book_crossings
 
     def __call__(self, state: StepState, s: int) -> bool:
         sys, dt = self.sys, self.dt

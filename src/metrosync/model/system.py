@@ -105,7 +105,7 @@ class SystemArrays:
         object.__setattr__(
             self, "total_inertia", inertia[:, None, None] if inertia.ndim == 1 else inertia
         )
-        if p > 1 and np.any(self.dry_friction > 0):
+        if p > 1 and np.any(np.asarray(self.dry_friction) > 0):
             raise ParameterError(
                 f"`dry_friction` > 0 on a platform with {p} coordinates: dry friction is a "
                 "law of one coordinate; a platform with more than one has none."
