@@ -93,8 +93,11 @@ class _StepSettings:
     record_every: int
     overturn_angle: float
     n_rec: int
-    #: the records' spacing, s (set by each step's `__post_init__`)
+    #: the records' spacing, s
     grid_dt: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.grid_dt = self.record_every * self.dt
 
     def _book_crossings(self, state, th, th_new, ok, t_old) -> None:
         """The phase's upward zero crossings in the step, at their linear instants."""
@@ -121,7 +124,7 @@ class _Step(_StepSettings):
         sys = self.sys
         self.rigid = np.isinf(sys.total_inertia)
         self.dry = (sys.dry_friction > 0) & ~self.rigid
-        self.grid_dt = self.record_every * self.dt
+        super().__post_init__()
 
     def __call__(self, state: StepState, s: int) -> bool:
         sys, dt = self.sys, self.dt
@@ -253,7 +256,7 @@ class _CoordinatesStep(_StepSettings):
                 consumer=f"{self.scheme.name}/numpy",
             )
         self.rigid = np.any(np.isinf(self.sys.total_inertia), axis=(1, 2))
-        self.grid_dt = self.record_every * self.dt
+        super().__post_init__()
 
     def __call__(self, state: StepState, s: int) -> bool:
         sys, dt = self.sys, self.dt
