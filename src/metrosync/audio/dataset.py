@@ -140,7 +140,7 @@ def analyze_audio(
         if near and abs(near / bpm - 1) <= HINT_RANGE:
             sep, heard = hinted, near
     heads = np.flatnonzero(sep.head)
-    ticks = det.Ticks(*(getattr(impacts, f)[heads] for f in det.Ticks.__dataclass_fields__))
+    ticks = _subset(impacts, heads)
     where = np.full(impacts.time.size, -1, dtype=np.int64)
     where[heads] = np.arange(heads.size)
     trains = [_on_ticks(t, where) for t in sep.trains]
@@ -326,6 +326,11 @@ def _told_apart(ticks, trains: list[Train]) -> tuple[list[Train], dict]:
     return kept, behind
 
 
+def _subset(ticks: det.Ticks, which: np.ndarray) -> det.Ticks:
+    """The ticks ``which`` (indices or a mask) selects, every field alike."""
+    return det.Ticks(*(getattr(ticks, f)[which] for f in det.Ticks.__dataclass_fields__))
+
+
 def _later_impacts_folded(ticks, trains: list[Train]):
     """(ticks, trains) less each train of another's later impacts (`trains.fold_parts`)
     that only shows as one once recovery has completed the train it follows (pieces
@@ -339,8 +344,7 @@ def _later_impacts_folded(ticks, trains: list[Train]):
     for t in kept:
         keep[t.index] = True  # a tick a metronome holds stays
     where = np.cumsum(keep) - 1
-    ticks = det.Ticks(*(getattr(ticks, f)[keep] for f in det.Ticks.__dataclass_fields__))
-    return ticks, [replace(t, index=where[t.index]) for t in kept]
+    return _subset(ticks, keep), [replace(t, index=where[t.index]) for t in kept]
 
 
 def _retimed(recording, scan, ticks, trains: list[Train]):
