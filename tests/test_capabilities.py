@@ -25,6 +25,7 @@ from metrosync.errors import EscapementWarning
 from metrosync.integrators import BACKENDS, REGISTRY
 from metrosync.model import Metronome, MetronomeDesign
 from metrosync.show.playground import playground_config
+from two_coordinates import padded
 
 
 def simulate_options(name: str) -> dict:
@@ -45,10 +46,34 @@ def test_the_consumers_are_the_registry_and_the_playground():
         if c.integrator and REGISTRY[c.integrator].fixed_step:
             assert c.backend in BACKENDS
     for f in FEATURES.values():
-        assert f.summary and f.lacks and f.parameters and f.kind in ("model", "run")
+        assert f.summary and f.lacks and f.parameters and f.kind in ("model", "run", "system")
 
 
-@pytest.mark.parametrize("feature", list(FEATURES))
+#: What switches on each feature that no parameter makes yet, in the per-run arrays.
+SYSTEM_EXAMPLES = {"platform-coordinates": padded}
+BY_PARAMETERS = [name for name, f in FEATURES.items() if f.kind != "system"]
+
+
+def assert_refused_by_name(refused, consumer: str, feature: str) -> None:
+    """``refused`` names the feature, its parameter and the consumer, and offers
+    consumers that run it."""
+    integrator = consumer.split("/")[0]
+    assert refused.feature == feature and refused.consumer == consumer
+    message = str(refused)
+    assert f"`{FEATURES[feature].parameters[0]}` = " in message
+    assert FEATURES[feature].lacks in message and "; use " in message
+    # What it offers instead does run the feature.
+    offered = message.rsplit("; use ", 1)[1]
+    names = re.findall(r"'(\w+)'", offered)
+    assert names
+    for other in names:
+        if offered.startswith("backend="):
+            assert runs(f"{integrator}/{other}", feature)
+        else:
+            assert runs(consumer_of(other, REGISTRY[other].backends[0]).name, feature)
+
+
+@pytest.mark.parametrize("feature", BY_PARAMETERS)
 @pytest.mark.parametrize("consumer", [c for c in CONSUMERS if c != "playground"])
 def test_every_integrator_runs_each_feature_or_refuses_it_by_name(consumer, feature):
     integrator, backend = consumer.split("/")
@@ -60,19 +85,7 @@ def test_every_integrator_runs_each_feature_or_refuses_it_by_name(consumer, feat
                           backend=backend if backend in BACKENDS else "numba", progress=False)  # fmt: skip  # noqa: E501
     except UnsupportedFeature as refused:
         assert not runs_it, f"{consumer} refused {feature}, which the table says it runs"
-        assert refused.feature == feature and refused.consumer == consumer
-        message = str(refused)
-        assert f"`{FEATURES[feature].parameters[0]}` = " in message
-        assert FEATURES[feature].lacks in message and "; use " in message
-        # What it offers instead does run the feature.
-        offered = message.rsplit("; use ", 1)[1]
-        names = re.findall(r"'(\w+)'", offered)
-        assert names
-        for other in names:
-            if offered.startswith("backend="):
-                assert runs(f"{integrator}/{other}", feature)
-            else:
-                assert runs(consumer_of(other, REGISTRY[other].backends[0]).name, feature)
+        assert_refused_by_name(refused, consumer, feature)
         return
     except ParameterError as error:  # no GPU here: the table let it through to the device
         assert backend == "gpu" and "needs an NVIDIA GPU" in str(error), error
@@ -87,7 +100,30 @@ def test_every_integrator_runs_each_feature_or_refuses_it_by_name(consumer, feat
         assert bool(ds.escapement_stopped.isel(run=0, metronome=0))
 
 
-@pytest.mark.parametrize("feature", list(FEATURES))
+def test_every_feature_no_parameter_makes_has_an_example_here():
+    assert {n for n, f in FEATURES.items() if f.kind == "system"} == set(SYSTEM_EXAMPLES)
+
+
+@pytest.mark.parametrize("feature", list(SYSTEM_EXAMPLES))
+@pytest.mark.parametrize("consumer", list(CONSUMERS))
+def test_every_consumer_takes_the_arrays_of_a_feature_or_refuses_them_by_name(consumer, feature):
+    """The per-run arrays alone switch these on; each consumer's entry point asks the
+    table with them (tests/integrators/test_platform_coordinates.py runs them)."""
+    plain = build_ensemble(3, 192.0, params=get_preset("default"), runs=2, seed=1).system
+    system = SYSTEM_EXAMPLES[feature](plain)
+    assert [f.name for f, _ in features_on(system)] == [feature]
+    if runs(consumer, feature):
+        require(consumer, system)
+        return
+    with pytest.raises(UnsupportedFeature) as refused:
+        require(consumer, system)
+    if consumer == "playground":
+        assert "the playground has no" in str(refused.value)
+    else:
+        assert_refused_by_name(refused.value, consumer, feature)
+
+
+@pytest.mark.parametrize("feature", BY_PARAMETERS)
 def test_the_playground_runs_each_feature_or_refuses_it_by_name(feature):
     f = FEATURES[feature]
     if f.kind != "model":  # the page takes model parameters only: ask the table
@@ -105,7 +141,9 @@ def test_the_playground_runs_each_feature_or_refuses_it_by_name(feature):
             playground_config(changes=f.example)
 
 
-@pytest.mark.parametrize("feature", [n for n, f in FEATURES.items() if f.from_system])
+@pytest.mark.parametrize(
+    "feature", [n for n, f in FEATURES.items() if f.from_system and f.kind == "model"]
+)
 def test_the_per_run_arrays_tell_the_same_as_the_parameters(feature):
     params = get_preset("default").with_changes(**FEATURES[feature].example)
     ens = build_ensemble(3, 192.0, params=params, runs=2, seed=1)

@@ -63,7 +63,8 @@ class Feature:
         switch it on; for a run option, `simulate`'s keyword arguments that ask for it
         (for two metronomes); tests ask every consumer with it.
     kind : ``"model"`` (a term of the equations, or the tuning), ``"run"`` (a run
-        option or record of `simulate`).
+        option or record of `simulate`), ``"system"`` (a form of the per-run arrays
+        that no parameter makes yet; tests build the arrays by hand).
     from_params : (ModelParameters) → `Found` when it is on, else None.
     from_system : (SystemArrays) → `Found` when it is on, else None; None when the
         arrays cannot tell (the tuning only sets the slider positions).
@@ -103,6 +104,16 @@ def _offset(values) -> float:
     """The offset furthest from 0, with its sign."""
     flat = np.ravel(np.asarray(values, dtype=float))
     return float(flat[np.argmax(np.abs(flat))])
+
+
+def _platform_coordinates(system) -> Found | None:
+    """A platform the one-coordinate kernels cannot take: several coordinates, or one
+    whose metronomes sit at different levers (`SystemArrays.one_coordinate`)."""
+    if system.coordinates > 1:
+        return ("platform", f"{system.coordinates} coordinates", "")
+    if system.one_coordinate() is None:
+        return ("platform", "metronomes at different levers", "")
+    return None
 
 
 def _platform_dry_friction(platform) -> Found | None:
@@ -162,8 +173,12 @@ FEATURES: dict[str, Feature] = {
             from_params=lambda p: (
                 ("escapement_reaction", False, "") if not p.platform.escapement_reaction else None
             ),
+            # Off in a run whose platform takes the reaction on none of its coordinates
+            # (a second coordinate, a translation, need not take it).
             from_system=lambda s: (
-                ("escapement_reaction", False, "") if np.any(s.escapement_reaction != 1) else None
+                ("escapement_reaction", False, "")
+                if np.any(np.all(s.escapement_reaction != 1, axis=-1))
+                else None
             ),
         ),
         Feature(
@@ -188,6 +203,16 @@ FEATURES: dict[str, Feature] = {
             from_params=lambda p: (
                 ("platform", "board", "") if p.platform.platform == "board" else None
             ),
+        ),
+        Feature(
+            name="platform-coordinates",
+            parameters=("platform",),
+            summary="a platform of several generalized coordinates (equations, P > 1)",
+            lacks="no platform of several coordinates (only the disk, the board)",
+            # No parameter builds one yet: a new platform term would (docs/model.md §9.1).
+            example={},
+            kind="system",
+            from_system=_platform_coordinates,
         ),
         Feature(
             name="steady-swing",
@@ -265,6 +290,10 @@ class Consumer:
 #: so each runs every feature but those it names; a feature added to the table is then
 #: compared between every layout and its NumPy twin (tests/integrators/test_kernels.py).
 _ALL = frozenset(FEATURES)
+#: The compiled kernels hold the platform as one coordinate per run, and located's
+#: impulse is written for one: a platform of several runs on the NumPy twin's verlet
+#: and on exact.
+_ONE_COORDINATE = frozenset({"platform-coordinates"})
 #: The playground's JavaScript (`metrosync.show.playground`): every term of the model
 #: (the forcing, the escapement's offset and reaction switch, dry friction on the
 #: platform, the board on rollers) and the steady-swing tuning; ``run(params, steps)``
@@ -284,14 +313,25 @@ PLAYGROUND_RUNS = frozenset(
 CONSUMERS: dict[str, Consumer] = {
     c.name: c
     for c in (
-        Consumer("verlet/numba", _ALL, "integrator 'verlet'"),
+        Consumer("verlet/numba", _ALL - _ONE_COORDINATE, "integrator 'verlet'"),
         Consumer("verlet/numpy", _ALL, "integrator 'verlet'", cost="numpy"),
-        Consumer("verlet/gpu", _ALL - {"dry-friction", "trajectories"}, "the GPU backend"),
-        Consumer("located/numba", _ALL - {"dry-friction"}, "integrator 'located'"),
-        Consumer("located/numpy", _ALL - {"dry-friction"}, "integrator 'located'", cost="numpy"),
+        Consumer(
+            "verlet/gpu",
+            _ALL - {"dry-friction", "trajectories"} - _ONE_COORDINATE,
+            "the GPU backend",
+        ),
+        Consumer(
+            "located/numba", _ALL - {"dry-friction"} - _ONE_COORDINATE, "integrator 'located'"
+        ),
+        Consumer(
+            "located/numpy",
+            _ALL - {"dry-friction"} - _ONE_COORDINATE,
+            "integrator 'located'",
+            cost="numpy",
+        ),
         Consumer(
             "located/gpu",
-            _ALL - {"dry-friction", "trajectories"},
+            _ALL - {"dry-friction", "trajectories"} - _ONE_COORDINATE,
             "integrator 'located' on the GPU",
         ),
         Consumer("exact/scipy", _ALL, "integrator 'exact'", cost="whole-run"),
@@ -373,10 +413,12 @@ def instead(who: Consumer, f: Feature) -> str:
         others = [b for b in backends_running(who.integrator, f.name) if b != who.backend]
         if others:
             return _alternatives("backend", others)
-    integrators = []
-    for c in CONSUMERS.values():
-        if c.integrator and f.name in c.runs and c.integrator not in integrators:
-            integrators.append(c.integrator)
+    integrators, seen = [], set()
+    for c in CONSUMERS.values():  # offered only when the integrator's default backend runs it
+        if c.integrator and c.integrator not in seen:
+            seen.add(c.integrator)
+            if f.name in c.runs:
+                integrators.append(c.integrator)
     integrators = [i for i in integrators if i != who.integrator]
     if who.integrator is None:  # the playground
         return "`metrosync.simulate` with " + _alternatives("integrator", integrators)
@@ -392,10 +434,12 @@ def _alternatives(option: str, names: list[str]) -> str:
 
 
 def describe_lacks(integrator: str) -> str:
-    """For help texts: what ``integrator``'s backends do not run, e.g. ``"no
-    dry-friction"`` or ``"on gpu no dry-friction, trajectories"``; "" when they run all."""
+    """For help texts: what ``integrator``'s backends do not run of what an option can
+    ask for, e.g. ``"no dry-friction"`` or ``"on gpu no dry-friction, trajectories"``;
+    "" when they run all."""
     own = [c for c in CONSUMERS.values() if c.integrator == integrator]
-    lacking = {c.backend: [f for f in FEATURES if f not in c.runs] for c in own}
+    askable = [name for name, f in FEATURES.items() if f.kind != "system"]  # by an option
+    lacking = {c.backend: [f for f in askable if f not in c.runs] for c in own}
     if len({tuple(v) for v in lacking.values()}) == 1:
         missing = next(iter(lacking.values()))
         return f"no {', '.join(missing)}" if missing else ""

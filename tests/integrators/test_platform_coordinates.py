@@ -11,9 +11,10 @@ import pytest
 from metrosync import build_ensemble, get_preset
 from metrosync.capabilities import UnsupportedFeature
 from metrosync.equations import SystemArrays
-from metrosync.integrators import exact, twin, verlet
+from metrosync.integrators import exact, located, twin, verlet
 from metrosync.integrators._state import StepState
 from metrosync.observables import platform_momentum, total_energy
+from two_coordinates import padded
 
 
 def run(advance, sys, ens, steps, **kwargs):
@@ -24,28 +25,6 @@ def run(advance, sys, ens, steps, **kwargs):
     advance(state, sys, dt=0.01, step0=0, n_steps=steps, record_every=10,
             overturn_angle=math.pi / 2, **kwargs)  # fmt: skip
     return state
-
-
-def padded(sys: SystemArrays, lever_y=None, inertia_y=0.3) -> SystemArrays:
-    """``sys`` (one coordinate) with a second coordinate: idle (lever 0) by default."""
-    runs, n = sys.shape
-    lever_y = np.zeros((runs, n)) if lever_y is None else lever_y
-    lever = np.stack([sys.lever[:, :, 0], lever_y], axis=-1)
-    inertia = np.zeros((runs, 2, 2))
-    inertia[:, 0, 0] = sys.total_inertia[:, 0, 0]
-    inertia[:, 1, 1] = inertia_y
-    return SystemArrays(
-        **{
-            **vars(sys),
-            "lever": lever,
-            "total_inertia": inertia,
-            "c_phi": np.concatenate([sys.c_phi, np.zeros((runs, 1))], axis=1),
-            "forcing_amplitude": np.concatenate([sys.forcing_amplitude, np.zeros((runs, 1))], 1),
-            "escapement_reaction": np.concatenate(
-                [sys.escapement_reaction, np.zeros((runs, 1))], 1
-            ),
-        }
-    )
 
 
 def disk(changes=None, runs=3, n=4, **options):
@@ -80,13 +59,32 @@ def test_exact_runs_a_disk_with_an_idle_second_coordinate_as_the_disk():
 
 
 @pytest.mark.parametrize("layout", sorted(verlet.LAYOUTS))
-def test_the_compiled_kernels_refuse_a_platform_of_two_coordinates(layout):
+@pytest.mark.parametrize("kernels", [verlet, located], ids=["verlet", "located"])
+def test_the_compiled_kernels_refuse_a_platform_of_two_coordinates(kernels, layout):
     ens = disk()
     with pytest.raises(UnsupportedFeature, match="2 coordinates") as refused:
-        run(verlet.advance_state, padded(ens.system), ens, 10, layout=layout)
+        run(kernels.advance_state, padded(ens.system), ens, 10, layout=layout)
     assert refused.value.feature == "platform-coordinates"
-    with pytest.raises(UnsupportedFeature, match="2 coordinates"):
+    assert refused.value.consumer == f"{kernels.__name__.rsplit('.', 1)[1]}/numba"
+
+
+def test_located_on_the_twin_refuses_a_platform_of_two_coordinates():
+    ens = disk()
+    with pytest.raises(UnsupportedFeature, match="2 coordinates") as refused:
         run(twin.LOCATED.advance_state, padded(ens.system), ens, 10)
+    assert refused.value.consumer == "located/numpy"
+    assert "use integrator='exact'" in str(refused.value)
+
+
+def test_metronomes_at_different_levers_are_refused_by_name_by_the_kernels():
+    """One coordinate, but each metronome at its own lever: the kernels take one lever
+    per run."""
+    ens = disk()
+    lever = ens.system.lever.copy()
+    lever[:, 0, 0] *= 1.5
+    uneven = SystemArrays(**{**vars(ens.system), "lever": lever})
+    with pytest.raises(UnsupportedFeature, match="different levers"):
+        run(verlet.advance_state, uneven, ens, 10)
 
 
 def free_plane(runs=2, n=4):

@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import metrosync
-from metrosync.capabilities import FEATURES, UnsupportedFeature, runs
+from metrosync.capabilities import FEATURES, UnsupportedFeature, features_on, runs
 from metrosync.cli import main
 from metrosync.errors import ParameterError
-from metrosync.model import PRESETS
+from metrosync.model import PRESETS, get_preset
 from metrosync.show.playground import SCRIPTS, playground_config, write_playground
 
 MODEL_FEATURES = [name for name, f in FEATURES.items() if f.kind == "model"]
@@ -366,7 +366,8 @@ def test_the_page_runs_each_model_feature_or_refuses_it_by_name(request, tmp_pat
     """Each feature of the capability table: refused by name, or the page's physics is
     `simulate(..., backend="numpy")`'s to 1e-9 over 10 000 steps with it on."""
     changes = FEATURE_CASES[case]
-    named = [FEATURES[n] for n in FEATURES if set(FEATURES[n].parameters) & set(changes)]
+    # The features these changes switch on (two features may share a parameter).
+    named = [f for f, _ in features_on(get_preset("default").with_changes(**changes))]
     if not all(runs("playground", f.name) for f in named):
         with pytest.raises(UnsupportedFeature) as refused:
             playground_config(changes=changes)
@@ -405,7 +406,6 @@ def test_the_board_preset_runs_in_the_page_as_in_numpy(browser, tmp_path, case):
     """Six metronomes on preset pantaleone2002's board: the page's physics is
     `simulate(..., backend="numpy")`'s to 1e-9 over 10 000 steps, the board's constants
     are the model's, and the page says it runs the board."""
-    from metrosync.model import get_preset
 
     changes = BOARD_CASES[case]
     page = write_playground(tmp_path / "play.html", preset="pantaleone2002", n=2, bpm=208.0,

@@ -36,7 +36,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..capabilities import UnsupportedFeature
 from ..model.system import SystemArrays
 
 
@@ -101,17 +100,14 @@ def constants_of(sys: SystemArrays):
 
 
 def one_coordinate(sys: SystemArrays):
-    """``sys`` with the platform's constants per run (`SystemArrays.one_coordinate`);
-    `UnsupportedFeature` for a platform the kernels do not run: one of more than one
-    coordinate, or whose metronomes' levers differ."""
+    """``sys`` with the platform's constants per run (`SystemArrays.one_coordinate`).
+    Any other platform is refused by name before a kernel is reached
+    (`metrosync.capabilities`, feature ``platform-coordinates``)."""
     flat = sys.one_coordinate()
     if flat is None:
-        raise UnsupportedFeature(
-            f"`platform` with {sys.coordinates} coordinates: the compiled kernels have "
-            "a platform of one coordinate only (the disk, the board); use backend='numpy' "
-            "or integrator='exact'.",
-            feature="platform-coordinates",
-            consumer="compiled kernels",
+        raise ValueError(
+            "the kernels' constants are for a platform of one coordinate; "
+            "`capabilities.require` refuses any other before a kernel runs"
         )
     return flat
 

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..capabilities import UnsupportedFeature
 from ..equations import SystemArrays, accelerations, disk_torque, dry_friction, holding_torque
 from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
@@ -133,7 +132,8 @@ class StepState:
     def kernel_state(self) -> State:
         """The state arrays as the kernels take them: the same arrays, not copies, the
         platform's seen as its one coordinate, (B,) views of the (B, 1) arrays.
-        `UnsupportedFeature` for a platform of more than one coordinate."""
+        `ValueError` for a platform of more than one coordinate (refused by name before,
+        `capabilities.require`)."""
         self._one_coordinate()
         s = self.state
         return s._replace(**{name: getattr(s, name)[:, 0] for name in PLATFORM_STATE})
@@ -151,13 +151,9 @@ class StepState:
         return StepState(self.kernel_state(), self.kernel_recording())
 
     def _one_coordinate(self) -> None:
-        if self.coordinates != 1:
-            raise UnsupportedFeature(
-                f"`platform` with {self.coordinates} coordinates: the compiled kernels "
-                "have a platform of one coordinate only (the disk, the board); use "
-                "backend='numpy' or integrator='exact'.",
-                feature="platform-coordinates",
-                consumer="compiled kernels",
+        if self.coordinates != 1:  # refused by name before (`capabilities.require`)
+            raise ValueError(
+                f"the kernels' state is for a platform of one coordinate, not {self.coordinates}"
             )
 
     def crossing_order(self) -> np.ndarray:

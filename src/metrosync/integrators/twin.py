@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..capabilities import UnsupportedFeature, require
+from ..capabilities import require
 from ..equations import (
     SystemArrays,
     accelerations,
@@ -99,6 +99,18 @@ class _StepSettings:
     def __post_init__(self) -> None:
         self.grid_dt = self.record_every * self.dt
 
+    def __call__(self, state: StepState, s: int) -> bool:
+        """Step ``s`` of every run still alive; False when none is."""
+        alive = (state.status & STATUS_DIVERGED) == 0
+        if not alive.any():
+            return False
+        self._advance(state, s, alive, _predicted(self, state, s, alive))
+        return True
+
+    def _advance(self, state: StepState, s: int, alive: np.ndarray, first: tuple) -> None:
+        """The rest of the step after its first pass ``first`` (`_predicted`)."""
+        raise NotImplementedError
+
     def _book_crossings(self, state, th, th_new, ok, t_old) -> None:
         """The phase's upward zero crossings in the step, at their linear instants."""
         up = (th < 0) & (th_new > 0) & ok[:, None]
@@ -126,15 +138,10 @@ class _Step(_StepSettings):
         self.dry = (sys.dry_friction > 0) & ~self.rigid
         super().__post_init__()
 
-    def __call__(self, state: StepState, s: int) -> bool:
+    def _advance(self, state: StepState, s: int, alive: np.ndarray, first: tuple) -> None:
         sys, dt = self.sys, self.dt
-        alive = (state.status & STATUS_DIVERGED) == 0
-        if not alive.any():
-            return False
         half = 0.5 * dt
-        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, kicks = _predicted(
-            self, state, s, alive
-        )
+        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, kicks = first
 
         forces = (sys, th_new, vel_pred, phd_pred, torque, t_new)
         others = disk_torque(sys, phd_pred, torque, t_new)
@@ -196,7 +203,6 @@ class _Step(_StepSettings):
         state.acc_phi[ok] = phdd[ok]
         if (s + 1) % self.record_every == 0:
             _record(state, (s + 1) // self.record_every, sys.omega, ok)
-        return True
 
     def _dry_friction(self, phi_dot, forces):
         """The disk's dry friction as a step starts resolving the disk, (B,), and where it
@@ -247,25 +253,14 @@ class _CoordinatesStep(_StepSettings):
     friction (a law of one coordinate)."""
 
     def __post_init__(self) -> None:
-        if self.scheme.impulsive:
-            raise UnsupportedFeature(
-                f"`platform` with {self.sys.coordinates} coordinates: integrator "
-                f"{self.scheme.name!r} has a platform of one coordinate only; use "
-                "integrator='verlet' (backend='numpy') or integrator='exact'.",
-                feature="platform-coordinates",
-                consumer=f"{self.scheme.name}/numpy",
-            )
+        if self.scheme.impulsive:  # refused by name before (`capabilities.require`)
+            raise ValueError(f"{self.scheme.name!r} has a platform of one coordinate only")
         self.rigid = np.any(np.isinf(self.sys.total_inertia), axis=(1, 2))
         super().__post_init__()
 
-    def __call__(self, state: StepState, s: int) -> bool:
+    def _advance(self, state: StepState, s: int, alive: np.ndarray, first: tuple) -> None:
         sys, dt = self.sys, self.dt
-        alive = (state.status & STATUS_DIVERGED) == 0
-        if not alive.any():
-            return False
-        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, _ = _predicted(
-            self, state, s, alive
-        )
+        t_old, t_new, th, thd, acc, th_new, vel_pred, phd_pred, phi_new, torque, _ = first
         phdd, thdd = accelerations(sys, th_new, vel_pred, phd_pred, torque, t_new)
         force = disk_torque(sys, phd_pred, torque, t_new)
         diverged = ~np.all(np.isfinite(phdd), axis=1) & alive
@@ -292,7 +287,6 @@ class _CoordinatesStep(_StepSettings):
         state.acc_phi[...] = np.where(ok2, phdd, state.acc_phi)
         if (s + 1) % self.record_every == 0:
             _record(state, (s + 1) // self.record_every, sys.omega, ok)
-        return True
 
 
 #: The twins of the two fixed-step schemes.

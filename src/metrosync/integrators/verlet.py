@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import numba as nb
 
+from ..capabilities import require
 from . import layout_metronomes, layout_runs
 from ._kernel_parts import drift
 from ._physics import escapement
@@ -102,6 +103,7 @@ def advance_state(
 ):
     """Advance ``state`` by ``n_steps`` steps from ``step0`` with the kernel for
     ``layout`` (default: chosen from the problem's size, `layouts.choose_layout`)."""
+    require("verlet/numba", sys)
     advance_in_layout(
         LAYOUTS,
         state,
