@@ -55,6 +55,24 @@ def test_a_train_of_every_kth_beat_gets_the_beats_between(k, seed):
     assert np.allclose(np.diff(times[out.index]) / np.diff(out.beat), 60.0 / 107.0, rtol=0.05)
 
 
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_limping_train_of_every_third_beat_with_gaps_is_divided(seed):
+    """A train of every third beat that lost a quarter of its own ticks: its pairs span
+    3, 6 or 9 beats. Across an odd number of beats a limp does not cancel, so the places
+    between, interpolated along each span, would sit off by a third, a half or four
+    ninths of the limp, and their offsets spread with the span (corpus seed 207: a
+    metronome followed at a third of its tempo)."""
+    rng = np.random.default_rng(seed)
+    times, train, own, others = setting(3, hidden=0.2, seed=seed)
+    kept = np.ones(train.index.size, dtype=bool)
+    kept[1:-1] = rng.uniform(size=train.index.size - 2) > 0.25
+    gappy = Train(train.index[kept], train.beat[kept], train.period, train.masked[kept])
+    (out,) = subdivided(times, [gappy])
+    assert out.period == pytest.approx(60.0 / 107.0)
+    assert len(set(out.index) - set(own)) <= 1
+    assert np.all(np.diff(out.beat) >= 1)
+
+
 def test_ticks_another_train_holds_are_not_taken():
     times, train, own, others = setting(2)
     between = np.setdiff1d(own, train.index)
