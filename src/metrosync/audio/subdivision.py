@@ -74,12 +74,11 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
         # (time, beat number, place j of k, kind of the train's beat it follows)
         limp = _limp(t, b, pairs, k)
         rows = [
-            (_place(t[p], t[p + 1], b[p] % 2, step[p] * k, i, limp), b[p] * k + i, i % k,
-             (b[p] + i // k) % 2)
-            for p in pairs
-            for i in range(1, step[p] * k)
+            (_place(t[p], t[p + 1], b[p] % 2, n, i, limp), b[p] * k + i, i % k, (b[p] + i // k) % 2)
+            for p, n in zip(pairs, step[pairs] * k, strict=True)
+            for i in range(1, n)
             if i % k
-        ]  # fmt: skip
+        ]
         where, number, place, kind = (np.array(c) for c in zip(*rows, strict=True))
         at = _fitting(free_t, where, place, kind, beat)
         if at is None:
