@@ -66,13 +66,14 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
     if pairs.size < MIN_PAIRS or free.size == 0:
         return None
     free_t = times[free]
+    odd_limp = _limp(t, b, step, pairs)
     for k in range(2, MAX_FRAGMENT + 1):
         beat = train.period / k
         if beat < MIN_BEAT:
             return None
         # every place between two of the train's ticks a divided beat would fill:
         # (time, beat number, place j of k, kind of the train's beat it follows)
-        limp = _limp(t, b, pairs, k)
+        limp = odd_limp if k % 2 else 0.0  # for an even k the limp cancels (`_limp`)
         rows = [
             (_place(t[p], t[p + 1], b[p] % 2, n, i, limp), b[p] * k + i, i % k, (b[p] + i // k) % 2)
             for p, n in zip(pairs, step[pairs] * k, strict=True)
@@ -92,9 +93,10 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
     return None
 
 
-def _limp(t: np.ndarray, b: np.ndarray, pairs: np.ndarray, k: int) -> float:
+def _limp(t: np.ndarray, b: np.ndarray, step: np.ndarray, pairs: np.ndarray) -> float:
     """How much longer the metronome's beat after its kind-0 beats is than after its
-    kind-1 beats, s, seen in a train of every k-th beat; 0 for an even k.
+    kind-1 beats, s, seen in a train of every k-th beat for an odd k (0 when too few
+    intervals show it).
 
     A limp alternates tick and tock. For an odd k the train's own beats alternate too,
     and its interval after a kind-0 beat holds one more long beat than the one after a
@@ -102,10 +104,8 @@ def _limp(t: np.ndarray, b: np.ndarray, pairs: np.ndarray, k: int) -> float:
     evenly along a span, would sit off by a third, a half or four ninths of the limp as
     the span is 1, 2 or 3 of the train's beats, and their offsets spread with the span
     (corpus seed 207). For an even k both intervals hold as many of each."""
-    if k % 2 == 0:
-        return 0.0
-    one = pairs[np.diff(b)[pairs] == 1]
-    after = np.diff(t)[one]
+    one = pairs[step[pairs] == 1]
+    after = t[one + 1] - t[one]
     kind0 = b[one] % 2 == 0
     if kind0.sum() < 3 or (~kind0).sum() < 3:
         return 0.0
