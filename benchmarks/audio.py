@@ -22,6 +22,8 @@
     python benchmarks/audio.py --corpus   # only the third
     python benchmarks/audio.py --seeds 12-23  # the corpus's recordings of seeds 12-23
                                               # (one to four metronomes), not timed
+    python benchmarks/audio.py --seeds 0-239 --failures  # and a line for each wrong
+        # count and each metronome below 0.99: diff two runs to see what a change moved
 """
 
 from __future__ import annotations
@@ -196,6 +198,8 @@ def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
             # a metronome hidden behind another most of the time: beyond one microphone
             heard.append(min(hearable(truth, k).mean() for k in range(n)) >= 0.5)
             rows.append(scores(ds, truth) if right[-1] else None)
+            if "--failures" in sys.argv:
+                print_failures(n, seed, ds.attrs["metronomes"], rows[-1])
     right, heard = np.array(right), np.array(heard)
     for name, use in (("all", np.ones(right.size, bool)), ("hearable", heard)):
         table = np.concatenate([r for r, u in zip(rows, use, strict=True) if u and r is not None])
@@ -210,7 +214,18 @@ def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
         )
 
 
-OPTIONS = ("--accuracy", "--corpus", "--seeds", "--make", "--make-corpus")
+def print_failures(n: int, seed: int, found: int, table) -> None:
+    """A line for a recording whose number of metronomes is wrong, or for each of its
+    metronomes below 0.99 in recall or precision."""
+    if table is None:
+        print(f"n={n} seed={seed}: {found} metronomes")
+        return
+    for k, (recall, precision, *_) in enumerate(table):
+        if recall < 0.99 or precision < 0.99:
+            print(f"n={n} seed={seed} metronome {k}: recall {recall:.3f} precision {precision:.3f}")
+
+
+OPTIONS = ("--accuracy", "--corpus", "--seeds", "--failures", "--make", "--make-corpus")
 
 
 def main() -> None:
