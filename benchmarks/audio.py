@@ -173,11 +173,15 @@ def seeds_option(default: range = range(6)) -> list[int]:
     """The corpus's seeds from ``--seeds A-B`` (inclusive) or ``--seeds A,B,C``."""
     if "--seeds" not in sys.argv:
         return list(default)
-    text = sys.argv[sys.argv.index("--seeds") + 1]
-    if "-" in text:
-        first, last = (int(x) for x in text.split("-"))
-        return list(range(first, last + 1))
-    return [int(x) for x in text.split(",")]
+    at = sys.argv.index("--seeds") + 1
+    text = sys.argv[at] if at < len(sys.argv) else ""
+    try:
+        if "-" in text:
+            first, last = (int(x) for x in text.split("-"))
+            return list(range(first, last + 1))
+        return [int(x) for x in text.split(",")]
+    except ValueError:
+        sys.exit(f"--seeds {text!r}: give a range A-B or a list A,B,C of whole numbers")
 
 
 def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
