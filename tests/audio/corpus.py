@@ -58,8 +58,8 @@ impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
        recording, each microphone);
     3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
        sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
-       height; peak 0.5–2 times the signal's peak) at uniform random times, each on
-       one random microphone;
+       height; peak 0.5–2 times the signal's peak) at uniform random times, and one
+       at each of ``bump_times`` (s), each on one random microphone;
     4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
        and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
        high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay

@@ -29,6 +29,7 @@ class Impairments:
     snr_db: float | None = None
     noise: str = "pink"
     bumps: int = 0
+    bump_times: tuple[float, ...] = ()
     phone_band: bool | tuple[float, float] = False
     compression: bool = False
     compression_threshold_db: float = -24.0
@@ -50,6 +51,8 @@ class Impairments:
             raise ParameterError(f"`noise` must be 'pink' or 'white', got {self.noise!r}.")
         if isinstance(self.bumps, bool) or not isinstance(self.bumps, int) or self.bumps < 0:
             raise ParameterError(f"`bumps` must be an integer ≥ 0, got {self.bumps!r}.")
+        if not all(isinstance(t, (int, float)) and t >= 0 for t in self.bump_times):
+            raise ParameterError(f"`bump_times` must be times ≥ 0 s, got {self.bump_times!r}.")
         if not isinstance(self.phone_band, bool):
             low, high = self.phone_band
             if not (10 <= low < high):
@@ -101,11 +104,12 @@ def impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> np
         noise = _noise(n, channels, imp.noise, rng)
         x += noise * np.sqrt(power / 10 ** (imp.snr_db / 10)).astype(np.float32)[None, :]
         applied["snr_db"] = imp.snr_db
-    if imp.bumps:
+    if imp.bumps or imp.bump_times:
         peak = float(np.abs(x).max())
         bumps = []
-        for _ in range(imp.bumps):
-            t0, c = rng.uniform(0, n / rate), int(rng.integers(channels))
+        for b in range(imp.bumps + len(imp.bump_times)):
+            t0 = rng.uniform(0, n / rate) if b < imp.bumps else imp.bump_times[b - imp.bumps]
+            c = int(rng.integers(channels))
             bumps.append((int(t0 * rate) / rate, c))
             k = int(t0 * rate)
             thump = _thump(rate, rng) * peak

@@ -386,6 +386,13 @@ def test_bumps_are_low_thumps_at_the_times_reported(four):
     # On several microphones, each bump on one of them.
     rec = make_recording(four, microphones=2, impairments=Impairments(bumps=6), seed=7)
     assert {c for _, c in rec.applied["bumps"]} == {0, 1}
+    # At times given, besides those drawn; the drawn ones are those drawn without them.
+    placed = make_recording(four, impairments=Impairments(bumps=3, bump_times=(1.25, 2.5)), seed=7)
+    drawn = make_recording(four, impairments=Impairments(bumps=3), seed=7).applied["bumps"]
+    times = sorted(t for t, _ in placed.applied["bumps"])
+    assert times == sorted([t for t, _ in drawn] + [1.25, 2.5])
+    with pytest.raises(ParameterError, match="bump_times"):
+        Impairments(bump_times=(-1.0,))
 
 
 def test_resampling_keeps_the_truth_and_quantization_the_grid(four):
