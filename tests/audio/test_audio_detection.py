@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import corpus
 import numpy as np
 import pytest
 import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio import detection as det
+from metrosync.audio.dataset import REFRACTORY
 from metrosync.audio.reader import BLOCK_FRAMES as BLOCK
 from metrosync.audio.reader import open_recording
+from metrosync.show.ticks import voices
 
 
 def scored(path, trains, **options):
@@ -46,6 +49,34 @@ def test_two_metronomes_recall_and_precision_above_99_percent(tmp_path, rng, noi
     recall, precision, errors, ds = scored(synth.write(tmp_path / "two.wav", x), trains)
     assert recall >= 0.99 and precision >= 0.99
     assert np.abs(errors).max() <= 1e-3
+
+
+def test_a_knock_on_the_phone_just_before_a_tick_does_not_time_the_tick(tmp_path):
+    """A hand knocks the phone 1.5–4 ms before a tick: the knock's crack is heard as the
+    rise and the tick, within the refractory time, is not heard apart; its onset was
+    the crack's (corpus seeds 206 and 46, two metronomes, timed 2.5 ms early). Where
+    the rise opens a low thump and falls away before a tick rises, the tick is timed.
+    Knocked ticks within 1 ms: 15 of 48 before, 43 after; the other ticks unchanged."""
+    right, others = [], []
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        train = corpus.steady_train(150.0, 30.0, voice=voices(1, seed)[0], seed=seed,
+                                    jitter_s=0.5e-3)  # fmt: skip
+        knocked = np.sort(rng.choice(np.arange(4, train.times.size - 4), 12, replace=False))
+        lead = rng.uniform(1.5e-3, 4e-3, knocked.size)
+        knocks = tuple(train.times[knocked] - lead)
+        impairments = corpus.Impairments.phone(bumps=0, bump_times=knocks)
+        made = corpus.make_recording([train], impairments=impairments, seed=seed)
+        recording = open_recording(made.write(tmp_path / f"knocks{seed}.wav"))
+        scan = det.scan(recording)
+        hops = det.pick_ticks(scan, round(REFRACTORY * recording.sample_rate / scan.hop))
+        found = np.sort(det.refine(recording, scan, hops).time)
+        truth = made.truth[0].times
+        error = np.min(np.abs(found[None, :] - truth[:, None]), axis=1)
+        right.extend(error[knocked] <= 1e-3)
+        others.extend(np.delete(error, knocked) <= 1e-3)
+    assert np.mean(right) >= 0.85
+    assert np.mean(others) >= 0.98
 
 
 def test_ticks_across_block_boundaries_are_timed_right(pair_recording):

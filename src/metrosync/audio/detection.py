@@ -32,6 +32,15 @@ a tick's resonances can beat and dip after its first impact, whose onset is want
 For a click that starts abruptly it is the click's first sample within a
 few tens of microseconds, and echoes, which come later, do not move it. The strength
 of a tick is its envelope peak (dBFS), also per channel.
+
+A knock on the phone. A hand that knocks the phone makes a crack (a millisecond of
+broadband noise) and a low thump. A crack a few milliseconds before a tick is the
+rise the detector hears, and the tick, within the refractory time, is not heard
+apart: its onset would be the crack's. Where the waveform smoothed over a millisecond
+(what is left of the thump) swings right after the rise (`THUMP_LEVEL`,
+`THUMP_RISE`), and the envelope then falls below `CRACK_DIP` of the crack's and rises
+again within `CRACK_REACH`, the onset is that later rise's, timed the same way from
+the dip.
 """
 
 from __future__ import annotations
@@ -68,6 +77,24 @@ RISE_WINDOW = 2.5e-3
 NOISE_CLEARANCE = 6.0
 #: Half-width of the waveform window timed around each tick, s.
 REFINE_HALF = 6e-3
+#: A knock on the phone opens with a crack, a burst of broadband noise that the
+#: detector hears as a rise, and goes on as a low thump. Its rise is taken for a crack
+#: where the waveform smoothed over this long (s; it keeps the thump, not the clicks)
+THUMP_SMOOTHING = 1e-3
+#: ... swings within this long after the rise (s)
+THUMP_AFTER = 3e-3
+#: ... by more than this times the tick's band-passed peak
+THUMP_LEVEL = 0.5
+#: ... and by this many times more than just before the rise.
+THUMP_RISE = 3.0
+#: The crack's own burst lasts about this long (s) ...
+CRACK_OWN = 0.5e-3
+#: ... and a tick that begins after it is sought this far after it (s), ...
+CRACK_REACH = 5e-3
+#: ... at a peak at least this many times the crack's, after the crack has fallen below
+#: this fraction of its own (a tick's ring does not fall so far so soon).
+CRACK_TICK = 0.5
+CRACK_DIP = 0.2
 #: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
 #: are not ticks, and the logarithms of digital silence stay finite.
 _FLOOR = 1e-10
@@ -316,6 +343,9 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
     reach = round(RISE_WINDOW * half / REFINE_HALF)
     near = (cols[None, :] >= np.maximum(ip - reach, 1)[:, None]) & (cols[None, :] <= ip[:, None])
     first = np.argmax((env >= level[:, None]) & near, axis=1)
+    cracked = _opens_thump(mix, first, peak, half)
+    for r in np.flatnonzero(cracked):
+        first[r], level[r], peak[r] = _after_crack(env[r], first[r], level[r], peak[r], half)
     j = np.maximum(first - 1, 0)
     e0, e1 = env[rows, j], env[rows, np.minimum(j + 1, env.shape[1] - 1)]
     frac = np.clip((level - e0) / np.where(e1 > e0, e1 - e0, 1.0), 0.0, 1.0)
@@ -327,6 +357,42 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
     else:
         channel_peak = peak[:, None]
     return j + frac, peak, channel_peak
+
+
+def _opens_thump(mix: np.ndarray, first: np.ndarray, peak: np.ndarray, half: int) -> np.ndarray:
+    """(n,) True where the rise at ``first`` opens a low-frequency thump: the waveform
+    smoothed over `THUMP_SMOOTHING` (which keeps what is below a few hundred hertz)
+    swings, within `THUMP_AFTER` after the rise, by more than `THUMP_LEVEL` times the
+    band-passed peak, and by `THUMP_RISE` times more than just before the rise."""
+    per_second = half / REFINE_HALF
+    low = ndimage.uniform_filter1d(mix, max(1, round(THUMP_SMOOTHING * per_second)), axis=1)
+    cols = np.arange(mix.shape[1])[None, :]
+    after = (cols >= first[:, None]) & (cols < first[:, None] + THUMP_AFTER * per_second)
+    before = (cols < first[:, None]) & (cols >= first[:, None] - THUMP_AFTER * per_second)
+    low -= (np.sum(np.where(before, low, 0.0), axis=1) / np.maximum(before.sum(axis=1), 1))[:, None]
+    swing_after = np.max(np.where(after, np.abs(low), 0.0), axis=1)
+    swing_before = np.max(np.where(before, np.abs(low), 0.0), axis=1)
+    return (swing_after > THUMP_LEVEL * peak) & (swing_after > THUMP_RISE * swing_before)
+
+
+def _after_crack(env: np.ndarray, first: int, level: float, peak: float, half: int):
+    """(first, level, peak) of the tick that begins after a knock's crack at ``first``,
+    or the same three where none does: the crack, a burst of noise, decays within a
+    millisecond or two; a tick that starts then rises from the dip it leaves to a peak
+    `CRACK_TICK` times the crack's or more, within `CRACK_REACH`."""
+    per_second = half / REFINE_HALF
+    start = first + round(CRACK_OWN * per_second)
+    stop = min(env.size, first + round(CRACK_REACH * per_second))
+    if stop <= start + 2:
+        return first, level, peak
+    crack = env[first:start].max()
+    top = start + int(np.argmax(env[start:stop]))
+    dip = first + int(np.argmin(env[first : top + 1]))
+    if env[top] < CRACK_TICK * crack or env[dip] > CRACK_DIP * crack:
+        return first, level, peak
+    new_level = env[dip] + ONSET_FRACTION * (env[top] - env[dip])
+    rise = dip + int(np.argmax(env[dip : top + 1] >= new_level))
+    return rise, new_level, env[top]
 
 
 def _segments(recording: Recording, starts: np.ndarray, length: int, chunk: int):
