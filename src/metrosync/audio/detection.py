@@ -37,10 +37,10 @@ A knock on the phone. A hand that knocks the phone makes a crack (a millisecond 
 broadband noise) and a low thump. A crack a few milliseconds before a tick is the
 rise the detector hears, and the tick, within the refractory time, is not heard
 apart: its onset would be the crack's. Where the waveform smoothed over a millisecond
-(what is left of the thump) swings right after the rise (`THUMP_LEVEL`,
-`THUMP_RISE`), and the envelope then falls below `CRACK_DIP` of the crack's and rises
-again within `CRACK_REACH`, the onset is that later rise's, timed the same way from
-the dip.
+(what is left of the thump) swings right after the rise and far less before it
+(`THUMP_LEVEL`, `THUMP_RISE`: a tick within a thump already going on is left alone),
+and the envelope then falls below `CRACK_DIP` of the crack's and rises again within
+`CRACK_REACH`, the onset is that later rise's, timed the same way from the dip.
 """
 
 from __future__ import annotations
@@ -83,10 +83,12 @@ REFINE_HALF = 6e-3
 THUMP_SMOOTHING = 1e-3
 #: ... swings within this long after the rise (s)
 THUMP_AFTER = 3e-3
+#: ... more than over this long before it (s)
+THUMP_BEFORE = 5e-3
 #: ... by more than this times the tick's band-passed peak
-THUMP_LEVEL = 0.5
+THUMP_LEVEL = 0.7
 #: ... and by this many times more than just before the rise.
-THUMP_RISE = 3.0
+THUMP_RISE = 5.0
 #: The crack's own burst lasts about this long (s) ...
 CRACK_OWN = 0.5e-3
 #: ... and a tick that begins after it is sought this far after it (s), ...
@@ -362,17 +364,24 @@ def _time_segments(segments: np.ndarray, scan: Scan, half: int):
 def _opens_thump(mix: np.ndarray, first: np.ndarray, peak: np.ndarray, half: int) -> np.ndarray:
     """(n,) True where the rise at ``first`` opens a low-frequency thump: the waveform
     smoothed over `THUMP_SMOOTHING` (which keeps what is below a few hundred hertz)
-    swings, within `THUMP_AFTER` after the rise, by more than `THUMP_LEVEL` times the
-    band-passed peak, and by `THUMP_RISE` times more than just before the rise."""
+    swings, from its lowest to its highest, within `THUMP_AFTER` after the rise by more
+    than `THUMP_LEVEL` times the band-passed peak, and by `THUMP_RISE` times more than
+    over `THUMP_BEFORE` before it (where a thump already goes on, it swings there too)."""
     per_second = half / REFINE_HALF
     low = ndimage.uniform_filter1d(mix, max(1, round(THUMP_SMOOTHING * per_second)), axis=1)
     cols = np.arange(mix.shape[1])[None, :]
     after = (cols >= first[:, None]) & (cols < first[:, None] + THUMP_AFTER * per_second)
-    before = (cols < first[:, None]) & (cols >= first[:, None] - THUMP_AFTER * per_second)
-    low -= (np.sum(np.where(before, low, 0.0), axis=1) / np.maximum(before.sum(axis=1), 1))[:, None]
-    swing_after = np.max(np.where(after, np.abs(low), 0.0), axis=1)
-    swing_before = np.max(np.where(before, np.abs(low), 0.0), axis=1)
-    return (swing_after > THUMP_LEVEL * peak) & (swing_after > THUMP_RISE * swing_before)
+    before = (cols < first[:, None]) & (cols >= first[:, None] - THUMP_BEFORE * per_second)
+    return (_swing(low, after) > THUMP_LEVEL * peak) & (
+        _swing(low, after) > THUMP_RISE * _swing(low, before)
+    )
+
+
+def _swing(values: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """(n,) highest less lowest of each row of ``values`` where ``where`` (0 for none)."""
+    high = np.max(np.where(where, values, -np.inf), axis=1)
+    low = np.min(np.where(where, values, np.inf), axis=1)
+    return np.where(where.any(axis=1), high - low, 0.0)
 
 
 def _after_crack(env: np.ndarray, first: int, level: float, peak: float, half: int):
