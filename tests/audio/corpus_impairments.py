@@ -105,6 +105,11 @@ def impair(x: np.ndarray, rate: int, imp: Impairments, rng, applied: dict) -> np
         x += noise * np.sqrt(power / 10 ** (imp.snr_db / 10)).astype(np.float32)[None, :]
         applied["snr_db"] = imp.snr_db
     if imp.bumps or imp.bump_times:
+        if any(t >= n / rate for t in imp.bump_times):
+            raise ParameterError(
+                f"`bump_times` must lie within the recording's {n / rate:.3f} s, "
+                f"got {imp.bump_times!r}."
+            )
         peak = float(np.abs(x).max())
         bumps = []
         for b in range(imp.bumps + len(imp.bump_times)):

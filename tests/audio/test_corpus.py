@@ -393,6 +393,8 @@ def test_bumps_are_low_thumps_at_the_times_reported(four):
     assert times == sorted([t for t, _ in drawn] + [1.25, 2.5])
     with pytest.raises(ParameterError, match="bump_times"):
         Impairments(bump_times=(-1.0,))
+    with pytest.raises(ParameterError, match="within the recording"):
+        make_recording(four, impairments=Impairments(bump_times=(1e4,)), seed=7)
 
 
 def test_resampling_keeps_the_truth_and_quantization_the_grid(four):

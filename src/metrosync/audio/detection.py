@@ -93,9 +93,10 @@ THUMP_RISE = 5.0
 CRACK_OWN = 0.5e-3
 #: ... and a tick that begins after it is sought this far after it (s), ...
 CRACK_REACH = 5e-3
-#: ... at a peak at least this many times the crack's, after the crack has fallen below
-#: this fraction of its own (a tick's ring does not fall so far so soon).
+#: ... at a peak at least this many times the crack's, ...
 CRACK_TICK = 0.5
+#: ... after the crack has fallen below this fraction of its own (a tick's ring does
+#: not fall so far so soon).
 CRACK_DIP = 0.2
 #: Power floor per sample (−100 dBFS, about the noise of 16-bit sound): quieter rises
 #: are not ticks, and the logarithms of digital silence stay finite.
@@ -372,9 +373,8 @@ def _opens_thump(mix: np.ndarray, first: np.ndarray, peak: np.ndarray, half: int
     cols = np.arange(mix.shape[1])[None, :]
     after = (cols >= first[:, None]) & (cols < first[:, None] + THUMP_AFTER * per_second)
     before = (cols < first[:, None]) & (cols >= first[:, None] - THUMP_BEFORE * per_second)
-    return (_swing(low, after) > THUMP_LEVEL * peak) & (
-        _swing(low, after) > THUMP_RISE * _swing(low, before)
-    )
+    swing = _swing(low, after)
+    return (swing > THUMP_LEVEL * peak) & (swing > THUMP_RISE * _swing(low, before))
 
 
 def _swing(values: np.ndarray, where: np.ndarray) -> np.ndarray:
