@@ -72,10 +72,14 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
         if beat < MIN_BEAT:
             return None
         # every place between two of the train's ticks a divided beat would fill:
-        # (time, beat number, place j of k, kind of the train's beat it follows)
+        # (time, beat number, place j of k, kind of the metronome's beat there). For an
+        # even k the train's ticks are all of one kind, and so are the beats at place j:
+        # one kind per place, however few of the train's beats of either parity a
+        # place was heard after (seed 168: another metronome hid every other tock).
         limp = odd_limp if k % 2 else 0.0  # for an even k the limp cancels (`_limp`)
         rows = [
-            (_place(t[p], t[p + 1], b[p] % 2, n, i, limp), b[p] * k + i, i % k, (b[p] + i // k) % 2)
+            (_place(t[p], t[p + 1], b[p] % 2, n, i, limp), b[p] * k + i, i % k,
+             (b[p] + i // k) % 2 if k % 2 else 0)  # fmt: skip
             for p, n in zip(pairs, step[pairs] * k, strict=True)
             for i in range(1, n)
             if i % k
