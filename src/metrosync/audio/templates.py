@@ -59,8 +59,13 @@ FIT_BEFORE = 3e-3
 FIT_AFTER = 5e-3
 #: Farthest a tick is moved, s.
 SEARCH = 3e-3
-#: A tick less like its train's sound than this is not its metronome's.
+#: A tick less like its train's sound than this is not its metronome's ...
 MIN_LIKENESS = 0.35
+#: ... unless the ticks of its kind (tick or tock) are all less alike: then one less
+#: like it than this share of their median is not its, nor one under `BUMP_LIKENESS`
+#: (a handling bump on the beat: under 0.1).
+LIKENESS_SHARE = 0.6
+BUMP_LIKENESS = 0.15
 #: Filtered beyond each end of a segment, s: the band-pass settles there.
 MARGIN = 3e-3
 
@@ -247,3 +252,22 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     in_ring = np.where(j > 0, h - h[np.maximum(j - 1, 0)], np.inf) <= AFTER
     out[held[in_ring]] = fitted[in_ring]
     return out, likeness
+
+
+def unlike(likeness: np.ndarray, trains: list[Train]) -> np.ndarray:
+    """(K,) True for the ticks that sound too little like their train's sound to be
+    its metronome's (see `MIN_LIKENESS`; NaN: unknown, never unlike). A kind of beat
+    whose every tick the sound explains less well (a softer tock, its first
+    milliseconds more the broadband crack of its impact than its resonances: 0.25-0.3
+    in corpus seed 147) is judged against its own median."""
+    out = likeness < MIN_LIKENESS
+    for t in trains:
+        for kind in (0, 1):
+            mine = t.index[t.beat % 2 == kind]
+            typical = likeness[mine[~t.masked[t.beat % 2 == kind]]]
+            typical = typical[np.isfinite(typical)]
+            if typical.size < MIN_CLEAR:
+                continue
+            limit = np.clip(LIKENESS_SHARE * np.median(typical), BUMP_LIKENESS, MIN_LIKENESS)
+            out[mine] = likeness[mine] < limit
+    return out
