@@ -73,8 +73,9 @@ END_BEATS = 2
 MAX_END_WALK = 64
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
-#: A tick in another's ring this many robust spreads off its beat is unattributed.
-RING_OFF_BEAT = 1.0
+#: A tick in another's ring this many robust spreads off its beat is unattributed: one
+#: spread dropped a metronome's usual ticks that happened to fall in a ring.
+RING_OFF_BEAT = 2.5
 
 
 def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.ndarray, np.ndarray]:
