@@ -205,7 +205,7 @@ def analyze_audio(
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
-    label = nearer_another(ticks.time, trains, _labels(k, trains))
+    label = nearer_another(ticks.time, trains, _labels(k, trains), likeness)
     label[templates.unlike(likeness, trains)] = -1  # a bump on the beat, not a tick
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)

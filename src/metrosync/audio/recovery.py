@@ -73,9 +73,12 @@ END_BEATS = 2
 MAX_END_WALK = 64
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
-#: A tick in another's ring this many robust spreads off its beat is unattributed: one
-#: spread dropped a metronome's usual ticks that happened to fall in a ring.
-RING_OFF_BEAT = 2.5
+#: A tick in another's ring this many robust spreads off its beat is unattributed ...
+RING_OFF_BEAT = 1.0
+#: ... or this many, where the sum of the sounds explains it this well (likeness): its
+#: onset was fitted, and one spread dropped a metronome's usual ticks in a ring.
+FITTED_OFF_BEAT = 2.5
+FITTED_LIKENESS = 0.7
 
 
 def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -414,15 +417,18 @@ def _own_offset(times: np.ndarray, train: Train) -> np.ndarray:
     return out
 
 
-def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) -> np.ndarray:
+def nearer_another(
+    times: np.ndarray, trains: list[Train], label: np.ndarray, likeness: np.ndarray | None = None
+) -> np.ndarray:
     """(K,) ``label`` (the metronome of each tick, −1 for none) with −1 for each tick
     that lies nearer another train's beat (a tick it heard, or one it missed or took
     from another, where predicted) than its own train's beat puts it, within the
     detector's resolution (two metronomes ticked together there and the tick's onset
     may be either's); and for each tick that falls within `RING` after another train's
     tick and lies off its own beat by more than `RING_OFF_BEAT` of its train's robust
-    spread (at least a millisecond): its onset is timed by the other's later impacts
-    and ring."""
+    spread (at least a millisecond; `FITTED_OFF_BEAT` where its ``likeness`` (K,) to
+    its sound is at least `FITTED_LIKENESS`): its onset is timed by the other's later
+    impacts and ring."""
     out = label.copy()
     if len(trains) < 2:
         return out
@@ -455,7 +461,10 @@ def nearer_another(times: np.ndarray, trains: list[Train], label: np.ndarray) ->
             before = x - heard[j][np.maximum(q - 1, 0)]
             since = np.minimum(since, np.where((q > 0) & (before > 0), before, np.inf))
         spread = 1.4826 * np.nanmedian(np.abs(offset - np.nanmedian(offset)))
-        limit = max(1e-3, RING_OFF_BEAT * spread) if np.isfinite(spread) else np.inf
+        bar = np.full(x.size, RING_OFF_BEAT)
+        if likeness is not None:
+            bar[likeness[mine] >= FITTED_LIKENESS] = FITTED_OFF_BEAT
+        limit = np.maximum(1e-3, bar * spread) if np.isfinite(spread) else np.inf
         drop = (other < own) & (other <= det.RESOLUTION)
         drop |= (since <= RING) & (own > limit)
         out[mine[drop]] = -1
