@@ -78,8 +78,12 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
         # place was heard after (seed 168: another metronome hid every other tock).
         limp = odd_limp if k % 2 else 0.0  # for an even k the limp cancels (`_limp`)
         rows = [
-            (_place(t[p], t[p + 1], b[p] % 2, n, i, limp), b[p] * k + i, i % k,
-             (b[p] + i // k) % 2 if k % 2 else 0)  # fmt: skip
+            (
+                _place(t[p], t[p + 1], b[p] % 2, n, i, limp),
+                b[p] * k + i,
+                i % k,
+                (b[p] + i // k) % 2 if k % 2 else 0,
+            )
             for p, n in zip(pairs, step[pairs] * k, strict=True)
             for i in range(1, n)
             if i % k

@@ -169,10 +169,10 @@ def _lined_up(waves: np.ndarray, kinds: np.ndarray, use: np.ndarray, onset: int,
         if rows.size < MIN_CLEAR:
             continue
         for _ in range(2):  # against the mean of the ticks as moved so far
-            mean = np.mean([waves[r, lo + s : hi + s] for r, s in zip(rows, shift[rows],
-                                                                     strict=True)], axis=0)  # fmt: skip
-            lags = np.array([np.argmax(np.correlate(waves[r, lo - reach : hi + reach], mean, "valid"))
-                             for r in rows]) - reach  # fmt: skip
+            moved = [waves[r, lo + s : hi + s] for r, s in zip(rows, shift[rows], strict=True)]
+            mean = np.mean(moved, axis=0)
+            reads = [waves[r, lo - reach : hi + reach] for r in rows]
+            lags = np.array([np.argmax(np.correlate(x, mean, "valid")) for x in reads]) - reach
             shift[rows] = lags - int(np.median(lags))
     return shift
 
