@@ -181,3 +181,38 @@ def test_a_train_of_later_impacts_seen_once_its_metronome_is_complete_is_no_tick
     assert kept_ticks.time.size == times.size - echo.size
     assert np.array_equal(kept_ticks.time[kept[0].index], times[np.sort(own)])
     assert np.array_equal(kept_ticks.time[kept[1].index], times[np.sort(theirs)])
+
+
+def test_two_metronomes_at_four_to_three_are_not_one_of_their_common_beat():
+    """Corpus seed 81: metronomes at 143.4 and 191.2 BPM (4:3 within 0.01 %), the
+    second's ticks and tocks of different sounds. A train of all the first's beats and
+    one of the second's ticks lie on one grid (286.8 BPM: every 2nd and every 3rd of
+    its beats), which then never sounds on two beats of every six: two metronomes,
+    not one followed in pieces."""
+    slow = ticks(95, beat=60 / 143.4, limp=0.0)
+    fast = ticks(127, beat=60 / 191.2, limp=0.0, start=0.3, seed=1)
+    # where the two tick together the detector hears one tick, which both trains hold
+    apart = np.min(np.abs(fast[:, None] - slow[None, :]), axis=1) > 5e-3
+    times, (a, _) = indexed(slow, fast[apart])
+    b = np.argmin(np.abs(fast[:, None] - times[None, :]), axis=1)
+    whole = train(a, times, 60 / 143.4)
+    its_ticks = train(b[::2], times, 2 * 60 / 191.2)
+    joined, _ = join_fragments(times, [whole, its_ticks], [0, 1])
+    assert len(joined) == 2
+
+
+def test_pieces_of_one_metronome_whose_other_beats_hide_behind_another_are_one():
+    """Corpus seed 162: one metronome followed as a train of every 2nd beat and one of
+    every 4th; the beats left, one in four, each fall 28 ms after another metronome's
+    tick, in its ring, and are not heard. Those places are not silent: another's tick
+    just before hides them."""
+    mine = ticks(100)
+    k = np.arange(mine.size)
+    hider = mine[k % 4 == 3] - 0.028
+    times, (own, _) = indexed(mine[k % 4 != 3], hider)
+    kept = k[k % 4 != 3]
+    halves = train(own[kept % 2 == 0], times, 2 * BEAT)
+    quarters = train(own[kept % 4 == 1], times, 4 * BEAT)
+    joined, _ = join_fragments(times, [halves, quarters], [0, 1])
+    assert len(joined) == 1
+    assert abs(joined[0].period / BEAT - 1) < 1e-3

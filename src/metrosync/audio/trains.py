@@ -47,7 +47,10 @@ the second's ticks fall on the first's grid of beats T (circular spread below
 it by under `MAX_DRIFT` of a beat over their shared time: two metronomes of nearly
 one tempo drift by more), almost never (10 %) within 0.3 T of the first's own ticks
 (a tick both hold is one tick, heard on both grids: every 2nd beat and every 3rd
-meet on every 6th; but at most half of the second's ticks);
+meet on every 6th; but at most half of the second's ticks), and the two leave no
+kind of beat of that grid (its number modulo their common cycle) where hardly any
+tick is heard, or hidden just behind another's: metronomes at a whole-number ratio of
+tempo (4:3) lie on one grid too, and never sound on some of its beats;
 or when one takes up the other's beat (the same period, or a whole multiple of it,
 within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
 15 %, after the other's last). (Two metronomes locked a whole
@@ -96,6 +99,13 @@ NEIGHBOURS = 3
 REFITS = 5
 #: Beats searched for a seed's successor, s (300 to 30 BPM).
 BEAT_RANGE = (0.2, 2.0)
+#: A kind of beat that two pieces of one metronome leave to others is heard at least
+#: this share of its places (within this share of a beat), held or not.
+HEARD_SILENT = 0.5
+SILENT_WINDOW = 0.04
+#: ... or where another's tick began up to this long before (s): its impacts and ring
+#: can hide one.
+HIDING = 0.045
 
 
 @dataclass(frozen=True)
@@ -607,8 +617,36 @@ def _common_beat(times: np.ndarray, ta: Train, tb: Train) -> float | None:
         off_grid = abs(np.angle(z) / (2 * np.pi))
         if spread < 2 * LOCKED_SPREAD and off_grid < 0.15:
             if _drift(t_b[inside], tb.beat[inside], gap_before / beat, z) < MAX_DRIFT:
-                return beat
+                if not _silent_beats(times, ta, tb, beat, math.lcm(ka, kb)):
+                    return beat
     return None
+
+
+def _silent_beats(times: np.ndarray, ta: Train, tb: Train, beat: float, cycle: int) -> bool:
+    """Whether trains a and b, joined on ``beat``, leave a kind of beat (its number
+    modulo ``cycle``, the pieces' common cycle) that neither holds and where hardly
+    any tick at all is heard (under `HEARD_SILENT` of those places, within
+    `SILENT_WINDOW` of a beat or `HIDING` before): two metronomes at a whole-number
+    ratio of tempo, not one metronome's pieces, whose other beats sound (held by
+    another piece, by none, or hidden behind another metronome's tick)."""
+    merged = _merge(times, ta, tb, beat)
+    b, t = merged.beat, times[merged.index]
+    # beats held only every g-th of the grid: the pieces' metronome ticks on that
+    # coarser grid, where the grid between is silent anyway
+    g = int(np.gcd.reduce(np.append(np.unique(b % cycle), cycle)))
+    b, cycle, beat = b // g, cycle // g, beat * g
+    missing = np.setdiff1d(np.arange(cycle), np.unique(b % cycle))
+    if missing.size == 0:
+        return False
+    numbers = np.arange(b[0], b[-1])
+    numbers = numbers[np.isin(numbers % cycle, missing)]
+    if numbers.size < 4:
+        return False
+    at = np.interp(numbers, b, t)
+    # heard: a tick near the place, or one just before that may hide it
+    first = np.searchsorted(times, at - HIDING)
+    last = np.searchsorted(times, at + SILENT_WINDOW * beat, side="right")
+    return bool(np.mean(last > first) < HEARD_SILENT)
 
 
 def _drift(t: np.ndarray, beat: np.ndarray, place: np.ndarray, z: complex) -> float:
