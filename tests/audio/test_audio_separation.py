@@ -174,6 +174,16 @@ def test_one_to_four_metronomes_of_distinct_sounds_on_one_channel(tmp_path):
     _assert_each_metronome_meets_the_issue(table)
 
 
+def test_a_metronome_whose_beats_another_covers_past_its_trains_end_is_followed_on(tmp_path):
+    """Corpus seed 176, four metronomes: 193.2 and 190.9 BPM meet near the end. The
+    first's train stopped there, and its walk by sound stopped at the two beats the
+    other's ticks covered: its last nine ticks, each heard alone, were no one's
+    (recall 0.91). The walk now seeks up to six beats on."""
+    ds, truth = recording(tmp_path, 4, 176)
+    assert ds.attrs["metronomes"] == 4
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
 @pytest.mark.parametrize("same_voice", [False, True], ids=["two makes", "one make"])
 def test_two_free_running_metronomes_4_bpm_apart_are_two(tmp_path, same_voice):
     ds, truth = recording(tmp_path, 2, 3, same_voice=same_voice, bpms=[100.0, 104.0],

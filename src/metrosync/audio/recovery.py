@@ -34,7 +34,8 @@ curve's highest point alone is not enough there: beyond a train's end it is as
 often the room's noise. A heard tick found so keeps the detector's onset unless it
 lies in another's ring. Where the tracker gave up on a train before the file ended,
 the search walks on, `END_BEATS` at a time, while the train's sound is found there
-(at most `MAX_END_WALK` steps). Up to `ROUNDS` rounds of all this: a beat found by its
+within `END_SKIP` beats (at most `MAX_END_WALK` steps): another metronome's ticks may
+cover the first beats beyond the end. Up to `ROUNDS` rounds of all this: a beat found by its
 sound lets the next round predict the beats beside it.
 
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
@@ -71,6 +72,9 @@ RING = 0.04
 END_BEATS = 2
 #: Steps of that walk, at most.
 MAX_END_WALK = 64
+#: Where a step finds nothing (another metronome's ticks cover those beats), the beats
+#: up to this many beyond the end are sought before the walk stops.
+END_SKIP = 6
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
 #: A tick in another's ring this many robust spreads off its beat is unattributed ...
@@ -249,8 +253,13 @@ def recover(recording, scan, ticks, trains: list[Train]):
         # a train the tracker gave up on before the file ended: walked on, `END_BEATS`
         # at a time, while its beats are found where its sound is
         for _ in range(MAX_END_WALK):
-            ticks, trains, added, joined = _by_sound(recording, scan, ticks, trains, sounds,
-                                                     gaps=False)  # fmt: skip
+            # beats just beyond an end that another metronome's ticks cover: further on
+            for beyond in range(END_BEATS, END_SKIP + 1, END_BEATS):
+                ticks, trains, added, joined = _by_sound(
+                    recording, scan, ticks, trains, sounds, gaps=False, beyond=beyond
+                )
+                if added + joined:
+                    break
             recovered += added
             found += added + joined
             if added + joined == 0:
@@ -260,7 +269,16 @@ def recover(recording, scan, ticks, trains: list[Train]):
     return ticks, trains, recovered
 
 
-def _by_sound(recording, scan, ticks, trains: list[Train], sounds, *, gaps: bool = True):
+def _by_sound(
+    recording,
+    scan,
+    ticks,
+    trains: list[Train],
+    sounds,
+    *,
+    gaps: bool = True,
+    beyond: int = END_BEATS,
+):
     """(ticks, trains, ticks added, heard ticks joined): each beat still missed (with
     ``gaps``), and the `END_BEATS` beyond each end of a train, sought by the train's own
     sound (``sounds``, `templates.learn`) within `templates.SEARCH` of the prediction,
@@ -279,8 +297,8 @@ def _by_sound(recording, scan, ticks, trains: list[Train], sounds, *, gaps: bool
     for m, train in enumerate(trains):
         if sounds[m] is None:
             continue
-        for beyond in (0, END_BEATS) if gaps else (END_BEATS,):
-            n, p = _predictions(ticks.time, train, beyond)
+        for reach in (0, beyond) if gaps else (beyond,):
+            n, p = _predictions(ticks.time, train, reach)
             ok = (p > lo) & (p < hi)
             metronomes += [m] * int(ok.sum())
             beats.append(n[ok])
