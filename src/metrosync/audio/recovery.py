@@ -35,8 +35,8 @@ often the room's noise. A heard tick found so keeps the detector's onset unless 
 lies in another's ring. Where the tracker gave up on a train before the file ended,
 the search walks on, `END_BEATS` at a time, while the train's sound is found there
 within `END_SKIP` beats (at most `MAX_END_WALK` steps): another metronome's ticks may
-cover the first beats beyond the end. Up to `ROUNDS` rounds of all this: a beat found by its
-sound lets the next round predict the beats beside it.
+cover the first beats beyond the end. Up to `ROUNDS` rounds of all this: a beat found
+by its sound lets the next round predict the beats beside it.
 
 `nearer_another(times, trains, label)` takes a tick's metronome away (−1) where the
 tick lies nearer another train's beat than its own train's beat puts it, within the
@@ -280,8 +280,8 @@ def _by_sound(
     beyond: int = END_BEATS,
 ):
     """(ticks, trains, ticks added, heard ticks joined): each beat still missed (with
-    ``gaps``), and the `END_BEATS` beyond each end of a train, sought by the train's own
-    sound (``sounds``, `templates.learn`) within `templates.SEARCH` of the prediction,
+    ``gaps``), and the ``beyond`` beats past each end of a train, sought by the train's
+    own sound (``sounds``, `templates.learn`) within `templates.SEARCH` of the prediction,
     beside the other trains' sounds: kept where it sounds like the train
     (`FOUND_LIKENESS`) and no tick is within the detector's resolution of it; a tick
     heard there that no train holds is the one found, timed on the sounds only where it

@@ -291,8 +291,9 @@ def unlike(likeness: np.ndarray, trains: list[Train]) -> np.ndarray:
     out = likeness < MIN_LIKENESS
     for t in trains:
         for kind in (0, 1):
-            mine = t.index[t.beat % 2 == kind]
-            typical = likeness[mine[~t.masked[t.beat % 2 == kind]]]
+            of_kind = t.beat % 2 == kind
+            mine = t.index[of_kind]
+            typical = likeness[t.index[of_kind & ~t.masked]]
             typical = typical[np.isfinite(typical)]
             if typical.size < MIN_CLEAR:
                 continue
