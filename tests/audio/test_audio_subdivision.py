@@ -191,6 +191,37 @@ def test_a_faint_train_at_a_fixed_lag_beyond_a_tick_is_its_echo(drop_db, folded,
     assert (len(parts) == 1 and set(parts[0]) == set(b.index)) == folded
 
 
+def test_a_train_that_took_its_tocks_later_impacts_gets_their_first_ones():
+    """Corpus seed 209, four metronomes: one metronome's train took its ticks and, on
+    the tocks' beats, each tock's later impact 27 ms on; the tocks' first impacts, 8 dB
+    louder, were a train of every second beat of their own. That train, ahead of every
+    second tick at a fixed lag, was folded away as a pre-echo, and the metronome heard
+    tick by tick was wrong on every tock. Louder than the ticks it comes before, it is
+    their first impact: the metronome's train takes it instead."""
+    rng = np.random.default_rng(209)
+    beat = 60 / 168.7
+    n = np.arange(100)
+    on = 0.1 + n * beat + rng.normal(0, 0.4e-3, n.size)
+    tock = n % 2 == 1
+    heard_later = tock & (rng.uniform(size=n.size) > 0.2)  # a fifth of them hidden
+    later = on[heard_later] + 0.02746 + rng.normal(0, 0.05e-3, int(heard_later.sum()))
+    times = np.concatenate([on, later])
+    strength = np.concatenate([np.where(tock, -12.0, -10.0), np.full(later.size, -20.0)])
+    order = np.argsort(times)
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    a_ticks = np.concatenate([where[n[~tock]], where[100:]])
+    a_beats = np.concatenate([n[~tock], n[heard_later]])
+    sort = np.argsort(a_beats)
+    a = Train(a_ticks[sort], a_beats[sort], beat, np.zeros(a_ticks.size, bool))
+    b = Train(where[n[tock]], np.arange(50), 2 * beat, np.zeros(50, bool))
+    kept, _, parts = fold_parts(times[order], [a, b], [0, 1], strength[order])
+    assert len(kept) == 1
+    (metronome,) = kept
+    assert np.array_equal(metronome.index, where[n]) and np.array_equal(metronome.beat, n)
+    assert set(np.concatenate(parts)) == set(where[100:])
+
+
 def test_a_tock_far_fainter_than_its_tick_is_not_its_echo():
     """Corpus seed 72: a metronome's tocks, 18.6 dB fainter than its ticks, half a beat
     on. Their lag from the tick before moves with the metronome's beat (its jitter),

@@ -387,7 +387,9 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
     A train B is part of a train A when B's ticks keep a fixed lag (spread below
     `PART_LAG_SPREAD`), within `MAX_TICK_LENGTH`, to A's, and either B's period is a
     multiple (2 or more) of A's (a sound ahead of or after every few ticks: the
-    pre-echo a lossy coder smears ahead of a click) or it is A's period, B comes after
+    pre-echo a lossy coder smears ahead of a click, so fainter than the ticks it comes
+    before: one louder is their first impact, A's train having taken a later one; corpus
+    seed 209) or it is A's period, B comes after
     A and is fainter (``strength`` (K,), dB): a later impact of each tick that sounds
     different from the first. A later impact at least `LATER_FAINTER` dB fainter is
     timed in the first one's ring: its lag may spread twice as much (an echo beyond
@@ -399,6 +401,7 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
     milliseconds apart keep a lag that wanders by more than that, as each one's beat
     jitters.
     """
+    trains = list(trains)
     keep = [True] * len(trains)
     folded = []
     for b, tb in enumerate(trains):
@@ -411,8 +414,8 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
                 continue
             t_a, t_b = times[ta.index], times[tb.index]
             j = np.clip(np.searchsorted(t_a, t_b), 1, t_a.size - 1)
-            lag = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b),
-                           t_b - t_a[j], t_b - t_a[j - 1])  # fmt: skip
+            nearer = np.where(np.abs(t_a[j] - t_b) < np.abs(t_a[j - 1] - t_b), j, j - 1)
+            lag = t_b - t_a[nearer]
             drop = (
                 float(np.mean(strength[ta.index]) - np.mean(strength[tb.index]))
                 if strength is not None
@@ -434,11 +437,45 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
                 continue
             if k == 1 and (middle <= 0 or strength is None or drop <= 1.0):
                 continue
+            if k > 1 and middle < 0 and strength is not None and np.mean(
+                strength[tb.index]) >= np.mean(strength[ta.index[nearer]]):  # fmt: skip
+                trains[a], later = _first_impacts_taken(times, ta, tb, nearer, lag, limit)
+                keep[b] = False
+                folded.append(later)
+                break
             keep[b] = False
             folded.append(tb.index[~tb.masked])
             break
     return ([t for t, k in zip(trains, keep, strict=True) if k],
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
+
+
+def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, limit: float):
+    """(A with B's ticks in place of the ticks of A's that each comes before at the
+    usual lag, and on the beats where A had none, those ticks of A's): B, louder and
+    ahead of every k-th of A's ticks at a fixed lag, is their first impact, where A's
+    train took a later one (or, once another's tick hid it, none)."""
+    middle = float(np.median(lag))
+    paired = np.abs(lag - middle) <= 3 * limit
+    at, first = np.unique(nearer[paired], return_index=True)
+    taken = np.flatnonzero(paired)[first]
+    index, masked = ta.index.copy(), ta.masked.copy()
+    later = index[at]
+    index[at], masked[at] = tb.index[taken], tb.masked[taken]
+    # the rest of B's ticks on the beats of A's they come before, where A has no tick
+    rest = np.setdiff1d(np.arange(tb.index.size), taken)
+    ref = nearer[rest]
+    number = ta.beat[ref] + np.round((times[tb.index[rest]] - middle - times[ta.index[ref]])
+                                     / ta.period).astype(ta.beat.dtype)  # fmt: skip
+    new, once = np.unique(number, return_index=True)
+    free = ~np.isin(new, ta.beat)
+    rest = rest[once[free]]
+    beat = np.concatenate([ta.beat, new[free]])
+    index = np.concatenate([index, tb.index[rest]])
+    masked = np.concatenate([masked, tb.masked[rest]])
+    order = np.argsort(beat, kind="stable")
+    beat = beat[order] - beat.min()  # one before A's first tick is beat 0
+    return Train(index[order], beat, ta.period, masked[order]), later
 
 
 def first_impacts(
