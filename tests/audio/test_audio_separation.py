@@ -194,6 +194,19 @@ def test_a_tick_far_off_its_beat_does_not_move_the_beats_beside_it(tmp_path):
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
+def test_a_metronome_another_covers_for_seven_beats_past_its_trains_end_is_followed_on(
+    tmp_path,
+):
+    """Corpus seed 74, four metronomes: near the end, another metronome's ticks fell
+    within 1-8 ms of one's for seven beats in a row (their tempi drift through each
+    other slowly). Its train stopped there, and its last four ticks, each heard alone,
+    were no one's (recall 0.94): the walk past the end sought six beats on. It now
+    seeks ten."""
+    ds, truth = recording(tmp_path, 4, 74)
+    assert ds.attrs["metronomes"] == 4
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
 @pytest.mark.parametrize("same_voice", [False, True], ids=["two makes", "one make"])
 def test_two_free_running_metronomes_4_bpm_apart_are_two(tmp_path, same_voice):
     ds, truth = recording(tmp_path, 2, 3, same_voice=same_voice, bpms=[100.0, 104.0],

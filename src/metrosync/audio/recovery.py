@@ -79,8 +79,9 @@ END_BEATS = 2
 #: Steps of that walk, at most.
 MAX_END_WALK = 64
 #: Where a step finds nothing (another metronome's ticks cover those beats), the beats
-#: up to this many beyond the end are sought before the walk stops.
-END_SKIP = 6
+#: up to this many beyond the end are sought before the walk stops (corpus seed 74:
+#: another's ticks covered seven beats in a row).
+END_SKIP = 10
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
 #: A tick in another's ring this many robust spreads off its beat is unattributed ...
