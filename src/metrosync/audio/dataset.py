@@ -50,6 +50,7 @@ from ..observables.order import equilibrium_order
 from . import detection as det
 from . import templates
 from .attribution import phase_difference
+from .fills import given_back
 from .hidden import hidden_count, hidden_trains
 from .interleaved import join_interleaved
 from .metronome import beat_statistics
@@ -146,6 +147,7 @@ def analyze_audio(
     trains = [_on_ticks(t, where) for t in sep.trains]
     trains = subdivided(ticks.time, trains)
     trains = join_interleaved(ticks.time, ticks.strength, trains)
+    trains = given_back(ticks.time, trains)
     ticks, trains, recovered = recover(recording, scan, ticks, trains)
     ticks, trains = _later_impacts_folded(ticks, trains)
     ticks, trains, likeness = _retimed(recording, scan, ticks, trains)
