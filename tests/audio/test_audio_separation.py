@@ -334,17 +334,33 @@ def test_files_not_recorded_together_draw_a_warning(tmp_path):
 def test_metronomes_hidden_behind_each_other_are_not_counted_twice(tmp_path, n, seed):
     """The corpus's two recordings where two metronomes at nearly one tempo tick
     together all along, one hidden behind the other most of the time (three
-    metronomes, seed 5: 180.6 and 180.8 BPM; four, seed 1: 193.9 and 193.1 BPM): the
-    two are said to be beyond telling apart, counted once each and not as extra
-    metronomes, and only the metronomes told apart get per-metronome figures, each
-    its own true metronome's ticks."""
+    metronomes, seed 5: 180.6 and 180.8 BPM; four, seed 1: 193.9 and 193.1 BPM): they
+    are counted once each, not as extra metronomes. Either they are said to be beyond
+    telling apart, and only the metronomes told apart get per-metronome figures, or
+    they are told apart by their sounds: then every metronome given figures is one
+    true metronome, at least 90 % of its ticks that one's, no two the same one. (Told
+    apart since the groupings by sound kept in case tempo alone makes more metronomes
+    may borrow a third of their ticks: seed 5's three each hold 98-100 % of their
+    heard ticks; seed 1's pair hold their own ticks, but the one hidden 77 % of the
+    time only those found where its beat put them, none of the few heard alone.)"""
     ds, truth = recording(tmp_path, n, seed)
     assert min(hearable(truth, k).mean() for k in range(n)) < 0.5
     assert ds.attrs["metronomes"] == n
-    assert ds.attrs["metronomes_hidden"] == 2
-    assert "2 metronomes could not be told apart" in ds.attrs["summary"]
-    assert ds.sizes["metronome"] == n - 2
-    assert 0 <= ds.attrs["hidden_r_acoustic"] <= 1 and ds.attrs["hidden_clusters"] >= 1
+    hidden = ds.attrs["metronomes_hidden"]
+    assert ds.sizes["metronome"] == n - hidden
+    if hidden:
+        assert hidden == 2
+        assert "2 metronomes could not be told apart" in ds.attrs["summary"]
+        assert 0 <= ds.attrs["hidden_r_acoustic"] <= 1 and ds.attrs["hidden_clusters"] >= 1
+    found, label = ds.tick_time.values, ds.tick_metronome.values
+    whose = []
+    for m in range(ds.sizes["metronome"]):
+        mine = found[label == m]
+        own = [np.mean(np.min(np.abs(mine[:, None] - t[None, :]), axis=1) <= 1e-3)
+               for t in truth]  # fmt: skip
+        assert max(own) >= 0.9
+        whose.append(int(np.argmax(own)))
+    assert len(set(whose)) == len(whose)
     told = scores(ds, truth)
     together = np.argsort([np.median(np.diff(t)) for t in truth])  # the two fastest
     alone = [k for k in range(n) if k not in together[:2]]
