@@ -6,7 +6,8 @@ One entry point, `analyze_audio(path)`; the steps are modules of their own:
 ticks followed as one train per metronome), `separation` (the two together: the
 metronomes told apart), `subdivision` (a train on every k-th beat of its metronome
 given the beats between), `interleaved` (one metronome followed as two trains, each
-on its own kind of beat and the other kind's later impacts, joined), `recovery`
+on its own kind of beat and the other kind's later impacts, joined), `fills` (a
+train made of another's missed beats, given back to it), `recovery`
 (ticks another hid, found again), `templates`
 (each metronome's learned sound: ticks in another's ring timed on it), `together`
 (several microphones aligned), `metronome` (one metronome's tempo, jitter and beat),
