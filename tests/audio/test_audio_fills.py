@@ -85,3 +85,13 @@ def test_a_fragment_at_a_whole_multiple_is_left_to_the_joins():
     a = train(mine[beat % 3 != 0], beat[beat % 3 != 0], 60 / 157.0)
     b = train(mine[beat % 3 == 0], beat[beat % 3 == 0] // 3, 3 * 60 / 157.0)
     assert given_back(times, [a, b]) == [a, b]
+
+
+def test_a_train_of_a_few_ticks_takes_none():
+    """Too few ticks to put a beat on: nothing is given to it (and nothing fails)."""
+    own = metronome(157.0, 100, seed=7)
+    times, (mine,) = indexed(own)
+    beat = np.arange(100)
+    a = train(mine[:1], beat[:1], 60 / 157.0)
+    b = train(mine[1:], beat[1:], 60 / 157.0 * 1.5)
+    assert given_back(times, [a, b]) == [a, b]

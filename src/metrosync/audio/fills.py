@@ -40,7 +40,7 @@ def given_back(times: np.ndarray, trains: list[Train]) -> list[Train]:
         dissolved = False
         for b, tb in enumerate(out):
             for a, ta in enumerate(out):
-                if a == b or _whole_multiple(tb.period, ta.period):
+                if a == b or ta.index.size < MIN_FILLS or _whole_multiple(tb.period, ta.period):
                     continue
                 number, fills = _fills(times, ta, tb)
                 if fills.sum() < max(MIN_FILLS, MIN_SHARE * tb.index.size):
