@@ -53,9 +53,12 @@ tick is heard, or hidden just behind another's: metronomes at a whole-number rat
 tempo (4:3) lie on one grid too, and never sound on some of its beats;
 or when one takes up the other's beat (the same period, or a whole multiple of it,
 within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
-15 %, after the other's last). (Two metronomes locked a whole
-number of beats apart at whole-number ratios of tempo would be taken for one;
-synchronized metronomes tick together, on each other's ticks.)
+15 %, after the other's last). Two ticks of the joined pieces within half a beat and
+`MAX_TICK_LENGTH` are one (a tick and its later impact); two within half a beat but
+farther apart are another metronome's sound on that beat, and the pieces are not
+one. (Two metronomes locked a whole number of beats apart at whole-number ratios of
+tempo would be taken for one; synchronized metronomes tick together, on each other's
+ticks.)
 """
 
 from __future__ import annotations
