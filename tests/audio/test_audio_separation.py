@@ -353,11 +353,10 @@ def test_metronomes_hidden_behind_each_other_are_not_counted_twice(tmp_path, n, 
     are counted once each, not as extra metronomes. Either they are said to be beyond
     telling apart, and only the metronomes told apart get per-metronome figures, or
     they are told apart by their sounds: then every metronome given figures is one
-    true metronome, at least 90 % of its ticks that one's, no two the same one. (Told
-    apart since the groupings by sound kept in case tempo alone makes more metronomes
-    may borrow a third of their ticks: seed 5's three each hold 98-100 % of their
-    heard ticks; seed 1's pair hold their own ticks, but the one hidden 77 % of the
-    time only those found where its beat put them, none of the few heard alone.)"""
+    true metronome, at least 90 % of its ticks that one's, no two the same one. (Seed
+    5 is told apart since the groupings by sound kept in case tempo alone makes more
+    metronomes may borrow a third of their ticks: its three each hold 98-100 % of
+    their heard ticks. Seed 1's pair is said to be beyond telling apart.)"""
     ds, truth = recording(tmp_path, n, seed)
     assert min(hearable(truth, k).mean() for k in range(n)) < 0.5
     assert ds.attrs["metronomes"] == n
