@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .trains import OFF_BEAT, Train
+from .trains import OFF_BEAT, Train, with_ticks
 
 #: Share of a train's ticks on another's missed beats that makes it that one's.
 MIN_SHARE = 0.5
@@ -45,7 +45,7 @@ def given_back(times: np.ndarray, trains: list[Train]) -> list[Train]:
                 number, fills = _fills(times, ta, tb)
                 if fills.sum() < max(MIN_FILLS, MIN_SHARE * tb.index.size):
                     continue
-                out[a] = _with(ta, tb.index[fills], number[fills])
+                out[a] = with_ticks(ta, tb.index[fills], number[fills])
                 del out[b]
                 dissolved = True
                 break
@@ -82,12 +82,3 @@ def _fills(times: np.ndarray, ta: Train, tb: Train) -> tuple[np.ndarray, np.ndar
     numbers, counts = np.unique(number[fills], return_counts=True)
     fills &= np.isin(number, numbers[counts == 1])
     return number, fills
-
-
-def _with(train: Train, index: np.ndarray, number: np.ndarray) -> Train:
-    """``train`` with the ticks ``index`` added on its beats ``number``."""
-    beat = np.concatenate([train.beat, number])
-    order = np.argsort(beat, kind="stable")
-    index = np.concatenate([train.index, index])[order]
-    masked = np.concatenate([train.masked, np.zeros(number.size, dtype=bool)])[order]
-    return Train(index, beat[order], train.period, masked)

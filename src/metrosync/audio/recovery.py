@@ -52,7 +52,7 @@ import numpy as np
 
 from . import detection as det
 from . import templates as tp
-from .trains import Train, holders, off_the_beat
+from .trains import Train, holders, off_the_beat, with_ticks
 
 WINDOW = 3e-3
 MIN_RISE = 1.0
@@ -237,11 +237,7 @@ def _take_unheld(times: np.ndarray, trains: list[Train], owner, beat, pred):
     out = []
     for m, train in enumerate(trains):
         mine = close & (owner == m)
-        index = np.concatenate([train.index, nearest[mine]])
-        number = np.concatenate([train.beat, beat[mine]])
-        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
-        k = np.argsort(number, kind="stable")
-        out.append(Train(index[k], number[k], train.period, masked[k]))
+        out.append(with_ticks(train, nearest[mine], beat[mine]))
     return out, close
 
 
@@ -415,12 +411,9 @@ def _merged(merged: dict, trains: list[Train], index, owner, beat, *, from_first
     out = []
     for m, train in enumerate(trains):
         mine = owner == m
-        numbers = np.concatenate([train.beat, beat[mine]])
-        masked = np.concatenate([train.masked, np.zeros(int(mine.sum()), dtype=bool)])
-        k = np.argsort(numbers, kind="stable")
-        first = numbers[k[0]] if from_first else 0
-        at = np.concatenate([train.index, index[mine]])[k]
-        out.append(Train(where[at], numbers[k] - first, train.period, masked[k]))
+        added = with_ticks(train, index[mine], beat[mine])
+        first = added.beat[0] if from_first else 0
+        out.append(Train(where[added.index], added.beat - first, train.period, added.masked))
     return new_ticks, out
 
 

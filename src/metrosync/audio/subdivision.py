@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .trains import MAX_FRAGMENT, OFF_BEAT, Train, robust_spread
+from .trains import MAX_FRAGMENT, OFF_BEAT, Train, robust_spread, with_ticks
 
 #: A tick between is sought this far (fraction of the divided beat) from its place.
 WINDOW = 0.15
@@ -105,11 +105,8 @@ def _divided(times: np.ndarray, train: Train, free: np.ndarray) -> Train | None:
         if at is None:
             continue
         ok = at >= 0
-        index = np.concatenate([train.index, free[at[ok]]])
-        numbers = np.concatenate([b * k, number[ok]])
-        masked = np.concatenate([train.masked, np.zeros(int(ok.sum()), dtype=bool)])
-        order = np.argsort(numbers, kind="stable")
-        return Train(index[order], numbers[order], beat, masked[order])
+        divided = Train(train.index, b * k, beat, train.masked)
+        return with_ticks(divided, free[at[ok]], number[ok])
     return None
 
 

@@ -383,6 +383,17 @@ def holders(k: int, trains: list[Train]) -> np.ndarray:
     return out
 
 
+def with_ticks(train: Train, index: np.ndarray, beat: np.ndarray, masked=None) -> Train:
+    """``train`` with the ticks ``index`` added on its beats ``beat``, in beat order;
+    each held as its own unless ``masked`` says it was taken from another voice."""
+    if masked is None:
+        masked = np.zeros(index.size, dtype=bool)
+    number = np.concatenate([train.beat, beat])
+    order = np.argsort(number, kind="stable")
+    return Train(np.concatenate([train.index, index])[order], number[order], train.period,
+                 np.concatenate([train.masked, masked])[order])  # fmt: skip
+
+
 def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strength=None):
     """Trains that are part of another's ticks, folded into it: (trains, voices,
     indices of the folded ticks).
@@ -442,7 +453,7 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
                 continue
             if k > 1 and middle < 0 and strength is not None and np.mean(
                 strength[tb.index]) >= np.mean(strength[ta.index[nearer]]):  # fmt: skip
-                trains[a], later = _first_impacts_taken(times, ta, tb, nearer, lag, limit)
+                trains[a], later = _first_impacts_taken(times, ta, tb, nearer, lag, middle, limit)
                 keep[b] = False
                 folded.append(later)
                 break
@@ -453,12 +464,11 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
             [v for v, k in zip(voice, keep, strict=True) if k], folded)  # fmt: skip
 
 
-def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, limit: float):
+def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, middle: float, limit: float):
     """(A with B's ticks in place of the ticks of A's that each comes before at the
-    usual lag, and on the beats where A had none, those ticks of A's): B, louder and
-    ahead of every k-th of A's ticks at a fixed lag, is their first impact, where A's
-    train took a later one (or, once another's tick hid it, none)."""
-    middle = float(np.median(lag))
+    usual lag ``middle``, and on the beats where A had none, those ticks of A's): B,
+    louder and ahead of every k-th of A's ticks at a fixed lag, is their first impact,
+    where A's train took a later one (or, once another's tick hid it, none)."""
     paired = np.abs(lag - middle) <= 3 * limit
     at, first = np.unique(nearer[paired], return_index=True)
     taken = np.flatnonzero(paired)[first]
@@ -473,12 +483,10 @@ def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, limit: float)
     new, once = np.unique(number, return_index=True)
     free = ~np.isin(new, ta.beat)
     rest = rest[once[free]]
-    beat = np.concatenate([ta.beat, new[free]])
-    index = np.concatenate([index, tb.index[rest]])
-    masked = np.concatenate([masked, tb.masked[rest]])
-    order = np.argsort(beat, kind="stable")
-    beat = beat[order] - beat.min()  # one before A's first tick is beat 0
-    return Train(index[order], beat, ta.period, masked[order]), later
+    out = with_ticks(Train(index, ta.beat, ta.period, masked), tb.index[rest], new[free],
+                     tb.masked[rest])  # fmt: skip
+    # one before A's first tick is beat 0
+    return Train(out.index, out.beat - out.beat[0], out.period, out.masked), later
 
 
 def first_impacts(
@@ -733,7 +741,7 @@ def _clash(times, ta: Train, tb: Train, beat: float) -> bool:
 
 def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
     """The two trains' ticks as one train of beat ``beat``, numbered by the beats
-    between them; of two ticks within half a beat, one."""
+    between them; of two ticks within half a beat and `MAX_TICK_LENGTH`, one."""
     index, first = np.unique(np.concatenate([ta.index, tb.index]), return_index=True)
     masked = np.concatenate([ta.masked, tb.masked])[first]
     # a tick both hold is masked only if both took it from another metronome
