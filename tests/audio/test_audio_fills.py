@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_audio_fragments import indexed, ticks
 
 from metrosync.audio.fills import given_back
 from metrosync.audio.trains import Train
@@ -11,23 +12,7 @@ from metrosync.audio.trains import Train
 
 def metronome(bpm, n, *, limp=0.03, start=0.2, seed=0):
     """Tick times of one metronome: tocks ``limp`` of a beat late, jittered 0.5 ms."""
-    rng = np.random.default_rng(seed)
-    beat = 60.0 / bpm
-    k = np.arange(n)
-    return start + k * beat + np.where(k % 2, limp * beat, 0.0) + rng.normal(0, 0.5e-3, n)
-
-
-def indexed(*groups):
-    """(all times sorted, each group's indices into them)."""
-    times = np.concatenate(groups)
-    order = np.argsort(times)
-    where = np.empty(times.size, dtype=np.int64)
-    where[order] = np.arange(times.size)
-    out, at = [], 0
-    for g in groups:
-        out.append(where[at : at + g.size])
-        at += g.size
-    return times[order], out
+    return ticks(n, beat=60.0 / bpm, limp=limp, start=start, jitter=0.5e-3, seed=seed)
 
 
 def train(index, beat, period):
