@@ -82,7 +82,10 @@ def test_each_example_runs_in_under_30_s(site):
         seconds[script.stem] = 60 * int(minutes) + float(secs)
     slow = {name: s for name, s in seconds.items() if s > 30.0}
     assert not slow, slow
-    assert sum(seconds.values()) > 5.0, seconds  # they did run
+    # Each ran: a script the gallery did not execute is timed at zero. A sum would be a
+    # guess at the machine's speed (a fast one ran all fourteen in 4.6 s).
+    idle = {name: s for name, s in seconds.items() if s <= 0.0}
+    assert not idle, idle
 
 
 def test_the_api_reference_documents_every_public_name(site):
