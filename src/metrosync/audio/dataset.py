@@ -208,7 +208,7 @@ def analyze_audio(
     acoustic = replace(acoustic, floor=floor, excess=excess)
     k = ticks.time.size
     label = nearer_another(ticks.time, trains, _labels(k, trains), likeness)
-    label[templates.unlike(likeness, trains)] = -1  # a bump on the beat, not a tick
+    label[templates.unlike(likeness, trains, ticks.time)] = -1  # a bump on the beat, not a tick
     is_tock = np.full(k, -1, dtype=np.int8)
     interval = np.full(k, np.nan)
     phase = np.full(k, np.nan)

@@ -40,7 +40,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy import signal
 
-from .detection import _segments
+from .detection import RESOLUTION, _segments
 from .trains import Train, holders
 
 #: Sound kept before each onset, s (room for the search below).
@@ -66,6 +66,10 @@ MIN_LIKENESS = 0.35
 #: (a handling bump on the beat: under 0.1).
 LIKENESS_SHARE = 0.6
 BUMP_LIKENESS = 0.15
+#: A tick that begins in another metronome's ring (its impacts and ring vary from tick
+#: to tick, and what the fit leaves of them is counted against the likeness) is not
+#: its train's below this: 0.2-0.32 for a few true ticks 10-60 ms after another's.
+RING_LIKENESS = 0.2
 #: A tick whose own sound fits this much away from its detected onset is timed by the
 #: fit, in a ring or not, s: a tick alone fits within 0.2 ms of its onset (0.6 ms at
 #: most in four corpus recordings of 650 ticks alone).
@@ -341,13 +345,17 @@ def _behind_a_crack(
     likeness[held[low[found]]] = alike[found]
 
 
-def unlike(likeness: np.ndarray, trains: list[Train]) -> np.ndarray:
+def unlike(likeness: np.ndarray, trains: list[Train], times=None) -> np.ndarray:
     """(K,) True for the ticks that sound too little like their train's sound to be
     its metronome's (see `MIN_LIKENESS`; NaN: unknown, never unlike). A kind of beat
     whose every tick the sound explains less well (a softer tock, its first
     milliseconds more the broadband crack of its impact than its resonances: 0.25-0.3
-    in corpus seed 147) is judged against its own median."""
+    in corpus seed 147) is judged against its own median. Given the tick ``times``
+    (s), a tick in another train's ring is judged against `RING_LIKENESS` at most."""
+    ring = _in_anothers_ring(times, trains) if times is not None else None
     out = likeness < MIN_LIKENESS
+    if ring is not None:
+        out[ring] = likeness[ring] < RING_LIKENESS
     for t in trains:
         for kind in (0, 1):
             of_kind = t.beat % 2 == kind
@@ -357,5 +365,24 @@ def unlike(likeness: np.ndarray, trains: list[Train]) -> np.ndarray:
             if typical.size < MIN_CLEAR:
                 continue
             limit = np.clip(LIKENESS_SHARE * np.median(typical), BUMP_LIKENESS, MIN_LIKENESS)
+            if ring is not None:
+                limit = np.where(ring[mine], min(limit, RING_LIKENESS), limit)
             out[mine] = likeness[mine] < limit
+    return out
+
+
+def _in_anothers_ring(times: np.ndarray, trains: list[Train]) -> np.ndarray:
+    """(K,) True for the ticks held by a train that begin in the ring of another train's
+    tick: past the detector's `RESOLUTION` after it, within `AFTER`."""
+    owner = holders(times.size, trains)
+    held = np.flatnonzero(owner >= 0)
+    out = np.zeros(times.size, dtype=bool)
+    for t in trains:
+        others = np.sort(times[held[owner[held] != owner[t.index[0]]]]) if t.index.size else []
+        if len(others) == 0:
+            continue
+        mine = times[t.index]
+        j = np.searchsorted(others, mine - RESOLUTION, side="right") - 1
+        since = np.where(j >= 0, mine - others[np.maximum(j, 0)], np.inf)
+        out[t.index] = since <= AFTER
     return out
