@@ -40,7 +40,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from scipy import signal
 
-from .detection import RESOLUTION, _segments
+from .detection import _segments
 from .trains import Train, holders
 
 #: Sound kept before each onset, s (room for the search below).
@@ -66,10 +66,14 @@ MIN_LIKENESS = 0.35
 #: (a handling bump on the beat: under 0.1).
 LIKENESS_SHARE = 0.6
 BUMP_LIKENESS = 0.15
-#: A tick that begins in another metronome's ring (its impacts and ring vary from tick
-#: to tick, and what the fit leaves of them is counted against the likeness) is not
-#: its train's below this: 0.2-0.32 for a few true ticks 10-60 ms after another's.
+#: A tick that begins in another metronome's ring past its later impacts (its ring
+#: varies from tick to tick, and what the fit leaves of it counts against the
+#: likeness) is not its train's below this: 0.24-0.26 for true ticks 41 ms after
+#: another's (corpus seeds 4/24, 4/138). Among the later impacts a tick that unlike
+#: may be timed by them (1.2-1.6 ms off 32-35 ms after another's: seeds 3/99, 4/75).
 RING_LIKENESS = 0.2
+#: How long after a tick its later impacts last, s (15-35 ms in real ticks).
+LATER_IMPACTS = 0.04
 #: A tick whose own sound fits this much away from its detected onset is timed by the
 #: fit, in a ring or not, s: a tick alone fits within 0.2 ms of its onset (0.6 ms at
 #: most in four corpus recordings of 650 ticks alone).
@@ -373,7 +377,7 @@ def unlike(likeness: np.ndarray, trains: list[Train], times=None) -> np.ndarray:
 
 def _in_anothers_ring(times: np.ndarray, trains: list[Train]) -> np.ndarray:
     """(K,) True for the ticks held by a train that begin in the ring of another train's
-    tick: past the detector's `RESOLUTION` after it, within `AFTER`."""
+    tick past its later impacts: `LATER_IMPACTS` to `AFTER` after it."""
     owner = holders(times.size, trains)
     held = np.flatnonzero(owner >= 0)
     out = np.zeros(times.size, dtype=bool)
@@ -382,7 +386,7 @@ def _in_anothers_ring(times: np.ndarray, trains: list[Train]) -> np.ndarray:
         if len(others) == 0:
             continue
         mine = times[t.index]
-        j = np.searchsorted(others, mine - RESOLUTION, side="right") - 1
+        j = np.searchsorted(others, mine, side="right") - 1
         since = np.where(j >= 0, mine - others[np.maximum(j, 0)], np.inf)
-        out[t.index] = since <= AFTER
+        out[t.index] = (since > LATER_IMPACTS) & (since <= AFTER)
     return out
