@@ -288,6 +288,17 @@ def test_ticks_in_another_metronomes_ring_that_sound_less_alike_are_kept(tmp_pat
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
+def test_no_tick_is_found_past_a_trains_end_in_another_metronomes_ring(tmp_path):
+    """Corpus seed 2/185: the walk past a train's end found a "tick" 72 ms into the
+    other metronome's ring, as alike as a tick (0.53) at 0.01 of its loudness
+    (precision 0.987). A tick found by its sound is as loud as one
+    (`recovery.FOUND_SCALE`)."""
+    ds, truth = recording(tmp_path, 2, 185)
+    assert ds.attrs["metronomes"] == 2
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+    assert (scores(ds, truth)[:, 1] == 1.0).all()
+
+
 @pytest.mark.parametrize("same_voice", [False, True], ids=["two makes", "one make"])
 def test_two_free_running_metronomes_4_bpm_apart_are_two(tmp_path, same_voice):
     ds, truth = recording(tmp_path, 2, 3, same_voice=same_voice, bpms=[100.0, 104.0],

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from metrosync.audio import detection as det
+from metrosync.audio import recovery
 from metrosync.audio import templates as tp
 from metrosync.audio.reader import open_recording
 from metrosync.audio.trains import Train
@@ -69,9 +70,29 @@ def test_a_sound_between_the_ticks_is_unlike_any_metronome(overlapping):
     between = 0.5 * (truth[index[0][10:20]] + truth[index[0][11:21]])
     between = between[np.min(np.abs(between[:, None] - truth[None, :]), axis=1) > 0.1]
     assert between.size >= 3
-    _, likeness = tp.fit(recording, scan, between, [sounds[0]] * between.size,
+    _, likeness, _ = tp.fit(recording, scan, between, [sounds[0]] * between.size,
                          [[] for _ in between])  # fmt: skip
     assert np.all(likeness < tp.MIN_LIKENESS)
+
+
+def test_a_fit_says_how_loud_the_tick_is_beside_its_sound(overlapping):
+    """The factor of the metronome's sound at a tick that sounds alone is of the order
+    of 1 (it was learned from such ticks); in another metronome's ring, 70 ms after
+    its tick with that tick's sound beside it, what is left is a sliver of a tick,
+    however alike (`recovery.FOUND_SCALE`)."""
+    recording, scan, truth, trains, index = overlapping
+    sounds = tp.learn(recording, scan, truth, trains)
+    since = _since_another(truth, index)
+    alone = index[0][since[index[0]] > tp.AFTER][:20]
+    found = tp.fit(recording, scan, truth[alone], [sounds[0]] * alone.size,
+                   [[] for _ in alone])  # fmt: skip
+    assert np.all(np.abs(found.scale) > 0.4)  # 0.49-1.6 (each tick's own loudness)
+    # 70 ms into the second metronome's ring, where the first has no tick
+    theirs = truth[index[1]]
+    ring = theirs[np.min(np.abs(theirs[:, None] + 0.07 - truth[None, :]), axis=1) > 0.1][:20] + 0.07
+    found = tp.fit(recording, scan, ring, [sounds[0]] * ring.size,
+                   [[(sounds[1], t - 0.07)] for t in ring])  # fmt: skip
+    assert np.all(np.abs(found.scale) < recovery.FOUND_SCALE)
 
 
 def test_a_tick_its_train_took_as_masked_in_a_ring_is_timed_like_its_own(overlapping):
@@ -156,9 +177,9 @@ def test_a_sound_learned_from_onsets_that_wander_is_lined_up(overlapping):
     alone = np.flatnonzero(since > tp.AFTER)
     alone = alone[np.isin(alone, index[0])]
     assert alone.size >= 8
-    _, likeness = tp.fit(recording, scan, truth[alone], [sounds[0]] * alone.size,
+    _, likeness, _ = tp.fit(recording, scan, truth[alone], [sounds[0]] * alone.size,
                          [[] for _ in alone])  # fmt: skip
-    _, likeness_exact = tp.fit(recording, scan, truth[alone], [exact[0]] * alone.size,
+    _, likeness_exact, _ = tp.fit(recording, scan, truth[alone], [exact[0]] * alone.size,
                                [[] for _ in alone])  # fmt: skip
     assert np.median(likeness) > 0.9
     assert np.median(likeness) > np.median(likeness_exact) - 0.03

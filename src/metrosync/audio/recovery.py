@@ -31,7 +31,8 @@ Last, each beat still missed, and the `END_BEATS` beyond each end of a train (wh
 the tracker gave up), is sought by the metronome's own sound (`templates.fit`, beside
 the other metronomes' sounds that overlap it) within `templates.SEARCH` of the
 prediction: a tick whose onset the detector timed too far off in another's ring, or
-never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`). The
+never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`) and is
+about as loud as its ticks (`FOUND_SCALE`). The
 curve's highest point alone is not enough there: beyond a train's end it is as
 often the room's noise. A heard tick found so keeps the detector's onset unless it
 lies in another's ring. Where the tracker gave up on a train before the file ended,
@@ -84,6 +85,11 @@ MAX_END_WALK = 64
 END_SKIP = 10
 #: A beat sought by its sound is found where it sounds at least this much like it.
 FOUND_LIKENESS = 0.5
+#: ... and found at least this loud, as a share of the ticks its sound was learned
+#: from: true ticks found by sound 0.34-1.4 (corpus seeds 2/185, 4/85, 3/187, 4/127,
+#: 4/10, 3/12); past a train's end, 72 ms into another metronome's ring, a tick of
+#: 0.01 its loudness was as alike (0.53; seed 2/185).
+FOUND_SCALE = 0.2
 #: A tick in another's ring this many robust spreads off its beat is unattributed ...
 RING_OFF_BEAT = 1.0
 #: ... or this many, where the sum of the sounds explains it this well (likeness): its
@@ -319,11 +325,13 @@ def _by_sound(
     stop = np.searchsorted(h, want_t + tp.FIT_AFTER + tp.SEARCH)
     context = [[(sounds[owner[k]], ticks.time[k]) for k in held[a:b] if owner[k] != m]
                for m, a, b in zip(want_m, first, stop, strict=True)]  # fmt: skip
-    onset, likeness = tp.fit(recording, scan, want_t, own, context)
+    onset, likeness, scale = tp.fit(recording, scan, want_t, own, context)
     j = np.clip(np.searchsorted(ticks.time, onset), 1, max(ticks.time.size - 1, 1))
     near = np.where(np.abs(ticks.time[j] - onset) < np.abs(ticks.time[j - 1] - onset), j, j - 1)
     close = np.abs(ticks.time[near] - onset) <= det.RESOLUTION
-    keep = (likeness >= FOUND_LIKENESS) & (~close | (owner[near] < 0))
+    # and as loud as a tick: in another's ring, what its sound leaves can be as alike
+    keep = (likeness >= FOUND_LIKENESS) & (np.abs(scale) >= FOUND_SCALE)
+    keep &= ~close | (owner[near] < 0)
     # one found tick per beat and per sound: two beats that found one onset are neither's
     _, first, counts = np.unique(np.round(onset[keep] * rate), return_index=True,
                                  return_counts=True)  # fmt: skip

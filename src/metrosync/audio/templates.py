@@ -35,6 +35,7 @@ sounds less like it than `MIN_LIKENESS` is not that metronome's.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
@@ -201,8 +202,17 @@ def _lined_up(waves: np.ndarray, kinds: np.ndarray, use: np.ndarray, onset: int,
     return shift
 
 
-def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
-    """(onsets (n,) s, likeness (n,)) of the ticks near ``at`` (n,) s, sorted: each
+class Fitted(NamedTuple):
+    """What `fit` found of each tick: its onset (s), its likeness, and the factor its
+    own sound is scaled by there (1: as loud as the ticks it was learned from)."""
+
+    onset: np.ndarray
+    likeness: np.ndarray
+    scale: np.ndarray
+
+
+def fit(recording, scan, at: np.ndarray, own: list, context: list) -> Fitted:
+    """`Fitted` (n,) of the ticks near ``at`` (n,) s, sorted: each
     fitted as the sound ``own[i]`` (a `Sound`: whichever of its two kinds fits better,
     so that a train's beats counted one off after a gap do not matter) at the onset
     within `SEARCH` of at[i] that explains most of the window, plus the sounds
@@ -222,6 +232,7 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     # it that the window can see, slid along it
     lo = onset - fit_before - search
     explained = np.empty((centre.size, 2 * search + 1))
+    scale = np.zeros_like(explained)  # the own sound's factor at each onset
     energy = np.einsum("nw,nw->n", segments, segments)
     alone = np.array([not c for c in context], dtype=bool)
     # the ticks no other overlaps, a whole sound at a time: one matrix product each
@@ -231,11 +242,16 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
         if rows.size == 0:
             continue
         best = np.zeros((rows.size, explained.shape[1]))
+        gain = np.zeros_like(best)
         for wave in own[rows[0]].waves:
             shifted = sliding_window_view(wave[lo : lo + width + 2 * search], width)
-            norm = np.einsum("kw,kw->k", shifted, shifted)
-            best = np.maximum(best, (segments[rows] @ shifted.T) ** 2 / np.maximum(norm, 1e-30))
+            norm = np.maximum(np.einsum("kw,kw->k", shifted, shifted), 1e-30)
+            product = segments[rows] @ shifted.T
+            better = product**2 / norm > best
+            best = np.where(better, product**2 / norm, best)
+            gain = np.where(better, product / norm, gain)
         explained[rows] = best
+        scale[rows] = gain
     for row in np.flatnonzero(~alone):
         columns = []
         for other, when in context[row]:
@@ -253,8 +269,11 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
             norm = cumulative[width:] - cumulative[:-width]
             # what of the own sound the context could explain is not the tick's
             norm = norm - np.sum([np.correlate(span, c, "valid") ** 2 for c in q.T], axis=0)
-            fitted = np.correlate(span, y, "valid") ** 2 / np.maximum(norm, 1e-30)
-            explained[row] = np.maximum(explained[row], fitted)
+            norm = np.maximum(norm, 1e-30)
+            product = np.correlate(span, y, "valid")
+            better = product**2 / norm > explained[row]
+            explained[row] = np.where(better, product**2 / norm, explained[row])
+            scale[row] = np.where(better, product / norm, scale[row])
     # index k: the onset `search` − k samples after the window's centre; refined on a
     # parabola through the best and its neighbours
     best = np.argmax(explained, axis=1)
@@ -267,7 +286,7 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> tuple:
     frac = np.where(inner, 0.5 * (e0 - e2) / np.where(inner, denom, -1.0), 0.0)
     times = (centre + search - best - frac) / rate
     likeness = e1 / np.maximum(energy, 1e-30)
-    return times, likeness
+    return Fitted(times, likeness, scale[rows, best])
 
 
 def _context(times, owner, sounds, held, rows=None, at=None) -> list:
@@ -297,7 +316,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
         return out, likeness
     own = [sounds[owner[i]] for i in held]
     context = _context(times, owner, sounds, held)
-    fitted, likeness[held] = fit(recording, scan, times[held], own, context)
+    fitted, likeness[held], _ = fit(recording, scan, times[held], own, context)
     likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
     j = np.searchsorted(h, h)
@@ -337,7 +356,7 @@ def _behind_a_crack(
     at = times[held[low]] + LATE
     own = [sounds[owner[i]] for i in held[low]]
     context = _context(out, owner, sounds, held, low, at)
-    later, alike = fit(recording, scan, at, own, context)
+    later, alike, _ = fit(recording, scan, at, own, context)
     # beyond the first search only, where it has not judged already (a different
     # context there is no reason to move a tick: corpus seed 3/17), and not at the
     # far end, where a tick would have been heard as an onset of its own; and plainly
