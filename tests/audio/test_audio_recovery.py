@@ -225,6 +225,21 @@ def test_a_tick_in_a_ring_is_judged_off_its_beat_by_its_own_trains_jitter(shift,
     fitted = np.ones(times.size)  # the sum of the sounds explains every tick
     out = rc.nearer_another(times, trains, label, fitted)
     assert (out[ia[20]] == 0) == kept
+    # a tick the fit explains closely, 2.6 spreads off (corpus seed 4/57: 0.96 alike,
+    # dropped at 1.6 ms off its neighbours' line), keeps its metronome; one the fit
+    # explains less well does not
+    offset = rc._own_offset(times, trains[0])
+    spread = 1.4826 * np.nanmedian(np.abs(offset - np.nanmedian(offset)))
+    a26 = a.copy()
+    a26[20] += 2.9 * spread - offset[np.flatnonzero(trains[0].index == ia[20])[0]]
+    times26, trains26, label26, ia26 = _two(a26, b)
+    offset = rc._own_offset(times26, trains26[0])
+    spreads = offset / (1.4826 * np.nanmedian(np.abs(offset - np.nanmedian(offset))))
+    assert 2.5 < spreads[np.flatnonzero(trains26[0].index == ia26[20])[0]] < 3.0
+    close = rc.nearer_another(times26, trains26, label26, np.full(times26.size, 0.95))
+    assert close[ia26[20]] == 0
+    fair = rc.nearer_another(times26, trains26, label26, np.full(times26.size, 0.8))
+    assert fair[ia26[20]] == -1
     # a tick the fit explains poorly keeps the narrow bar
     fitted[ia[20]] = 0.5
     narrow = rc.nearer_another(times, trains, label, fitted)[ia[20]]

@@ -96,6 +96,12 @@ RING_OFF_BEAT = 1.0
 #: onset was fitted, and one spread dropped a metronome's usual ticks in a ring.
 FITTED_OFF_BEAT = 2.5
 FITTED_LIKENESS = 0.7
+#: ... or this many where its sound explains it this well: fitted so closely, a ring
+#: hardly moved it, and a tick's jitter alone puts one in a hundred 2.6 spreads off
+#: its beat (corpus seed 4/57: a tick on time, 0.96 alike, 1.6 ms off its
+#: neighbours' line).
+TRUSTED_OFF_BEAT = 3.0
+TRUSTED_LIKENESS = 0.9
 
 
 def _predictions(times: np.ndarray, train: Train, beyond: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -455,8 +461,8 @@ def nearer_another(
     may be either's); and for each tick that falls within `RING` after another train's
     tick and lies off its own beat by more than `RING_OFF_BEAT` of its train's robust
     spread (at least a millisecond; `FITTED_OFF_BEAT` where its ``likeness`` (K,) to
-    its sound is at least `FITTED_LIKENESS`): its onset is timed by the other's later
-    impacts and ring."""
+    its sound is at least `FITTED_LIKENESS`, `TRUSTED_OFF_BEAT` where at least
+    `TRUSTED_LIKENESS`): its onset is timed by the other's later impacts and ring."""
     out = label.copy()
     if len(trains) < 2:
         return out
@@ -492,6 +498,7 @@ def nearer_another(
         bar = np.full(x.size, RING_OFF_BEAT)
         if likeness is not None:
             bar[likeness[mine] >= FITTED_LIKENESS] = FITTED_OFF_BEAT
+            bar[likeness[mine] >= TRUSTED_LIKENESS] = TRUSTED_OFF_BEAT
         limit = np.maximum(1e-3, bar * spread) if np.isfinite(spread) else np.inf
         drop = (other < own) & (other <= det.RESOLUTION)
         drop |= (since <= RING) & (own > limit)
