@@ -349,9 +349,11 @@ def _behind_a_crack(
     a few milliseconds after it is no onset of its own (the detector's `RESOLUTION`);
     its train holds the crack, which sounds unlike it (corpus seeds 3/176, 4/40, 3/5:
     likeness 0.07-0.21, the tick 3.9-4.5 ms later). Each tick too unlike its sound to
-    stay is fitted again `LATE` after its onset; where its own sound is there, beyond
-    the first fit's `SEARCH`, it is the tick. ``held[rows]``: the ticks to look at."""
-    low = rows[unlike(likeness, trains)[held[rows]]]
+    stay (`unlike`, with its lower bar in another's ring: a tick there, 0.34 alike,
+    was moved onto a later sound, corpus seed 4/110) is fitted again `LATE` after its
+    onset; where its own sound is there, beyond the first fit's `SEARCH`, it is the
+    tick. ``held[rows]``: the ticks to look at."""
+    low = rows[unlike(likeness, trains, times)[held[rows]]]
     if low.size == 0:
         return
     at = times[held[low]] + LATE
