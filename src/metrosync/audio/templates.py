@@ -403,9 +403,9 @@ def _in_anothers_ring(times: np.ndarray, trains: list[Train]) -> np.ndarray:
     owner = holders(times.size, trains)
     held = np.flatnonzero(owner >= 0)
     out = np.zeros(times.size, dtype=bool)
-    for t in trains:
-        others = np.sort(times[held[owner[held] != owner[t.index[0]]]]) if t.index.size else []
-        if len(others) == 0:
+    for m, t in enumerate(trains):
+        others = np.sort(times[held[owner[held] != m]])
+        if others.size == 0 or t.index.size == 0:
             continue
         mine = times[t.index]
         j = np.searchsorted(others, mine, side="right") - 1
