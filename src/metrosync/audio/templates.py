@@ -23,13 +23,22 @@ its background and times the tick late by a millisecond or two. Over `FIT_BEFORE
 before to `FIT_AFTER` after the detected onset, the waveform is fitted by least
 squares as a·(own sound at τ) + Σ b_j·(sound j at its onset t_j), for every τ within
 `SEARCH` of the detected onset, whole samples apart; the τ of the smallest residual
-(refined on a parabola) is the onset. The other ticks keep their times: their onsets
-are the first thing heard, where the detector is exact.
+(refined on a parabola) is the onset; a is the tick's scale (`Fitted.scale`: 1 for a
+tick as loud as those its sound was learned from). The other ticks keep their times
+(their onsets are the first thing heard, where the detector is exact), unless their
+own sound fits more than `CRACK` away: something began just before them.
+
+Behind a crack. A tick that begins within the detector's resolution after a louder
+sound (a handling bump's crack, another metronome's later impact) has no onset of its
+own; its train holds the crack. Where that onset sounds too unlike the tick to stay
+and the first search found only the crack, the end of its reach or nothing like a
+tick, the tick is sought `LATE` after the onset (see `_behind_a_crack`).
 
 Likeness. The share of the window's energy (less what the other ticks explain) that
 the tick's own sound explains at its best onset: above 0.4 for the corpus's ticks,
 under 0.1 for a handling bump on a metronome's beat. A tick held by a train that
-sounds less like it than `MIN_LIKENESS` is not that metronome's.
+sounds less like it than `MIN_LIKENESS` is not that metronome's; in another's ring
+past its later impacts, than `RING_LIKENESS`.
 """
 
 from __future__ import annotations
