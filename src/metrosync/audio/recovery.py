@@ -32,7 +32,8 @@ the tracker gave up), is sought by the metronome's own sound (`templates.fit`, b
 the other metronomes' sounds that overlap it) within `templates.SEARCH` of the
 prediction: a tick whose onset the detector timed too far off in another's ring, or
 never heard, is found where it sounds like the metronome (`FOUND_LIKENESS`) and is
-about as loud as its ticks (`FOUND_SCALE`). The
+about as loud as its ticks (`FOUND_SCALE`); one found over `RECENTRE` off its
+prediction is judged on a window around where it was found. The
 curve's highest point alone is not enough there: beyond a train's end it is as
 often the room's noise. A heard tick found so keeps the detector's onset unless it
 lies in another's ring. Where the tracker gave up on a train before the file ended,
