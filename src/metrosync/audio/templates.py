@@ -341,10 +341,12 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     # where the first search's best is the onset itself (the crack), the end of its
     # reach, or nothing like a tick, the tick may lie beyond; one found in between is
     # there, only sounding less like itself (another metronome's tick on its onset:
-    # corpus seeds 3/78, 4/25, 4/3, moved 1.2-2.3 ms, 0.16-0.29 alike; seed 4/55
-    # found 0.03 in between, its tick 4.7 ms after another's later impact)
+    # corpus seeds 3/78, 4/25, moved 1.2-2.3 ms, 0.26-0.29 alike; nothing like a
+    # tick: under `RING_LIKENESS`, what no tick sounds like even in a ring, as seeds
+    # 4/55 and 4/27 found in between, 0.03 and 0.17, their ticks 4.2-4.7 ms after
+    # another's later impact)
     moved = np.abs(fitted - h)
-    reach = (moved <= CRACK) | (moved >= SEARCH - EDGE) | (likeness[held] < BUMP_LIKENESS)
+    reach = (moved <= CRACK) | (moved >= SEARCH - EDGE) | (likeness[held] < RING_LIKENESS)
     _behind_a_crack(recording, scan, times, out, likeness, trains, sounds, owner, held,
                     np.flatnonzero(reach))  # fmt: skip
     return out, likeness
