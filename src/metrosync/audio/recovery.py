@@ -333,20 +333,17 @@ def _by_sound(
     own = [sounds[m] for m in want_m]
     h = ticks.time[held]
 
-    def context(at, metronome):
-        first = np.searchsorted(h, at - tp.AFTER, side="right")
-        stop = np.searchsorted(h, at + tp.FIT_AFTER + tp.SEARCH)
-        return [[(sounds[owner[k]], ticks.time[k]) for k in held[a:b] if owner[k] != m]
-                for m, a, b in zip(metronome, first, stop, strict=True)]  # fmt: skip
+    def around(at, metronome):
+        return tp.context(ticks.time, owner, sounds, held, at, metronome)
 
-    onset, likeness, scale = tp.fit(recording, scan, want_t, own, context(want_t, want_m))
+    onset, likeness, scale = tp.fit(recording, scan, want_t, own, around(want_t, want_m))
     # a tick found well off its prediction was judged on a window that held little of
     # it: judged again on one around it
     again = np.flatnonzero((np.abs(onset - want_t) > RECENTRE) & (likeness < FOUND_LIKENESS))
     if again.size:
         again = again[np.argsort(onset[again])]
         refit = tp.fit(recording, scan, onset[again], [own[i] for i in again],
-                       context(onset[again], want_m[again]))  # fmt: skip
+                       around(onset[again], want_m[again]))  # fmt: skip
         onset[again], likeness[again], scale[again] = refit
     j = np.clip(np.searchsorted(ticks.time, onset), 1, max(ticks.time.size - 1, 1))
     near = np.where(np.abs(ticks.time[j] - onset) < np.abs(ticks.time[j - 1] - onset), j, j - 1)

@@ -254,11 +254,8 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> Fitted:
         gain = np.zeros_like(best)
         for wave in own[rows[0]].waves:
             shifted = sliding_window_view(wave[lo : lo + width + 2 * search], width)
-            norm = np.maximum(np.einsum("kw,kw->k", shifted, shifted), 1e-30)
-            product = segments[rows] @ shifted.T
-            better = product**2 / norm > best
-            best = np.where(better, product**2 / norm, best)
-            gain = np.where(better, product / norm, gain)
+            norm = np.einsum("kw,kw->k", shifted, shifted)
+            best, gain = _better(best, gain, segments[rows] @ shifted.T, norm)
         explained[rows] = best
         scale[rows] = gain
     for row in np.flatnonzero(~alone):
@@ -278,11 +275,9 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> Fitted:
             norm = cumulative[width:] - cumulative[:-width]
             # what of the own sound the context could explain is not the tick's
             norm = norm - np.sum([np.correlate(span, c, "valid") ** 2 for c in q.T], axis=0)
-            norm = np.maximum(norm, 1e-30)
-            product = np.correlate(span, y, "valid")
-            better = product**2 / norm > explained[row]
-            explained[row] = np.where(better, product**2 / norm, explained[row])
-            scale[row] = np.where(better, product / norm, scale[row])
+            explained[row], scale[row] = _better(
+                explained[row], scale[row], np.correlate(span, y, "valid"), norm
+            )
     # index k: the onset `search` − k samples after the window's centre; refined on a
     # parabola through the best and its neighbours
     best = np.argmax(explained, axis=1)
@@ -298,17 +293,25 @@ def fit(recording, scan, at: np.ndarray, own: list, context: list) -> Fitted:
     return Fitted(times, likeness, scale[rows, best])
 
 
-def _context(times, owner, sounds, held, rows=None, at=None) -> list:
-    """For each of ``held[rows]`` (``held``: sorted indices of ticks with a sound; rows:
-    all by default), the (Sound, onset) of the ticks of other trains that sound in its
-    fit window, centred on ``at`` (s; its own time by default)."""
+def _better(best, gain, product, norm):
+    """(best, gain) where the sound's product with the window at each onset explains
+    more of it (product²/norm) than ``best`` does: that share and the sound's factor
+    there (product/norm)."""
+    norm = np.maximum(norm, 1e-30)
+    explains = product**2 / norm
+    better = explains > best
+    return np.where(better, explains, best), np.where(better, product / norm, gain)
+
+
+def context(times, owner, sounds, held, at, whose) -> list:
+    """For each fit window centred on ``at`` (s) for a tick of train ``whose`` (one each),
+    the (Sound, onset) of the held ticks of other trains that sound in it (``held``:
+    sorted indices of the ticks with a sound; ``owner``: each tick's train)."""
     h = times[held]
-    rows = np.arange(held.size) if rows is None else rows
-    at = h[rows] if at is None else at
     first = np.searchsorted(h, at - AFTER, side="right")
     stop = np.searchsorted(h, at + FIT_AFTER + SEARCH)
-    return [[(sounds[owner[k]], times[k]) for k in held[a:b] if owner[k] != owner[i]]
-            for i, a, b in zip(held[rows], first, stop, strict=True)]  # fmt: skip
+    return [[(sounds[owner[k]], times[k]) for k in held[a:b] if owner[k] != w]
+            for w, a, b in zip(whose, first, stop, strict=True)]  # fmt: skip
 
 
 def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
@@ -324,8 +327,8 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     if held.size == 0:
         return out, likeness
     own = [sounds[owner[i]] for i in held]
-    context = _context(times, owner, sounds, held)
-    fitted, likeness[held], _ = fit(recording, scan, times[held], own, context)
+    around = context(times, owner, sounds, held, times[held], owner[held])
+    fitted, likeness[held], _ = fit(recording, scan, times[held], own, around)
     likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
     j = np.searchsorted(h, h)
@@ -336,7 +339,8 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     # and a tick whose own sound begins well away from its onset: the detector timed
     # something just before it (a handling bump's crack 1-2.6 ms ahead, corpus seeds
     # 3/172, 3/231, 4/181, 4/98), or the tick late in the bump's thump
-    behind = (np.abs(fitted - h) > CRACK) & (likeness[held] >= CRACK_LIKENESS)
+    moved = np.abs(fitted - h)
+    behind = (moved > CRACK) & (likeness[held] >= CRACK_LIKENESS)
     out[held[in_ring | behind]] = fitted[in_ring | behind]
     # where the first search's best is the onset itself (the crack), the end of its
     # reach, or nothing like a tick, the tick may lie beyond; one found in between is
@@ -345,7 +349,6 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     # tick: under `RING_LIKENESS`, what no tick sounds like even in a ring, as seeds
     # 4/55 and 4/27 found in between, 0.03 and 0.17, their ticks 4.2-4.7 ms after
     # another's later impact)
-    moved = np.abs(fitted - h)
     reach = (moved <= CRACK) | (moved >= SEARCH - EDGE) | (likeness[held] < RING_LIKENESS)
     _behind_a_crack(recording, scan, times, out, likeness, trains, sounds, owner, held,
                     np.flatnonzero(reach))  # fmt: skip
@@ -369,8 +372,8 @@ def _behind_a_crack(
         return
     at = times[held[low]] + LATE
     own = [sounds[owner[i]] for i in held[low]]
-    context = _context(out, owner, sounds, held, low, at)
-    later, alike, _ = fit(recording, scan, at, own, context)
+    around = context(out, owner, sounds, held, at, owner[held[low]])
+    later, alike, _ = fit(recording, scan, at, own, around)
     # beyond the first search only, where it has not judged already (a different
     # context there is no reason to move a tick: corpus seed 3/17), and not at the
     # far end, where a tick would have been heard as an onset of its own; and plainly

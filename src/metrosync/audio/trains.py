@@ -734,9 +734,13 @@ def _clash(times, ta: Train, tb: Train, beat: float) -> bool:
     """Whether a tick of one train lies within half a beat of one of the other's but
     beyond a tick's length (`MAX_TICK_LENGTH`): not a later impact of it, a sound of
     another metronome on the same beat; the two are not pieces of one."""
-    t = np.sort(times[np.union1d(ta.index, tb.index)])
-    gap = np.diff(t)
-    return bool(np.any((np.rint(gap / beat) == 0) & (gap > MAX_TICK_LENGTH)))
+    gap = np.diff(np.sort(times[np.union1d(ta.index, tb.index)]))
+    return bool(np.any(_on_one_beat(gap, beat) & (gap > MAX_TICK_LENGTH)))
+
+
+def _on_one_beat(gap: np.ndarray, beat: float) -> np.ndarray:
+    """Whether ticks ``gap`` (s) apart lie on one beat of ``beat`` (within half of it)."""
+    return np.rint(gap / beat) == 0
 
 
 def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
@@ -754,7 +758,7 @@ def _merge(times, ta: Train, tb: Train, beat: float) -> Train:
     # metronomes: each such pair counted a beat more, and 189 BPM became 201)
     while index.size > 2:
         gap = np.diff(times[index])
-        same = np.flatnonzero((np.rint(gap / beat) == 0) & (gap <= MAX_TICK_LENGTH))
+        same = np.flatnonzero(_on_one_beat(gap, beat) & (gap <= MAX_TICK_LENGTH))
         if same.size == 0:
             break
         i = same[0]
