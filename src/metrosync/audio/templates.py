@@ -346,7 +346,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     # something just before it (a handling bump's crack 1-2.6 ms ahead, corpus seeds
     # 3/172, 3/231, 4/181, 4/98), or the tick late in the bump's thump
     moved = np.abs(fitted - h)
-    behind = (moved > CRACK) & (likeness[held] >= CRACK_LIKENESS)
+    behind = _begins_away(fitted, h, likeness[held])
     out[held[in_ring | behind]] = fitted[in_ring | behind]
     # where the first search's best is the onset itself (the crack), the end of its
     # reach, or nothing like a tick, the tick may lie beyond; one found in between is
@@ -359,6 +359,13 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     _behind_a_crack(recording, scan, times, out, likeness, trains, sounds, owner, held,
                     np.flatnonzero(reach))  # fmt: skip
     return out, likeness
+
+
+def _begins_away(fitted: np.ndarray, onset: np.ndarray, likeness: np.ndarray) -> np.ndarray:
+    """Whether each tick's own sound, fitted at ``fitted`` (s), begins more than `CRACK`
+    from its detected ``onset`` and sounds like it there (`CRACK_LIKENESS`): something
+    else made the onset."""
+    return (np.abs(fitted - onset) > CRACK) & (likeness >= CRACK_LIKENESS)
 
 
 def _beside_a_hidden_tick(
@@ -387,7 +394,7 @@ def _beside_a_hidden_tick(
     where = np.array(rows)[order]
     beside = [beside[i] for i in order]
     again = fit(recording, scan, times[held[where]], [own[r] for r in where], beside)
-    take = (np.abs(again.onset - times[held[where]]) > CRACK) & (again.likeness >= CRACK_LIKENESS)
+    take = _begins_away(again.onset, times[held[where]], again.likeness)
     fitted[where[take]] = again.onset[take]
     likeness[held[where[take]]] = again.likeness[take]
 
