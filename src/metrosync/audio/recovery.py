@@ -311,8 +311,6 @@ def _by_sound(
     rate = recording.sample_rate
     lo, hi = tp.BEFORE + tp.MARGIN, recording.frames / rate - tp.AFTER - tp.MARGIN
     owner = holders(ticks.time.size, trains)
-    held = np.flatnonzero(owner >= 0)
-    held = held[[sounds[owner[i]] is not None for i in held]]
     metronomes: list[int] = []
     beats: list[np.ndarray] = []
     times: list[np.ndarray] = []
@@ -331,10 +329,10 @@ def _by_sound(
     order = np.argsort(want_t)
     want_m, want_n, want_t = want_m[order], want_n[order], want_t[order]
     own = [sounds[m] for m in want_m]
-    h = ticks.time[held]
+    sources = tp.sounding(ticks.time, trains, sounds)
 
     def around(at, metronome):
-        return tp.context(ticks.time, owner, sounds, held, at, metronome)
+        return tp.context(ticks.time, sources, sounds, at, metronome)
 
     onset, likeness, scale = tp.fit(recording, scan, want_t, own, around(want_t, want_m))
     # a tick found well off its prediction was judged on a window that held little of
@@ -360,8 +358,7 @@ def _by_sound(
     reuse = chosen[close[chosen]]
     time = ticks.time.copy()
     # heard, but in another's ring: timed on the sounds
-    k = np.searchsorted(h, ticks.time[near[reuse]], side="left")
-    ringing = (k > 0) & (ticks.time[near[reuse]] - h[np.maximum(k - 1, 0)] <= tp.AFTER)
+    ringing = tp.ringing(ticks.time, sources, ticks.time[near[reuse]])
     time[near[reuse[ringing]]] = onset[reuse[ringing]]
     fresh = chosen[~close[chosen]]
     fields = det.Ticks.__dataclass_fields__
