@@ -354,8 +354,9 @@ def context(times, sources, sounds, at, whose) -> list:
 
 def ringing(times: np.ndarray, sources, at: np.ndarray) -> np.ndarray:
     """(n,) True where ``at`` (s) lies within `AFTER` after a sounding tick of
-    ``sources`` (`sounding`) that begins before it: in its ring."""
-    h = np.sort(times[sources[0]])
+    ``sources`` (`sounding`, in the order of these ``times``) that begins before it:
+    in its ring."""
+    h = times[sources[0]]
     j = np.searchsorted(h, at, side="left")
     return (j > 0) & (at - h[np.maximum(j - 1, 0)] <= AFTER)
 

@@ -53,7 +53,7 @@ tick is heard, or hidden just behind another's: metronomes at a whole-number rat
 tempo (4:3) lie on one grid too, and never sound on some of its beats;
 or when one takes up the other's beat (the same period, or a whole multiple of it,
 within 1 %, its first tick a whole number of beats, at most `MAX_BRIDGED`, within
-15 %, after the other's last). Two ticks of the joined pieces within half a beat and
+`OFF_GRID`, after the other's last). Two ticks of the joined pieces within half a beat and
 `MAX_TICK_LENGTH` are one (a tick and its later impact); two within half a beat but
 farther apart are another metronome's sound on that beat, and the pieces are not
 one. Of the pieces that could join a train, the one nearest its grid joins: two
@@ -85,10 +85,11 @@ LOCKED_SPREAD = 0.04
 MAX_FRAGMENT = 6
 #: Most beats between a train's end and a train that takes up its beat.
 MAX_BRIDGED = 64
-#: Farthest a piece's ticks lie off the other piece's grid (beats): a limp.
+#: Farthest a piece's ticks lie off the other piece's grid (beats): a limp; and a
+#: train that takes up another's beat, off the grid laid from the other's last tick.
 OFF_GRID = 0.15
-#: Where a train taking up another's beat ranks among joins, as if that far off the
-#: grid: after every pair of pieces that share a grid.
+#: Where a train taking up another's beat ranks among joins, as if as far off the
+#: grid as it may lie: after every pair of pieces that share a grid.
 CONTINUED = OFF_GRID
 #: Largest drift (beats) of one piece of a metronome's train on another's grid over
 #: the time they share: two metronomes under 1 % apart in tempo drift by more.
@@ -742,7 +743,7 @@ def _continues(times: np.ndarray, ta: Train, tb: Train) -> float | None:
     end, start = times[ta.index[-1]], times[tb.index[0]]
     beat = 0.5 * (short + long_ / k)
     beats = (start - end) / beat
-    if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > 0.15:
+    if not 1 <= round(beats) <= MAX_BRIDGED or abs(beats - round(beats)) > OFF_GRID:
         return None
     return beat
 
