@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from metrosync.audio import recovery as rc
-from metrosync.audio.trains import Train
+from metrosync.audio.trains import Train, off_the_beat
 
 
 def limping(beats: int, period=0.4, limp=0.02, drift=-1e-6, start=1.0) -> np.ndarray:
@@ -132,6 +132,42 @@ def test_ticks_off_the_beat_found_first_let_the_rest_be_found(seed):
     kept = rc._on_beat(t, train)
     left = set(beat) - set(beat[kept.index])
     assert {5, 41} <= left <= {1, 5, 41, 45, 49}
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_ticks_off_the_beat_at_a_trains_end_put_no_right_ones_off(seed):
+    """A train of corpus seed 4/210 as the tracker left it (offsets from the beat in
+    ms). Its last three tocks are another metronome's, 28-74 ms late: too near the end
+    to be judged by neighbours on both sides, they stayed, and as neighbours they put
+    the right tocks before them off the beat, pass by pass, for nine beats. A tick the
+    fit finds off the beat has no say on its neighbours."""
+    ticks = [b for b in range(0, 105, 4) if b not in (28, 72)]
+    tocks = [*range(1, 24, 2), *range(27, 46, 2), 51, 55, 57, 59, 61, 63, 67, 69, 75, 81, 83]
+    off = {0: -34.0, 52: -8.5, 100: -42.2, 1: -13.8, 9: -4.4, 27: -11.4, 51: -19.0,
+           75: 28.5, 81: 44.3, 83: 74.2}  # fmt: skip
+    beat = np.array(sorted(ticks + tocks))
+    t = 0.15 + 0.3562 * beat + 6e-3 * (beat % 2)
+    t += np.random.default_rng(seed).normal(0, 0.4e-3, beat.size)
+    t += 1e-3 * np.array([off.get(b, 0.0) for b in beat])
+    train = Train(np.arange(beat.size), beat, 0.3562, np.zeros(beat.size, bool))
+    kept = rc._on_beat(t, train)
+    assert set(beat) - set(beat[kept.index]) == set(off)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_run_of_another_metronomes_ticks_draws_no_fit_to_itself(seed):
+    """The same train of corpus seed 4/210 at the end: fifteen of its tocks are another
+    metronome's, drifting from 3 to 86 ms late, and the quadratic fitted from all the
+    tocks followed them and put the seven right tocks after them off the beat. A fit
+    begun from a third of the tocks has more of them on it."""
+    late = {59: 5.4, 61: 3.4, 63: 9.4, 65: 9.5, 67: 12.5, 71: 28.3, 73: 27.8, 75: 28.1,
+            77: 34.1, 79: 37.2, 81: 43.8, 83: 47.7, 91: 69.9, 93: 76.5, 97: 86.2}  # fmt: skip
+    beat = np.array([b for b in range(112) if b % 2 == 0 or b not in (41, 69, 85, 87, 89, 95)])
+    t = 0.15 + 0.3562 * beat + 6e-3 * (beat % 2)
+    t += np.random.default_rng(seed).normal(0, 0.4e-3, beat.size)
+    t += 1e-3 * np.array([late.get(b, 0.0) for b in beat])
+    off = set(beat[off_the_beat(t, beat)])
+    assert {b for b, ms in late.items() if ms > 5} <= off <= set(late)
 
 
 def test_a_train_on_its_beat_is_kept_whole():
