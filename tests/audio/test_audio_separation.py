@@ -358,6 +358,17 @@ def test_a_run_of_another_metronomes_ticks_puts_no_right_ticks_off_their_beat(tm
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
+def test_a_first_impact_at_the_files_start_is_its_metronomes_tick(tmp_path):
+    """Corpus seed 4/209: a metronome's train held its first beat only as hidden behind
+    another's tick, 25 ms after the tock's first impact; the train of every second
+    beat that held that impact was folded into it, and the impact, on a beat already
+    held, was left to no one (recall 0.988). A first impact takes a beat its train
+    holds only as hidden (`trains.fold_parts`)."""
+    ds, truth = recording(tmp_path, 4, 209)
+    assert ds.attrs["metronomes"] == 4
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
 def test_a_tick_found_off_its_prediction_is_judged_around_where_it_was_found(tmp_path):
     """Corpus seed 4/160: the walk past a train's end predicted its last tick 3.2 ms
     early; the window around the prediction held only the tick's first 1.8 ms, it

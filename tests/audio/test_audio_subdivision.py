@@ -222,6 +222,36 @@ def test_a_train_that_took_its_tocks_later_impacts_gets_their_first_ones():
     assert set(np.concatenate(parts)) == set(where[100:])
 
 
+def test_a_first_impact_takes_the_beat_its_train_held_only_as_hidden():
+    """Corpus seed 209 again, at the file's start: the metronome's train held its first
+    tock's beat as hidden behind another metronome's tick 25 ms after the tock (not its
+    later impact's usual lag). The tock's first impact, held by the train of every
+    second beat, was dropped with that train; it now takes the beat."""
+    rng = np.random.default_rng(209)
+    beat = 60 / 168.7
+    n = np.arange(100)
+    on = 0.1 + n * beat + rng.normal(0, 0.4e-3, n.size)
+    tock = n % 2 == 1
+    heard_later = tock & (n > 1)
+    later = on[heard_later] + 0.02746 + rng.normal(0, 0.05e-3, int(heard_later.sum()))
+    another = on[1] + 0.0249  # another metronome's tick, which the train took as hiding
+    times = np.concatenate([on, later, [another]])
+    strength = np.concatenate([np.where(tock, -12.0, -10.0), np.full(later.size, -20.0), [-10.0]])
+    order = np.argsort(times)
+    where = np.empty(times.size, dtype=np.int64)
+    where[order] = np.arange(times.size)
+    a_ticks = np.concatenate([where[n[~tock]], where[100 : 100 + later.size], [where[-1]]])
+    a_beats = np.concatenate([n[~tock], n[heard_later], [1]])
+    a_masked = np.arange(a_ticks.size) == a_ticks.size - 1
+    sort = np.argsort(a_beats)
+    a = Train(a_ticks[sort], a_beats[sort], beat, a_masked[sort])
+    b = Train(where[n[tock]], np.arange(50), 2 * beat, np.zeros(50, bool))
+    kept, _, _ = fold_parts(times[order], [a, b], [0, 1], strength[order])
+    (metronome,) = kept
+    assert np.array_equal(metronome.index, where[n]) and np.array_equal(metronome.beat, n)
+    assert not metronome.masked.any()
+
+
 def test_a_tock_far_fainter_than_its_tick_is_not_its_echo():
     """Corpus seed 72: a metronome's tocks, 18.6 dB fainter than its ticks, half a beat
     on. Their lag from the tick before moves with the metronome's beat (its jitter),

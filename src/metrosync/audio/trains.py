@@ -478,9 +478,11 @@ def fold_parts(times: np.ndarray, trains: list[Train], voice: list[int], strengt
 
 def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, middle: float, limit: float):
     """(A with B's ticks in place of the ticks of A's that each comes before at the
-    usual lag ``middle``, and on the beats where A had none, those ticks of A's): B,
-    louder and ahead of every k-th of A's ticks at a fixed lag, is their first impact,
-    where A's train took a later one (or, once another's tick hid it, none)."""
+    usual lag ``middle``, and B's other ticks on the beats where A had none or held
+    only another's tick that hid its own (corpus seed 4/209, at the file's start);
+    the ticks of A's so replaced): B, louder and ahead of every k-th of A's ticks at a
+    fixed lag, is their first impact, where A's train took a later one (or, once
+    another's tick hid it, none)."""
     paired = np.abs(lag - middle) <= 3 * limit
     at, first = np.unique(nearer[paired], return_index=True)
     taken = np.flatnonzero(paired)[first]
@@ -493,10 +495,13 @@ def _first_impacts_taken(times, ta: Train, tb: Train, nearer, lag, middle: float
     number = ta.beat[ref] + np.round((times[tb.index[rest]] - middle - times[ta.index[ref]])
                                      / ta.period).astype(ta.beat.dtype)  # fmt: skip
     new, once = np.unique(number, return_index=True)
-    free = ~np.isin(new, ta.beat)
-    rest = rest[once[free]]
-    out = with_ticks(Train(index, ta.beat, ta.period, masked), tb.index[rest], new[free],
-                     tb.masked[rest])  # fmt: skip
+    rest = rest[once]
+    # and where A holds only another's tick that hid its own, B's tick heard there
+    hidden = np.isin(new, ta.beat[masked]) & ~tb.masked[rest]
+    free = ~np.isin(new, ta.beat) | hidden
+    stays = ~(np.isin(ta.beat, new[hidden]) & masked)
+    out = with_ticks(Train(index[stays], ta.beat[stays], ta.period, masked[stays]),
+                     tb.index[rest[free]], new[free], tb.masked[rest[free]])  # fmt: skip
     # one before A's first tick is beat 0
     return Train(out.index, out.beat - out.beat[0], out.period, out.masked), later
 
