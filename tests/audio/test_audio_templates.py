@@ -163,6 +163,19 @@ def test_a_tick_in_another_metronomes_ring_is_judged_against_a_lower_bar():
     assert set(np.flatnonzero(tp.unlike(likeness, [a, b])[where[:40]])) == {2, 3, 5, 11, 17, 23, 29}
 
 
+def test_a_tick_after_two_metronomes_on_one_onset_is_in_their_ring():
+    """An onset two trains hold as hidden behind each other, neither as its own, rings
+    as both: a third train's tick 41 ms after it is judged against `RING_LIKENESS`, as
+    after any other's tick."""
+    times = np.array([0.0, 0.041, 0.5, 0.541, 1.0])
+    no = np.zeros(2, dtype=bool)
+    a = Train(np.array([0, 2]), np.array([0, 1]), 0.5, np.array([True, False]))
+    b = Train(np.array([0, 4]), np.array([0, 2]), 0.5, np.array([True, False]))
+    c = Train(np.array([1, 3]), np.array([0, 1]), 0.5, no)
+    likeness = np.array([np.nan, 0.26, 0.8, 0.26, 0.8])
+    assert not tp.unlike(likeness, [a, b, c], times).any()
+
+
 def test_a_sound_learned_from_onsets_that_wander_is_lined_up(overlapping):
     """The detector's onsets of ticks that sound alone wander by a few tenths of a
     millisecond, a period of the resonances; their plain average was smeared, every

@@ -314,14 +314,14 @@ def _better(best, gain, product, norm):
     return np.where(better, explains, best), np.where(better, product / norm, gain)
 
 
-def sounding(times: np.ndarray, trains: list[Train], sounds) -> tuple[np.ndarray, np.ndarray]:
-    """((J,) tick indices, (J,) trains) of the held ticks whose train's sound is known,
-    in time order, each with the train whose sound it is: the train that holds it as
-    its own (`holders`), or, for a tick two or more trains hold and none as its own
-    alone, each of them. Two metronomes a millisecond or two apart make one onset that
-    each train takes as hidden by the other; both sound there (corpus seeds 4/85,
-    4/127: a third metronome's tick 31-36 ms later, fitted without their rings, was
-    timed 1.4-1.6 ms off)."""
+def sounding(times: np.ndarray, trains: list[Train], sounds=None) -> tuple[np.ndarray, np.ndarray]:
+    """((J,) tick indices, (J,) trains) of the held ticks (with ``sounds``, those whose
+    train's sound is known), in time order, each with the train whose sound it is: the
+    train that holds it as its own (`holders`), or, for a tick two or more trains hold
+    and none as its own alone, each of them. Two metronomes a millisecond or two apart
+    make one onset that each train takes as hidden by the other; both sound there
+    (corpus seeds 4/85, 4/127: a third metronome's tick 31-36 ms later, fitted without
+    their rings, was timed 1.4-1.6 ms off)."""
     owner = holders(times.size, trains)
     tick = [np.flatnonzero(owner >= 0)]
     by = [owner[tick[0]]]
@@ -334,8 +334,9 @@ def sounding(times: np.ndarray, trains: list[Train], sounds) -> tuple[np.ndarray
         tick.append(shared)
         by.append(np.full(shared.size, m))
     ticks, whose = np.concatenate(tick), np.concatenate(by)
-    known = np.array([sounds[m] is not None for m in whose], dtype=bool)
-    ticks, whose = ticks[known], whose[known]
+    if sounds is not None:
+        known = np.array([sounds[m] is not None for m in whose], dtype=bool)
+        ticks, whose = ticks[known], whose[known]
     order = np.lexsort((whose, times[ticks]))
     return ticks[order], whose[order]
 
@@ -521,12 +522,12 @@ def unlike(likeness: np.ndarray, trains: list[Train], times=None) -> np.ndarray:
 
 def _in_anothers_ring(times: np.ndarray, trains: list[Train]) -> np.ndarray:
     """(K,) True for the ticks held by a train that begin in the ring of another train's
-    tick past its later impacts: `LATER_IMPACTS` to `AFTER` after it."""
-    owner = holders(times.size, trains)
-    held = np.flatnonzero(owner >= 0)
+    tick past its later impacts: `LATER_IMPACTS` to `AFTER` after it (a tick two trains
+    hold as hidden behind each other sounds as both, `sounding`)."""
+    ticks, whose = sounding(times, trains)
     out = np.zeros(times.size, dtype=bool)
     for m, t in enumerate(trains):
-        others = np.sort(times[held[owner[held] != m]])
+        others = times[ticks[whose != m]]
         if others.size == 0 or t.index.size == 0:
             continue
         mine = times[t.index]
