@@ -137,10 +137,11 @@ def test_ticks_off_the_beat_found_first_let_the_rest_be_found(seed):
 @pytest.mark.parametrize("seed", range(5))
 def test_ticks_off_the_beat_at_a_trains_end_put_no_right_ones_off(seed):
     """A train of corpus seed 4/210 as the tracker left it (offsets from the beat in
-    ms). Its last three tocks are another metronome's, 28-74 ms late: too near the end
-    to be judged by neighbours on both sides, they stayed, and as neighbours they put
-    the right tocks before them off the beat, pass by pass, for nine beats. A tick the
-    fit finds off the beat has no say on its neighbours."""
+    ms). Its last three tocks are other onsets, 28-74 ms late (a later impact of the
+    tock, others' rings): too near the end to be judged by neighbours on both sides,
+    they stayed, and as neighbours they put the right tocks before them off the beat,
+    pass by pass, for nine beats. A tick the fit finds off the beat has no say on its
+    neighbours."""
     ticks = [b for b in range(0, 105, 4) if b not in (28, 72)]
     tocks = [*range(1, 24, 2), *range(27, 46, 2), 51, 55, 57, 59, 61, 63, 67, 69, 75, 81, 83]
     off = {0: -34.0, 52: -8.5, 100: -42.2, 1: -13.8, 9: -4.4, 27: -11.4, 51: -19.0,
@@ -155,9 +156,10 @@ def test_ticks_off_the_beat_at_a_trains_end_put_no_right_ones_off(seed):
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_a_run_of_another_metronomes_ticks_draws_no_fit_to_itself(seed):
-    """The same train of corpus seed 4/210 at the end: fifteen of its tocks are another
-    metronome's, drifting from 3 to 86 ms late, and the quadratic fitted from all the
+def test_a_run_of_ticks_drifting_off_the_beat_draws_no_fit_to_itself(seed):
+    """The same train of corpus seed 4/210 at the end: for forty beats its tocks were
+    other onsets, drifting from 3 to 86 ms late (the tocks' later impacts, others'
+    rings), and the quadratic fitted from all the
     tocks followed them and put the seven right tocks after them off the beat. A fit
     begun from a third of the tocks has more of them on it."""
     late = {59: 5.4, 61: 3.4, 63: 9.4, 65: 9.5, 67: 12.5, 71: 28.3, 73: 27.8, 75: 28.1,

@@ -345,14 +345,15 @@ def test_a_tick_that_sounds_more_like_itself_alone_is_timed_alone(tmp_path):
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
-def test_a_run_of_another_metronomes_ticks_puts_no_right_ticks_off_their_beat(tmp_path):
-    """Corpus seed 4/210: a tock train took another metronome's ticks, drifting from
-    3 to 86 ms late, for forty beats. Three of them at a train's end put the right
-    tocks before them off the beat, as neighbours, pass by pass; over the whole train,
-    the quadratic followed them and put the right tocks after them off (recall 0.83,
-    and 0.99 for a fourth metronome). Of the fits begun from all the tocks and from
-    each third, the one most tocks are on is taken, and a tick it puts off the beat
-    has no say on its neighbours (`trains.off_the_beat`)."""
+def test_a_run_drifting_off_the_beat_puts_no_right_ticks_off_it(tmp_path):
+    """Corpus seed 4/210: for forty beats a tock train took other onsets for its
+    tocks (their later impacts, others' rings), drifting from 3 to 86 ms late. Three
+    of them at a train's end put the right tocks before them off the beat, as
+    neighbours, pass by pass; over the whole train, the quadratic followed them and
+    put the right tocks after them off (recall 0.83, and 0.99 for a fourth
+    metronome). Of the fits begun from all the tocks and from each third, the one
+    most tocks are on is taken, and a tick it puts off the beat has no say on its
+    neighbours (`trains.off_the_beat`)."""
     ds, truth = recording(tmp_path, 4, 210)
     assert ds.attrs["metronomes"] == 4
     _assert_each_metronome_meets_the_issue(scores(ds, truth))

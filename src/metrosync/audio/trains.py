@@ -586,8 +586,8 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
     # through each other, a train that took some of the other's ticks bends away
     # from any quadratic, which then hides a tick 10 ms off. A tick the fit finds
     # off the beat has no say (corpus seed 4/210: a tock train's last three ticks,
-    # another metronome's 28-74 ms late, put the right tocks before them off their
-    # beat, pass by pass, for nine beats)
+    # onsets 28-74 ms after its metronome's tocks, put the right tocks before them
+    # off their beat, pass by pass, for nine beats)
     for sel in kinds:
         sel = sel[~out[sel]]
         local = times[sel] - _from_neighbours(beat[sel], times[sel])
@@ -601,10 +601,11 @@ def off_the_beat(times: np.ndarray, beat: np.ndarray) -> np.ndarray:
 def _from_the_beat(n: np.ndarray, t: np.ndarray) -> np.ndarray:
     """(S,) each tick's distance from its train's beat, a quadratic in the beat number
     ``n``: of the fits begun from all the ticks and from each third of them
-    (`_fit_from`), the one most ticks lie within `OFF_BEAT` of. A run of another
-    metronome's ticks drifting through the train draws the fit begun from all to
-    itself (corpus seed 4/210: fifteen tocks 3-86 ms late, and the seven right tocks
-    after them put off the beat)."""
+    (`_fit_from`), the one most ticks lie within `OFF_BEAT` of. A run of ticks that
+    drift off the beat (a train that followed the wrong onsets for a while: its own
+    later impacts, others' rings) draws the fit begun from all to itself (corpus seed
+    4/210: fifteen tocks 3-86 ms late, and the seven right tocks after them put off
+    the beat)."""
     bounds = np.linspace(0, n.size, 4).astype(int)
     position = np.arange(n.size)
     thirds = [(position >= a) & (position < b) for a, b in pairwise(bounds)]
