@@ -193,6 +193,36 @@ def test_beats_heard_on_one_side_only_are_predicted_with_the_local_swing():
     assert np.all(err[-4:] < 0.7 * by_mean[-4:])
 
 
+@pytest.mark.parametrize(
+    ("mistimed", "ringing"),
+    [
+        ({2: -3.5e-3}, [2]),  # the beat of its kind, two on, early in a ring (seed 4/51)
+        ({1: 7.5e-3}, [1, 2]),  # the beat beside it late, both in rings (seed 3/260)
+        ({1: 7.5e-3}, [1]),  # the beat beside it late in a ring
+        ({}, []),  # no ring
+    ],
+)
+def test_the_beat_just_past_an_end_is_predicted_from_a_beat_outside_others_rings(mistimed, ringing):
+    """Corpus seed 4/51: a train's first beat was sought 5.4 ms early, from the beat of
+    its kind two on, heard 3.5 ms early in another metronome's ring, and it was not
+    found. There a beat just past an end is predicted from the beat beside it, by the
+    train's step between the two kinds (its limp); but not where that beat lies in a
+    ring too (seed 3/260: heard 7.5 ms late)."""
+    t = limping(41) + np.random.default_rng(51).normal(0, 0.1e-3, 41)
+    heard = t.copy()
+    for beat, error in mistimed.items():
+        heard[beat] += error
+        heard[-1 - beat] -= error  # the same at the train's last beats
+    in_ring = np.zeros(41, dtype=bool)
+    in_ring[ringing] = True
+    in_ring[[-1 - beat for beat in ringing]] = True
+    keep = np.ones(41, dtype=bool)
+    keep[[0, -1]] = False  # the beats sought
+    beats, predicted = rc._predictions(heard, train_of(heard, keep), 1, in_ring)
+    assert beats.tolist() == [0, 40]
+    assert np.abs(predicted - t[[0, 40]]).max() < 1e-3
+
+
 def _two(times_a, times_b):
     times = np.concatenate([times_a, times_b])
     order = np.argsort(times, kind="stable")
