@@ -3,7 +3,8 @@
 Contract: `hidden_trains(periods, jitters)` takes each train's beat period (s) and
 the jitter of its beats (s, `metronome.beat_statistics`), and returns the indices of
 the trains that follow no one metronome; `hidden_count(times, span, trains)` says how
-many metronomes their ticks hold.
+many metronomes their ticks hold; `followers(periods, jitters)` returns the indices of
+the trains that follow a metronome told apart every few beats.
 
 Two metronomes of nearly one tempo that tick together all along, one hidden behind
 the other most of the time, cannot be told apart on one microphone: the tracker
@@ -20,9 +21,11 @@ give themselves away by their beat and their tempo:
 
 Real metronomes on one disk neither lock at 3:2 nor keep jumping by milliseconds, so
 the trains of the metronomes told apart stay; a pair that locks 1:1, however
-unsteady, starts nothing. The metronomes behind the hidden trains are counted from
-their ticks: the ticks no kept train holds, per beat of their own tempo, at least two
-and at most as many as the hidden trains.
+unsteady, starts nothing. An unsteady train alone whose tempo is a whole fraction of
+a steady train's follows that metronome's ticks, or their later impacts, every few
+beats among other sounds: it is no metronome at all (`followers`). The metronomes
+behind the hidden trains are counted from their ticks: the ticks no kept train holds,
+per beat of their own tempo, at least two and at most as many as the hidden trains.
 """
 
 from __future__ import annotations
@@ -83,6 +86,24 @@ def hidden_trains(periods, jitters) -> list[int]:
                 group.add(i)
                 grew = True
     return sorted(group)
+
+
+def followers(periods, jitters) -> list[int]:
+    """Indices (sorted) of the unsteady trains (jitter above `MAX_JITTER`) whose beat is
+    a whole multiple (2 to `RATIO`, within `LOCK`) of a steady train's: they follow
+    that metronome's ticks, or their later impacts, every few beats among a few other
+    sounds (corpus seed 4/363: a train at a quarter of a metronome's tempo, seven of
+    its ten ticks 33 ms after that metronome's, and a jitter of 27 ms), and are no
+    metronome of their own."""
+    periods = np.asarray(periods, dtype=float)
+    jitters = np.nan_to_num(np.asarray(jitters, dtype=float), nan=0.0)
+    steady = np.flatnonzero(jitters <= MAX_JITTER)
+    out = []
+    for i in np.flatnonzero(jitters > MAX_JITTER).tolist():
+        ratios = (_locked(periods[i], periods[j], harmonic=True) for j in steady)
+        if any(ab is not None and ab[0] > 1 and ab[1] == 1 for ab in ratios):
+            out.append(int(i))
+    return out
 
 
 def hidden_count(times: np.ndarray, span: float, hidden: int) -> tuple[int, float, float]:
