@@ -408,6 +408,17 @@ def test_a_train_of_a_metronomes_later_impacts_every_few_beats_is_no_metronome(t
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
+def test_a_grouping_by_sound_that_holds_a_metronome_tempo_alone_missed_is_taken(tmp_path):
+    """Corpus seed 3/355 (first run of seeds 336-383): no grouping by sound held every
+    voice, and tempo alone found two metronomes of three; the 121 BPM one, most of its
+    ticks heard, was left to no one. A grouping whose trains each hold half their
+    beats had all three (that one in two pieces of every third beat, joined), and is
+    now taken whether tempo alone makes more metronomes than it or fewer."""
+    ds, truth = recording(tmp_path, 3, 355)
+    assert ds.attrs["metronomes"] == 3
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
 def test_a_tick_found_off_its_prediction_is_judged_around_where_it_was_found(tmp_path):
     """Corpus seed 4/160: the walk past a train's end predicted its last tick 3.2 ms
     early; the window around the prediction held only the tick's first 1.8 ms, it

@@ -8,9 +8,9 @@ impacts), or none with the reason.
 Steps: the impacts are grouped into voices by their sound (`voices`: the grouping with
 the most voices in which every voice carries tick trains of its own, but a voice of a
 few odd sounds with none (all such under `ODD_VOICE` of the ticks); where none does
-and tempo alone would make as many metronomes as the first grouping whose trains
-each hold `trains.MIN_COVERAGE` of their beats (else `LAST_COVERAGE`) and borrow at
-most `LAST_BORROWED` of their ticks from other voices, or more, that grouping; where a
+and there is a grouping whose trains each hold `trains.MIN_COVERAGE` of their beats
+(else `LAST_COVERAGE`) and borrow at most `LAST_BORROWED` of their ticks from other
+voices, the first such grouping rather than tempo alone; where a
 grouping of fewer voices makes more metronomes than the first whose trains each hold
 `trains.MIN_COVERAGE` of their beats, the latter: a metronome whose sounds share
 voices with others' falls into pieces its voices no longer join);
@@ -124,11 +124,13 @@ def separate(recording, impacts, *, bpm: float | None = None, seed: int = 0) -> 
             ):
                 weak[least] = voices, head, gaps, found, groups
     fallback = weak.get(tr.MIN_COVERAGE, weak.get(LAST_COVERAGE))
-    if voices.count == 1 and fallback is not None and len(found) >= len(fallback[3]):
+    if voices.count == 1 and fallback is not None:
         # tempo alone would make more metronomes than the sounds: a faint metronome,
         # a third of its beats unheard, is one metronome, not pieces of several; or as
         # many: two of nearly one tempo, their ticks meeting again and again, are told
-        # apart by their sounds, where tempo alone swaps them (corpus seed 96)
+        # apart by their sounds, where tempo alone swaps them (corpus seed 96); or
+        # fewer: it left a metronome whose ticks were heard to no one (seed 3/355: one
+        # of 121 BPM, in two pieces of every third beat where sounds were told apart)
         voices, head, gaps, found, groups = fallback
     elif tr.MIN_COVERAGE in weak and len(found) > len(weak[tr.MIN_COVERAGE][3]):
         # so would fewer voices: a metronome whose tick and tock were two voices, its
