@@ -302,8 +302,9 @@ def _settled(ticks, trains: list[Train]) -> list[Train] | None:
     """The trains recovery left, looked at again once it has put other metronomes'
     ticks off their beats, or None where nothing changes; then to be recovered again:
     - a slow train is divided where the ticks between are free only now (corpus seed
-      4/346: a tock 2-25 ms from another's tick all along, at 3:2, that metronome's
-      train held them, and their metronome was heard at half its tempo);
+      4/346: its tocks fell 2-25 ms from another metronome's ticks all along, at 3:2;
+      that metronome's train held them until recovery put them off its beat, and the
+      slow metronome was heard at half its tempo);
     - a train that follows a metronome told apart every few beats (`hidden.followers`)
       is dropped, and its ticks on that metronome's beats left to it (corpus seed 4/363:
       a fifth metronome of four, of a quarter of one's tempo and a jitter of 27 ms)."""
