@@ -179,6 +179,7 @@ def _trains(times, strength, voices: Voices, beat_range):
             found.append(t)
             of_voice.append(v)
     found, of_voice = tr.drop_shared(found, of_voice)
+    found = tr.own_again(found, of_voice, voices.labels)
     found, of_voice, folded = tr.fold_parts(times, found, of_voice, strength)
     for index in folded:
         head[index] = False
