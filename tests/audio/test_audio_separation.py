@@ -433,6 +433,42 @@ def test_a_metronome_whose_ticks_trains_of_a_fraction_of_its_tempo_took_first_is
     _assert_each_metronome_meets_the_issue(scores(ds, truth))
 
 
+def test_a_tick_fitted_at_the_early_end_of_its_search_is_sought_beyond_it(tmp_path):
+    """Corpus seed 3/477 (first run of seeds 432-479): a metronome's first tick, 52 ms
+    into another's ring, was sought by its sound from a prediction 7.6 ms late, found
+    2.6 ms earlier, and timed in the ring at the early end of the fit's reach: 2.1 ms
+    late (recall 0.988). Fitted at the end of its reach, it is fitted again around
+    there, and timed there where it sounds more like itself
+    (`templates._before_the_reach`)."""
+    ds, truth = recording(tmp_path, 3, 477)
+    assert ds.attrs["metronomes"] == 3
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
+def test_a_tick_in_a_ring_timed_farther_off_its_beat_than_a_fit_reaches_is_sought_there(
+    tmp_path,
+):
+    """Unseen corpus seed 4/360: a metronome's ticks 45-54 ms after another's had their
+    onsets timed 6-10 ms late by that one's later impacts and ring, beyond the reach
+    of the fit in the ring (3 ms), and kept so (recall 0.975, precision 0.965). Such a
+    tick is fitted again where its neighbours of its kind put its beat
+    (`templates._toward_the_beat`)."""
+    ds, truth = recording(tmp_path, 4, 360)
+    assert ds.attrs["metronomes"] == 4
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
+def test_a_tick_behind_a_bumps_crack_with_no_other_tick_near_is_timed_by_its_sound(tmp_path):
+    """Corpus seed 4/466 (first run of seeds 432-479): a handling bump's crack 2.8 ms
+    before a tick made its onset; the tick's own sound fitted on time, but 0.41 alike
+    (the bump's thump under it), under the 0.5 a tick moved off its onset needs where
+    another's tick may have drawn it. With no other train's tick in the window, the
+    bar is a tick's own (`templates.MIN_LIKENESS`)."""
+    ds, truth = recording(tmp_path, 4, 466)
+    assert ds.attrs["metronomes"] == 4
+    _assert_each_metronome_meets_the_issue(scores(ds, truth))
+
+
 def test_a_tick_found_off_its_prediction_is_judged_around_where_it_was_found(tmp_path):
     """Corpus seed 4/160: the walk past a train's end predicted its last tick 3.2 ms
     early; the window around the prediction held only the tick's first 1.8 ms, it

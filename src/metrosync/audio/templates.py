@@ -34,13 +34,20 @@ own sound fits more than `CRACK` away: something began just before them. A tick 
 another train holds as hidden behind it is fitted again with that train's sound at
 the onset among the b_j, and timed so where its own sound then fits more than `CRACK`
 away: two metronomes a millisecond apart make one onset, the first's
-(`_beside_a_hidden_tick`).
+(`_beside_a_hidden_tick`). Where the other's ring timed the onset later than the
+fit reaches, the fit's best lies at the early end of its search, and is sought
+again around there (`_before_the_reach`); or the tick lies farther off the beat its
+neighbours of its kind put it at than `SEARCH`, and is fitted again there
+(`_toward_the_beat`). Either is taken only where the tick sounds more like itself.
 
 Behind a crack. A tick that begins within the detector's resolution after a louder
 sound (a handling bump's crack, another metronome's later impact) has no onset of its
 own; its train holds the crack. Where that onset sounds too unlike the tick to stay
 and the first search found only the crack, the end of its reach or nothing like a
 tick, the tick is sought `LATE` after the onset (see `_behind_a_crack`).
+A tick whose own sound fits more than `CRACK` from its onset is timed by that fit
+where it sounds enough like itself there (`CRACK_LIKENESS`; `MIN_LIKENESS` where no
+other metronome's tick sounds in its window).
 
 Likeness. The share of the window's energy (less what the other ticks explain) that
 the tick's own sound explains at its best onset: above 0.4 for the corpus's ticks,
@@ -102,6 +109,8 @@ CRACK = 0.7e-3
 #: ... where it sounds at least this much like it there (a crack 1-2.6 ms ahead:
 #: 0.57-0.92 in the corpus; a tick moved onto another's on one onset, 0.46).
 CRACK_LIKENESS = 0.5
+#: Ticks of its kind each side of a tick that say where its beat is.
+NEIGHBOURS = 4
 #: A fit's best this near the end of its `SEARCH` is at the end of its reach, s.
 EDGE = 0.25e-3
 #: Where a tick too unlike its sound is looked for again, after its detected onset,
@@ -384,6 +393,13 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
                           fitted, likeness)  # fmt: skip
     likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
+    alike = likeness[held]
+
+    def held_around(at, rows):
+        return context(times, sources, sounds, at, owner[held[rows]])
+
+    _before_the_reach(recording, scan, h, own, fitted, alike, held_around)
+    likeness[held] = alike
     # masked ticks too: each is timed by its owner's sound, and a tick that only the
     # train that took it as masked holds is that train's own, its sound read in the
     # ring as another's (corpus seed 58, two metronomes: kept 1.4 ms late)
@@ -392,8 +408,9 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     # something just before it (a handling bump's crack 1-2.6 ms ahead, corpus seeds
     # 3/172, 3/231, 4/181, 4/98), or the tick late in the bump's thump
     moved = np.abs(fitted - h)
-    behind = _begins_away(fitted, h, likeness[held])
+    behind = _begins_away(fitted, h, likeness[held], alone=np.array([not c for c in around]))
     out[held[in_ring | behind]] = fitted[in_ring | behind]
+    _toward_the_beat(recording, scan, times, out, likeness, trains, sounds, sources, held[in_ring])
     # where the first search's best is the onset itself (the crack), the end of its
     # reach, or nothing like a tick, the tick may lie beyond; one found in between is
     # there, only sounding less like itself (another metronome's tick on its onset:
@@ -407,11 +424,75 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     return out, likeness
 
 
-def _begins_away(fitted: np.ndarray, onset: np.ndarray, likeness: np.ndarray) -> np.ndarray:
+def _before_the_reach(recording, scan, onset, own, fitted, likeness, around) -> None:
+    """Ticks whose own sound fits best at the early end of the search (`EDGE`), fitted
+    again around there (``fitted``, ``likeness`` (n,) changed in place; ``around(at,
+    rows)``: the other ticks that sound in windows at ``at``) and timed so where
+    they sound more like it within that search's reach: another's ring can time a
+    tick's onset more than `SEARCH` late (corpus seed 3/477: the first tick of a
+    metronome, sought by sound from a prediction 7.6 ms late, fitted 2.9 ms before
+    its found onset, 0.89 alike; it was 2.1 ms earlier still). Only earlier: a tick
+    that begins well after its onset would have been heard as an onset of its own."""
+    rows = np.flatnonzero((fitted - onset <= -(SEARCH - EDGE)) & ~np.isnan(likeness))
+    if rows.size == 0:
+        return
+    at = fitted[rows]
+    again = fit(recording, scan, at, [own[r] for r in rows], around(at, rows))
+    inside = np.abs(again.onset - at) < SEARCH - EDGE
+    better = inside & (again.likeness > likeness[rows])
+    fitted[rows[better]] = again.onset[better]
+    likeness[rows[better]] = again.likeness[better]
+
+
+def _toward_the_beat(recording, scan, times, out, likeness, trains, sounds, sources, ticks) -> None:
+    """Ticks in another's ring (``ticks``, held) timed farther off their beat than a fit
+    reaches (`SEARCH`), fitted again where their train's beat puts them (``out``,
+    ``likeness`` changed in place) and timed there where they sound more like
+    themselves: another's later impacts and ring can hide a tick's first milliseconds
+    from the detector (corpus seed 4/360: ticks 45-54 ms after another's, their onsets
+    8-12 ms late, fitted within 3 ms of them). The beat: where the tick's neighbours
+    of its kind (`NEIGHBOURS` each side) put it, by their median line (robust to
+    neighbours so timed too)."""
+    owner = holders(times.size, trains)
+    place = np.full(ticks.size, np.nan)
+    for m, train in enumerate(trains):
+        mine = np.flatnonzero(owner[ticks] == m)
+        for row in mine:
+            k = int(np.flatnonzero(train.index == ticks[row])[0])
+            kind = np.flatnonzero(train.beat % 2 == train.beat[k] % 2)
+            pos = int(np.searchsorted(kind, k))
+            near = np.concatenate([kind[max(pos - NEIGHBOURS, 0) : pos],
+                                   kind[pos + 1 : pos + 1 + NEIGHBOURS]])  # fmt: skip
+            if near.size < 4:
+                continue
+            t, b = out[train.index[near]], train.beat[near].astype(float)
+            i, j = np.triu_indices(near.size, 1)
+            slope = np.median((t[j] - t[i]) / (b[j] - b[i]))
+            place[row] = np.median(t + slope * (train.beat[k] - b))
+    rows = np.flatnonzero((np.abs(out[ticks] - place) > SEARCH) & ~np.isnan(likeness[ticks]))
+    if rows.size == 0:
+        return
+    at = place[rows]
+    whose = owner[ticks[rows]]
+    again = fit(recording, scan, at, [sounds[m] for m in whose],
+                context(times, sources, sounds, at, whose))  # fmt: skip
+    inside = np.abs(again.onset - at) < SEARCH - EDGE
+    better = inside & (again.likeness > likeness[ticks[rows]])
+    out[ticks[rows[better]]] = again.onset[better]
+    likeness[ticks[rows[better]]] = again.likeness[better]
+
+
+def _begins_away(
+    fitted: np.ndarray, onset: np.ndarray, likeness: np.ndarray, alone: np.ndarray | None = None
+) -> np.ndarray:
     """Whether each tick's own sound, fitted at ``fitted`` (s), begins more than `CRACK`
-    from its detected ``onset`` and sounds like it there (`CRACK_LIKENESS`): something
-    else made the onset."""
-    return (np.abs(fitted - onset) > CRACK) & (likeness >= CRACK_LIKENESS)
+    from its detected ``onset`` and sounds like it there (`CRACK_LIKENESS`; where no
+    other train's tick sounds in its window (``alone``), `MIN_LIKENESS`: no other
+    metronome's onset can have drawn it there, and a bump's thump under a tick leaves
+    it less alike, corpus seed 4/466: 0.41, its crack 2.8 ms ahead): something else
+    made the onset."""
+    bar = np.where(alone, MIN_LIKENESS, CRACK_LIKENESS) if alone is not None else CRACK_LIKENESS
+    return (np.abs(fitted - onset) > CRACK) & (likeness >= bar)
 
 
 def _alone_where_it_fits_better(recording, scan, at, own, around, fitted, likeness) -> None:
