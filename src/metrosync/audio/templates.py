@@ -393,13 +393,7 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
                           fitted, likeness)  # fmt: skip
     likeness[held[[not all(sound.learned) for sound in own]]] = np.nan
     h = times[held]
-    alike = likeness[held]
-
-    def held_around(at, rows):
-        return context(times, sources, sounds, at, owner[held[rows]])
-
-    _before_the_reach(recording, scan, h, own, fitted, alike, held_around)
-    likeness[held] = alike
+    _before_the_reach(recording, scan, times, fitted, likeness, owner, sounds, sources, held)
     # masked ticks too: each is timed by its owner's sound, and a tick that only the
     # train that took it as masked holds is that train's own, its sound read in the
     # ring as another's (corpus seed 58, two metronomes: kept 1.4 ms late)
@@ -410,7 +404,8 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     moved = np.abs(fitted - h)
     behind = _begins_away(fitted, h, likeness[held], alone=np.array([not c for c in around]))
     out[held[in_ring | behind]] = fitted[in_ring | behind]
-    _toward_the_beat(recording, scan, times, out, likeness, trains, sounds, sources, held[in_ring])
+    _toward_the_beat(recording, scan, times, out, likeness, owner, trains, sounds, sources,
+                     held[in_ring])  # fmt: skip
     # where the first search's best is the onset itself (the crack), the end of its
     # reach, or nothing like a tick, the tick may lie beyond; one found in between is
     # there, only sounding less like itself (another metronome's tick on its onset:
@@ -424,41 +419,40 @@ def retime(recording, scan, times: np.ndarray, trains: list[Train], sounds):
     return out, likeness
 
 
-def _before_the_reach(recording, scan, onset, own, fitted, likeness, around) -> None:
-    """Ticks whose own sound fits best at the early end of the search (`EDGE`), fitted
-    again around there (``fitted``, ``likeness`` (n,) changed in place; ``around(at,
-    rows)``: the other ticks that sound in windows at ``at``) and timed so where
-    they sound more like it within that search's reach: another's ring can time a
-    tick's onset more than `SEARCH` late (corpus seed 3/477: the first tick of a
-    metronome, sought by sound from a prediction 7.6 ms late, fitted 2.9 ms before
-    its found onset, 0.89 alike; it was 2.1 ms earlier still). Only earlier: a tick
-    that begins well after its onset would have been heard as an onset of its own."""
-    rows = np.flatnonzero((fitted - onset <= -(SEARCH - EDGE)) & ~np.isnan(likeness))
-    if rows.size == 0:
-        return
-    at = fitted[rows]
-    again = fit(recording, scan, at, [own[r] for r in rows], around(at, rows))
-    inside = np.abs(again.onset - at) < SEARCH - EDGE
-    better = inside & (again.likeness > likeness[rows])
-    fitted[rows[better]] = again.onset[better]
-    likeness[rows[better]] = again.likeness[better]
+def _before_the_reach(
+    recording, scan, times, fitted, likeness, owner, sounds, sources, held
+) -> None:
+    """Held ticks (``held``; ``fitted`` (n,) their fits, ``likeness`` (K,), both changed
+    in place) whose own sound fits best at the early end of the search (`EDGE`), fitted
+    again around there and timed so where they sound more like it within that search's
+    reach: another's ring can time a tick's onset more than `SEARCH` late (corpus seed
+    3/477: the first tick of a metronome, sought by sound from a prediction 7.6 ms
+    late, fitted 2.9 ms before its found onset, 0.89 alike; it was 2.1 ms earlier
+    still). Only earlier: a tick that begins well after its onset would have been heard
+    as an onset of its own."""
+    early = fitted - times[held] <= -(SEARCH - EDGE)
+    rows = np.flatnonzero(early & ~np.isnan(likeness[held]))
+    if rows.size:
+        fitted[rows], likeness[held[rows]] = _refitted(
+            recording, scan, times, fitted[rows], likeness[held[rows]],
+            owner[held[rows]], sounds, sources)  # fmt: skip
 
 
-def _toward_the_beat(recording, scan, times, out, likeness, trains, sounds, sources, ticks) -> None:
-    """Ticks in another's ring (``ticks``, held) timed farther off their beat than a fit
-    reaches (`SEARCH`), fitted again where their train's beat puts them (``out``,
-    ``likeness`` changed in place) and timed there where they sound more like
-    themselves: another's later impacts and ring can hide a tick's first milliseconds
-    from the detector (corpus seed 4/360: ticks 45-54 ms after another's, their onsets
-    8-12 ms late, fitted within 3 ms of them). The beat: where the tick's neighbours
-    of its kind (`NEIGHBOURS` each side) put it, by their median line (robust to
-    neighbours so timed too)."""
-    owner = holders(times.size, trains)
+def _toward_the_beat(
+    recording, scan, times, out, likeness, owner, trains, sounds, sources, ticks
+) -> None:
+    """Ticks in another's ring (``ticks``, held; ``owner``: `holders`) timed farther off
+    their beat than a fit reaches (`SEARCH`), fitted again where their train's beat puts
+    them (``out``, ``likeness`` changed in place) and timed there where they sound more
+    like themselves: another's later impacts and ring can hide a tick's first
+    milliseconds from the detector (corpus seed 4/360: ticks 45-54 ms after another's,
+    their onsets 8-12 ms late, fitted within 3 ms of them). The beat: where the tick's
+    neighbours of its kind (`NEIGHBOURS` each side) put it, by their median line
+    (robust to neighbours so timed too)."""
     place = np.full(ticks.size, np.nan)
     for m, train in enumerate(trains):
         mine = np.flatnonzero(owner[ticks] == m)
-        for row in mine:
-            k = int(np.flatnonzero(train.index == ticks[row])[0])
+        for row, k in zip(mine, np.searchsorted(train.index, ticks[mine]), strict=True):
             kind = np.flatnonzero(train.beat % 2 == train.beat[k] % 2)
             pos = int(np.searchsorted(kind, k))
             near = np.concatenate([kind[max(pos - NEIGHBOURS, 0) : pos],
@@ -470,16 +464,23 @@ def _toward_the_beat(recording, scan, times, out, likeness, trains, sounds, sour
             slope = np.median((t[j] - t[i]) / (b[j] - b[i]))
             place[row] = np.median(t + slope * (train.beat[k] - b))
     rows = np.flatnonzero((np.abs(out[ticks] - place) > SEARCH) & ~np.isnan(likeness[ticks]))
-    if rows.size == 0:
-        return
-    at = place[rows]
-    whose = owner[ticks[rows]]
+    if rows.size:
+        out[ticks[rows]], likeness[ticks[rows]] = _refitted(
+            recording, scan, times, place[rows], likeness[ticks[rows]], owner[ticks[rows]],
+            sounds, sources, kept=out[ticks[rows]])  # fmt: skip
+
+
+def _refitted(recording, scan, times, at, likeness, whose, sounds, sources, kept=None):
+    """((n,) onsets, (n,) likeness): each tick of train ``whose`` fitted again around
+    ``at`` (s), beside the other ticks that sound there (``sources``, `sounding`), where
+    the fit lands within that search's reach (short of `EDGE`) and sounds more like the
+    tick than its ``likeness`` now; elsewhere ``kept`` (default ``at``) and its
+    likeness."""
     again = fit(recording, scan, at, [sounds[m] for m in whose],
                 context(times, sources, sounds, at, whose))  # fmt: skip
-    inside = np.abs(again.onset - at) < SEARCH - EDGE
-    better = inside & (again.likeness > likeness[ticks[rows]])
-    out[ticks[rows[better]]] = again.onset[better]
-    likeness[ticks[rows[better]]] = again.likeness[better]
+    better = (np.abs(again.onset - at) < SEARCH - EDGE) & (again.likeness > likeness)
+    kept = at if kept is None else kept
+    return np.where(better, again.onset, kept), np.where(better, again.likeness, likeness)
 
 
 def _begins_away(
