@@ -56,6 +56,21 @@ def test_bpm_outside_tunable_range_is_rejected():
         d.l2_for_bpm(float("nan"))
 
 
+@pytest.mark.parametrize("tuning", ["small-amplitude", "steady-swing"])
+@pytest.mark.parametrize("bpm", [0.0, -5.0])
+def test_a_tempo_at_or_below_zero_is_refused_as_such(bpm, tuning):
+    # It once recursed without end: the fix offered for a low BPM asked a widened
+    # design to tune to it, which was out of its range too.
+    d = MetronomeDesign(tuning=tuning)
+    with pytest.raises(ParameterError, match=r"`bpm` = -?\d+ BPM: a tempo must be positive"):
+        d.l2_for_bpm(bpm)
+
+
+def test_a_slow_tempo_no_slider_position_reaches_says_so():
+    with pytest.raises(ParameterError, match=r"no slider position reaches it"):
+        MetronomeDesign().l2_for_bpm(1e-3)
+
+
 def test_inverted_pendulum_is_rejected():
     with pytest.raises(ParameterError, match=r"h = .* <= 0.*inverted"):
         Metronome(MetronomeDesign(), l2=0.2)

@@ -177,6 +177,13 @@ class MetronomeDesign:
             )
         inverted = self.w1 * self.l1 / self.w2 if self.w2 > 0 else math.inf
         wide = replace(self, l2_bounds=(0.0, min(inverted * (1 - 1e-9), 1e3)))
+        wide_low, wide_high = wide.bpm_range()
+        if not wide_low <= bpm <= wide_high:
+            # Asking `wide` to tune to it would ask this question again, forever.
+            return text + (
+                f"; no slider position reaches it (L2 from 0 to just short of the inverted "
+                f"pendulum, {wide.l2_bounds[1]:.4g} m, tunes {wide_low:.4g} to {wide_high:.4g} BPM)."
+            )
         try:
             needed = float(wide.l2_for_bpm(bpm))
         except ParameterError:
@@ -211,6 +218,11 @@ class MetronomeDesign:
         bpm_arr = np.asarray(bpm, dtype=float)
         if not np.all(np.isfinite(bpm_arr)):
             raise ParameterError(f"`{name}` must be finite, got {describe(bpm)}.")
+        if np.any(bpm_arr <= 0):
+            # Checked apart from the range: no slider position (nor any widening of
+            # `l2_bounds` that `out_of_range` could offer) reaches a BPM at or below zero.
+            value = float(bpm_arr[bpm_arr <= 0].flat[0])
+            raise ParameterError(f"`{name}` = {value:g} BPM: a tempo must be positive.")
         low, high = self.bpm_range()
         bad = (bpm_arr < low) | (bpm_arr > high)
         if not np.any(bad):
