@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .._files import write_netcdf
+from .._input_files import check_input_file
 from ..errors import ParameterError
 
 #: Suffixes of a NetCDF-4 (HDF5) dataset.
@@ -91,9 +92,7 @@ def read_dataset(path: Path, what: str = "input file"):
     """Load a NetCDF file written by metrosync into memory."""
     import xarray as xr
 
-    path = Path(path)
-    if not path.is_file():
-        raise ParameterError(f"cannot read {what} {str(path)!r}: the file does not exist.")
+    path = check_input_file(path, what)
     try:
         with xr.open_dataset(path, engine="h5netcdf") as ds:
             return ds.load()

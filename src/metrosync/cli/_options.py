@@ -54,6 +54,19 @@ def int_list(text: str) -> list[int]:
     return values
 
 
+def seed(text: str) -> int:
+    """Parse a random seed: a whole number from 0 up, as NumPy's generators take."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected a whole number such as 0 or 7, got {text!r}"
+        ) from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"a seed is a whole number from 0 up, got {value}")
+    return value
+
+
 def group_spec(text: str) -> Group:
     """Parse ``--group N@BPM[:SIGMA]`` (see `metrosync.groups.parse_group`)."""
     try:
@@ -115,7 +128,7 @@ def add_ensemble_options(parser: argparse.ArgumentParser, *, runs: int = 20) -> 
     parser.set_defaults(_runs_default=runs)
     g.add_argument("--duration", type=float, default=600.0, help="simulated time, s")
     g.add_argument("--dt", type=float, default=0.01, help="time step, s")
-    g.add_argument("--seed", type=int, default=0, help="random seed")
+    g.add_argument("--seed", type=seed, default=0, help="random seed")
     g.add_argument("--preset", default="default", help="parameter preset (see `metrosync presets`)")
     add_platform_option(g)
     g.add_argument(

@@ -8,7 +8,7 @@ from .._files import atomic_path
 from .._words import plural
 from ..errors import ParameterError
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, seed
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -47,7 +47,7 @@ def register(subparsers) -> None:
         help="film the run as a phone would (--out FILE.mp4, .mov or .mkv)",
     )  # fmt: skip
     phone.add_argument(
-        "--phone-seed", type=int, default=0, help="draws the scene and the phone's settings"
+        "--phone-seed", type=seed, default=0, help="draws the scene and the phone's settings"
     )
     phone.add_argument(
         "--size", default="1280x720",

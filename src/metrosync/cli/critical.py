@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ._io import FIGURE, NETCDF, check_output, read_dataset, write_outputs
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, seed
 
 
 def register(subparsers) -> None:
@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     )
     parser.add_argument("sweep", type=Path, help="merged sweep written by `metrosync sweep`")
     parser.add_argument("--bootstrap", type=int, default=1000, help="bootstrap replicas")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
+    parser.add_argument("--seed", type=seed, default=0, help="seed of the bootstrap")
     parser.add_argument("--select", action="append", default=[], metavar="NAME=VALUE",
                         help="pick one value of another swept parameter (repeatable)")  # fmt: skip
     figure = parser.add_mutually_exclusive_group()

@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._input_files import check_input_file
 from .._words import plural
 from ..errors import (
     ChannelCountError,
@@ -90,7 +91,7 @@ def read_log(
     -------
     GateLog
     """
-    path = Path(source)
+    path = check_input_file(source, "light-gate log", allow_empty=True)
     try:
         data = path.read_bytes()
     except OSError as error:

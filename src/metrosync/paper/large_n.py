@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .._input_files import check_input_file
 from ..errors import ParameterError
 from ..sweeps.critical import critical_frequency, plot_critical
 from ..sweeps.scaling import (
@@ -83,11 +84,13 @@ class LargeN:
 def read_large_n(path: str | Path, *, n_boot: int = 200, seed: int = 0) -> LargeN:
     """The `LargeN` of the merged sweep at ``path`` (one σ, several N, a BPM grid)."""
     path = Path(path)
-    if not path.is_file():
+    try:
+        check_input_file(path, "`large_n` sweep")
+    except ParameterError as error:
         raise ParameterError(
-            f"`large_n`: no file {str(path)!r}; give the merged sweep of the large-N study "
+            f"{error} Give the merged sweep of the large-N study "
             f"(`metrosync sweep studies/large_n/sigma_0.75.toml --out FILE.nc`)."
-        )
+        ) from None
     try:
         with xr.open_dataset(path, engine="h5netcdf") as opened:
             ds = opened.load()

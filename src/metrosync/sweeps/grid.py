@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .._input_files import check_input_file
 from .._version import __version__
 from ..errors import ParameterError, describe
 from ..groups import as_groups, describe_groups, shifted
@@ -357,7 +358,7 @@ class Grid:
         ``record_every``, ``integrator``, ``backend``, ``groups`` (e.g.
         ``["7@184", "7@184:0.5"]``). ``overrides`` replace or extend (``axes``/``fixed``
         are merged by name)."""
-        path = Path(path)
+        path = check_input_file(path, "grid file")
         try:
             data = tomllib.loads(path.read_text())
         except OSError as error:

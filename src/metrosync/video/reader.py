@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._input_files import check_input_file
 from .._words import plural
 from ..errors import MetrosyncError
 
@@ -173,11 +174,7 @@ def open_video(path: str | Path) -> Video:
     """
     import av
 
-    path = Path(path)
-    if not path.is_file():
-        raise VideoFileError(f"cannot read video {str(path)!r}: the file does not exist.")
-    if path.stat().st_size == 0:
-        raise VideoFileError(f"cannot read video {str(path)!r}: the file is empty.")
+    path = check_input_file(path, "video", error=VideoFileError)
     with _open(path) as container:
         if not container.streams.video:
             kinds = sorted({s.type for s in container.streams})
