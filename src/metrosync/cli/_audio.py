@@ -1,9 +1,9 @@
 """``metrosync analyze recording.wav``: the options and the run for sound recordings.
 
 `metrosync.cli.analyze` adds these options to its parser and hands a recording (a
-file with an audio suffix, see `metrosync.audio.reader`) to `run_audio`; light-gate
-logs go on as before. An option that only one kind of input uses draws a warning
-when given with the other.
+file with an audio or video suffix, see `metrosync.audio.reader`: a video's sound
+track is analysed) to `run_audio`; light-gate logs go on as before. An option that
+only one kind of input uses draws a warning when given with the other.
 """
 
 from __future__ import annotations
@@ -53,7 +53,8 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
         _lightgate_defaults={dest: parser.get_default(dest) for dest in LIGHTGATE_OPTIONS}
     )
     g = parser.add_argument_group(
-        "sound recordings (.wav, .flac, .ogg, .mp3: one file, or several with --together)",
+        "sound recordings (.wav, .flac, .ogg, .mp3, a phone's .m4a, a video's sound: one "
+        "file, or several with --together)",
         "Tick times, tempo, beat (tick/tock), and how together the ticks fall.",
     )
     g.add_argument(

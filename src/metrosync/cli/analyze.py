@@ -32,7 +32,8 @@ def register(subparsers) -> None:
         help="analyse light-gate logs (real or virtual) or a sound recording",
         description="Read light-gate logs, clean them, and measure r(t), the metronomes' "
         "frequencies and their spread. Several logs are repeated runs and are averaged. "
-        "A sound recording (.wav, .flac, .ogg, .mp3) is analysed for its ticks instead.",
+        "A sound recording (.wav, .flac, .ogg, .mp3, a phone's .m4a) or a video (.mp4, .mov) "
+        "is analysed for its ticks instead.",
         formatter_class=HelpFormatter,
     )
     parser.add_argument("logs", nargs="+", type=Path, metavar="LOG",
