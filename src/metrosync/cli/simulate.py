@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
 from .._words import plural
 from ..errors import ParameterError
 from ..integrators._cache import compile_seconds
+from ..model.tuning import MEANINGS
 from ..observables.death import SILENT_PERIODS
 from ..plots import plot_order
 from ..status import STATUS_STOPPED
@@ -21,6 +21,7 @@ from ._options import (
     add_aliases,
     add_ensemble_options,
     ensemble_defaults,
+    path_option,
     simulate_from_args,
 )
 
@@ -50,13 +51,13 @@ def register(subparsers) -> None:
     )
     add_ensemble_options(parser)
     out = parser.add_argument_group("output")
-    out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
-    out.add_argument("--plot", type=Path, default=None,
+    out.add_argument("--out", type=path_option, default=None, help="write the dataset to FILE.nc")
+    out.add_argument("--plot", type=path_option, default=None,
                      help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
     gate = parser.add_argument_group("virtual light gate")
     gate.add_argument(
         "--lightgate-dir",
-        type=Path,
+        type=path_option,
         default=None,
         metavar="DIR",
         help="write one light-gate log per run to DIR (simulates recording every step)",
@@ -189,8 +190,8 @@ def summary(
     if np.isfinite(ticks).any():
         lines.append(
             f"  tick rate (measured over the last {a['tick_rate_span']:g} s): "
-            f"{np.nanmin(ticks):.2f} .. {np.nanmax(ticks):.2f} per minute (the nominal BPM "
-            f"tunes the small-swing frequency; a wider swing ticks slower)"
+            f"{np.nanmin(ticks):.2f} .. {np.nanmax(ticks):.2f} per minute "
+            f"({a['tuning']} tuning: {MEANINGS[a['tuning']]})"
         )
     window = f"  equilibrium r (last {a['equilibrium_window']:g} s, crossing phases)"
     ok = status == 0

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import FIGURE, NETCDF, check_output, write_outputs
-from ._options import HelpFormatter, add_aliases, add_platform_option, model_changes
+from ._options import HelpFormatter, add_aliases, add_platform_option, model_changes, path_option
 
 
 def register(subparsers) -> None:
@@ -38,8 +38,9 @@ def register(subparsers) -> None:
         "--tuning",
         choices=("small-amplitude", "steady-swing"),
         default=None,
-        help="how a nominal BPM sets the slider; the same as --set tuning=NAME (default: the "
-        "preset's, small-amplitude)",
+        help="how a nominal BPM sets the slider: small-amplitude tunes the small-swing "
+        "frequency, steady-swing the tick rate at the steady swing; the same as --set "
+        "tuning=NAME (default: the preset's own, as `metrosync presets` lists it)",
     )
     g = parser.add_argument_group("prediction")
     g.add_argument(
@@ -72,13 +73,13 @@ def register(subparsers) -> None:
     o = parser.add_argument_group("output")
     o.add_argument(
         "--cache",
-        type=Path,
+        type=path_option,
         default=None,
         help="folder of cached measurements (default: ~/.cache/metrosync/theory)",
     )
     o.add_argument("--no-cache", action="store_true", help="measure everything again")
-    o.add_argument("--out", type=Path, default=None, help="write the results to FILE.nc")
-    o.add_argument("--plot", type=Path, default=None, help="write the figure to FILE.png")
+    o.add_argument("--out", type=path_option, default=None, help="write the results to FILE.nc")
+    o.add_argument("--plot", type=path_option, default=None, help="write the figure to FILE.png")
     o.add_argument(
         "--no-simulate",
         action="store_true",
@@ -92,6 +93,7 @@ def register(subparsers) -> None:
         sigmas="--sigma",
         sigma_bpm="--sigma",
         measure_n="--measure-n",
+        method="--method",
         changes="--set",
         n="--n",
         simulate_n="--no-simulate",

@@ -182,7 +182,8 @@ class MetronomeDesign:
             # Asking `wide` to tune to it would ask this question again, forever.
             return text + (
                 f"; no slider position reaches it (L2 from 0 to just short of the inverted "
-                f"pendulum, {wide.l2_bounds[1]:.4g} m, tunes {wide_low:.4g} to {wide_high:.4g} BPM)."
+                f"pendulum, {wide.l2_bounds[1]:.4g} m, tunes {wide_low:.4g} to "
+                f"{wide_high:.4g} BPM)."
             )
         try:
             needed = float(wide.l2_for_bpm(bpm))

@@ -20,6 +20,14 @@ from ..errors import ParameterError
 #: Tuning names: how a nominal BPM becomes a slider position (module docstring).
 TUNINGS = ("small-amplitude", "steady-swing")
 
+#: What a nominal BPM means under each tuning, as a summary says it to a user.
+MEANINGS = {
+    "small-amplitude": "the nominal BPM tunes the small-swing frequency; a wider swing "
+    "ticks slower",
+    "steady-swing": "the nominal BPM is the tick rate at the steady swing, as a real "
+    "metronome's marking",
+}
+
 
 def check_tuning(tuning) -> None:
     """Raise `ParameterError` unless ``tuning`` is one of `TUNINGS`."""

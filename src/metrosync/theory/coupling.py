@@ -158,7 +158,9 @@ def measure_by_growth(
         raise ParameterError(
             f"at {bpm} BPM the order parameter did not grow cleanly out of the splay state "
             f"(r = {r[0]:.3g} at {t_min} s, max {np.nanmax(r):.3g} within {duration:.0f} s); "
-            f"K cos α may be <= 0 here, where the growth method does not apply."
+            f"K cos α may be <= 0 here, where the growth method does not apply; measure K "
+            f"with `method` = 'pair' instead (two metronomes' phase difference, which needs "
+            f"no growth)."
         )
     window = slice(0, past[0])
     growth, growth_se = _line(grid[window], np.log(r[window]))
