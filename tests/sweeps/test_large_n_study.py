@@ -24,7 +24,7 @@ def test_full_grids_sweep_the_large_sizes_around_the_onset(name, sigma):
     assert bpm.size >= 7 and np.ptp(bpm) >= 20
 
 
-def test_quick_form_runs_the_machinery_end_to_end(tmp_path, capsys):
+def test_quick_form_runs_the_machinery_end_to_end(tmp_path, capsys, monkeypatch):
     out = tmp_path / "quick.nc"
     args = ["sweep", str(STUDY / "quick.toml"), "--out", str(out), "--no-progress"]
     assert main(args) == 0
@@ -39,6 +39,7 @@ def test_quick_form_runs_the_machinery_end_to_end(tmp_path, capsys):
     result = tmp_path / "c.nc"
     args = ["critical", str(out), "--scaling", "kuramoto", "--bootstrap", "20",
             "--out", str(result)]  # fmt: skip
+    monkeypatch.chdir(tmp_path)
     assert main(args) == 0
     assert "omega_c(inf) = " in capsys.readouterr().out
     assert (tmp_path / "quick_collapse.png").stat().st_size > 1000

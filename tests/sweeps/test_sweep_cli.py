@@ -7,7 +7,7 @@ import xarray as xr
 from metrosync.cli import main
 
 
-def test_sweep_then_critical(tmp_path, capsys):
+def test_sweep_then_critical(tmp_path, capsys, monkeypatch):
     out = tmp_path / "s.nc"
     args = ["sweep", "--bpm", "184:192:2", "--n", "2,3", "--runs", "4", "--duration", "5",
             "--set", "c_phi=2e-5", "--out", str(out), "--no-progress"]  # fmt: skip
@@ -20,10 +20,14 @@ def test_sweep_then_critical(tmp_path, capsys):
     assert main(args) == 0
     assert "0 computed, 10 reused" in capsys.readouterr().out
 
+    here = tmp_path / "here"  # the default figure goes to the working folder, not the sweep's
+    here.mkdir()
+    monkeypatch.chdir(here)
     assert main(["critical", str(out), "--bootstrap", "50", "--out", str(tmp_path / "c.nc")]) == 0
     text = capsys.readouterr().out
     assert "omega_c (sigma_r peak)" in text and "N -> inf (peak)" in text
-    assert (tmp_path / "s_critical.png").stat().st_size > 0
+    assert (here / "s_critical.png").stat().st_size > 0 and "wrote s_critical.png" in text
+    assert not (tmp_path / "s_critical.png").exists()
     with xr.open_dataset(tmp_path / "c.nc", engine="h5netcdf") as c:
         assert c.omega_c_peak.dims == ("n",) and c.omega_c_peak.attrs["units"] == "BPM"
         assert [name for name in c.variables if "long_name" not in c[name].attrs] == []

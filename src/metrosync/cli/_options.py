@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import math
 import warnings
+from pathlib import Path
 
 from ..capabilities import describe_lacks
 from ..errors import ParameterError
@@ -54,6 +55,14 @@ def int_list(text: str) -> list[int]:
     return values
 
 
+def path_option(text: str) -> Path:
+    """Parse a file or folder option: any path but an empty one, which `Path` would
+    read as the current folder (``--out ""`` would write there without saying so)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a path, got {text!r}")
+    return Path(text)
+
+
 def seed(text: str) -> int:
     """Parse a random seed: a whole number from 0 up, as NumPy's generators take."""
     try:
@@ -64,6 +73,24 @@ def seed(text: str) -> int:
         ) from None
     if value < 0:
         raise argparse.ArgumentTypeError(f"a seed is a whole number from 0 up, got {value}")
+    return value
+
+
+def positive_seconds(text: str) -> float:
+    """Parse a time in seconds that must be finite and > 0, e.g. ``--window 2.5``.
+
+    Refused while the arguments are parsed, so that a window or a spacing that no input
+    could use stops a command before it reads anything (`track` would otherwise decode
+    a whole video first). Whether it fits a particular input is the command's check.
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(
+            f"expected a time in seconds, finite and > 0, such as 0.5; got {text!r}"
+        )
     return value
 
 

@@ -10,11 +10,16 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
-from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import read_dataset
-from ._options import add_aliases, add_ensemble_options, ensemble_defaults, simulate_from_args
+from ._options import (
+    add_aliases,
+    add_ensemble_options,
+    ensemble_defaults,
+    path_option,
+    simulate_from_args,
+)
 
 
 def add_source_options(parser: argparse.ArgumentParser, *, record_seconds: float | None) -> None:
@@ -26,7 +31,7 @@ def add_source_options(parser: argparse.ArgumentParser, *, record_seconds: float
     parser.add_argument(
         "input",
         nargs="?",
-        type=Path,
+        type=path_option,
         default=None,
         help="NetCDF file from `metrosync simulate --save-every K --out FILE.nc`; "
         "without it, simulate with the options below",

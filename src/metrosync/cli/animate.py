@@ -8,7 +8,7 @@ from .._files import atomic_path
 from .._words import plural
 from ..errors import ParameterError
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases, seed
+from ._options import HelpFormatter, add_aliases, path_option, seed
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -22,7 +22,9 @@ def register(subparsers) -> None:
     )
     add_source_options(parser, record_seconds=0.05)
     out = parser.add_argument_group("animation")
-    out.add_argument("--out", type=Path, default=Path("metrosync.gif"), help="FILE.gif or FILE.mp4")
+    out.add_argument(
+        "--out", type=path_option, default=Path("metrosync.gif"), help="FILE.gif or FILE.mp4"
+    )
     out.add_argument("--fps", type=float, default=None,
                      help="frames per second: 15 unless given, at most 50 for a GIF; "
                      "60 with --phone")  # fmt: skip

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 from ..errors import ParameterError
 from ._io import FIGURE, check_output, read_dataset
-from ._options import HelpFormatter
+from ._options import HelpFormatter, path_option
 
 #: --bpm of `c-theta --log` when none is given.
 DEFAULT_BPM = 192.0
@@ -30,8 +29,8 @@ def register(subparsers) -> None:
         formatter_class=HelpFormatter,
     )
     src = ct.add_mutually_exclusive_group(required=True)
-    src.add_argument("--log", type=Path, help="light-gate log of the decay")
-    src.add_argument("--trajectory", type=Path,
+    src.add_argument("--log", type=path_option, help="light-gate log of the decay")
+    src.add_argument("--trajectory", type=path_option,
                      help="NetCDF of `metrosync simulate --save-every 1 --set drive=0 "
                      "--set inertia=inf`")  # fmt: skip
     ct.add_argument("--offset", type=float, default=None,
@@ -68,7 +67,7 @@ def register(subparsers) -> None:
     cp.add_argument("--bracket", type=float, nargs=2, default=(1e-3, 10.0), metavar=("LOW", "HIGH"),
                     help="c_phi range searched, kg m²/s")  # fmt: skip
     for p in (ct, dr, cp):
-        p.add_argument("--plot", type=Path, default=None,
+        p.add_argument("--plot", type=path_option, default=None,
                        help="write the fit to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
         p.set_defaults(func=run)
 

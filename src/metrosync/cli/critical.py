@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ._io import FIGURE, NETCDF, check_output, read_dataset, write_outputs
-from ._options import HelpFormatter, add_aliases, seed
+from ._options import HelpFormatter, add_aliases, path_option, seed
 
 
 def register(subparsers) -> None:
@@ -22,16 +22,19 @@ def register(subparsers) -> None:
         ),
         formatter_class=HelpFormatter,
     )
-    parser.add_argument("sweep", type=Path, help="merged sweep written by `metrosync sweep`")
+    parser.add_argument("sweep", type=path_option, help="merged sweep written by `metrosync sweep`")
     parser.add_argument("--bootstrap", type=int, default=1000, help="bootstrap replicas")
     parser.add_argument("--seed", type=seed, default=0, help="seed of the bootstrap")
     parser.add_argument("--select", action="append", default=[], metavar="NAME=VALUE",
                         help="pick one value of another swept parameter (repeatable)")  # fmt: skip
     figure = parser.add_mutually_exclusive_group()
-    figure.add_argument("--plot", type=Path, default=None,
-                        help="figure path (default: SWEEP with suffix _critical.png)")  # fmt: skip
+    figure.add_argument("--plot", type=path_option, default=None,
+                        help="figure path (default: NAME_critical.png in the current folder, NAME "
+                        "the sweep file's name without .nc)")  # fmt: skip
     figure.add_argument("--no-plot", action="store_true", help="skip the figure")
-    parser.add_argument("--out", type=Path, default=None, help="write the estimates to FILE.nc")
+    parser.add_argument(
+        "--out", type=path_option, default=None, help="write the estimates to FILE.nc"
+    )
     parser.add_argument(
         "--scaling",
         choices=("kuramoto", "free"),
@@ -45,9 +48,9 @@ def register(subparsers) -> None:
     )
     parser.add_argument(
         "--collapse-plot",
-        type=Path,
+        type=path_option,
         default=None,
-        help="collapse figure path (default: SWEEP with suffix _collapse.png)",
+        help="collapse figure path (default: NAME_collapse.png in the current folder)",
     )
     add_aliases(parser, n_boot="--bootstrap")
     parser.set_defaults(func=run)
@@ -72,11 +75,7 @@ def _open(path: Path, select: list[str]):
 def run(args) -> int:
     from ..sweeps.critical import METHODS, critical_frequency, plot_critical
 
-    plot = (
-        None
-        if args.no_plot
-        else args.plot or args.sweep.with_name(args.sweep.stem + "_critical.png")
-    )
+    plot = None if args.no_plot else args.plot or Path(args.sweep.stem + "_critical.png")
     check_output(plot, "--plot", suffixes=FIGURE)
     check_output(args.out, "--out", suffixes=NETCDF)
     collapse_plot = None
@@ -89,9 +88,7 @@ def run(args) -> int:
         if args.collapse_plot is not None:
             raise ParameterError("`--collapse-plot` and `--no-plot` exclude each other; give one.")
     else:
-        collapse_plot = args.collapse_plot or args.sweep.with_name(
-            args.sweep.stem + "_collapse.png"
-        )
+        collapse_plot = args.collapse_plot or Path(args.sweep.stem + "_collapse.png")
         check_output(collapse_plot, "--collapse-plot", suffixes=FIGURE)
     ds = _open(args.sweep, args.select)
     result = critical_frequency(ds, n_boot=args.bootstrap, seed=args.seed)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from .._words import plural
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, path_option
 from ._show_source import add_source_options, load_or_simulate
 
 #: The choices of ``--tick-sound`` (`metrosync.show.sound.TICK_SOUNDS`, not imported
@@ -29,7 +29,7 @@ def register(subparsers) -> None:
     )
     add_source_options(parser, record_seconds=None)
     out = parser.add_argument_group("sound")
-    out.add_argument("--out", type=Path, default=Path("metrosync.wav"), help="FILE.wav")
+    out.add_argument("--out", type=path_option, default=Path("metrosync.wav"), help="FILE.wav")
     out.add_argument("--speedup", type=float, default=1.0, help="play faster than real time")
     out.add_argument("--sample-rate", type=int, default=44100, help="samples per second")
     out.add_argument(

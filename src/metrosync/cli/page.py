@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, path_option
 from ._show_source import add_source_options, load_or_simulate
 
 
@@ -20,7 +20,7 @@ def register(subparsers) -> None:
     )
     add_source_options(parser, record_seconds=0.05)
     out = parser.add_argument_group("page")
-    out.add_argument("--out", type=Path, default=Path("metrosync.html"), help="FILE.html")
+    out.add_argument("--out", type=path_option, default=Path("metrosync.html"), help="FILE.html")
     out.add_argument("--max-rate", type=float, default=50.0,
                      help="keep at most this many records per second")  # fmt: skip
     add_aliases(parser, max_rate="--max-rate")

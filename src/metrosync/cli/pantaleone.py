@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._io import check_output
+from ._options import path_option
 
 
 def register(subparsers) -> None:
@@ -25,7 +26,7 @@ def register(subparsers) -> None:
     mode.add_argument("--full", dest="mode", action="store_const", const="full",
                       help="the report's statistics (about 2 min on 2 cores)")  # fmt: skip
     parser.set_defaults(mode="quick")
-    parser.add_argument("--out", type=Path, default=Path("results-pantaleone"),
+    parser.add_argument("--out", type=path_option, default=Path("results-pantaleone"),
                         help="output folder (default: results-pantaleone)")  # fmt: skip
     parser.set_defaults(func=run)
 

@@ -5,7 +5,14 @@ from __future__ import annotations
 from pathlib import Path
 
 from ._io import check_output
-from ._options import HelpFormatter, add_aliases, add_platform_option, model_changes, seed
+from ._options import (
+    HelpFormatter,
+    add_aliases,
+    add_platform_option,
+    model_changes,
+    path_option,
+    seed,
+)
 
 
 def register(subparsers) -> None:
@@ -32,7 +39,7 @@ def register(subparsers) -> None:
     g.add_argument("--dt", type=float, default=0.01, help="time step, s")
     g.add_argument("--seed", type=seed, default=0, help="seed of the first random start")
     out = parser.add_argument_group("page")
-    out.add_argument("--out", type=Path, default=Path("playground.html"), help="FILE.html")
+    out.add_argument("--out", type=path_option, default=Path("playground.html"), help="FILE.html")
     add_aliases(parser, sigma_bpm="--sigma", changes="--set")
     parser.set_defaults(func=run)
 

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import sys
 import warnings
-from pathlib import Path
 
 from .._words import plural
 from ..errors import Interrupted, ParameterError
-from ._options import HelpFormatter, add_aliases, int_list
+from ._options import HelpFormatter, add_aliases, int_list, path_option
 
 
 def register(subparsers) -> None:
@@ -25,7 +24,7 @@ def register(subparsers) -> None:
         formatter_class=HelpFormatter,
     )
     parser.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyACM0 or COM3")
-    parser.add_argument("--out", type=Path, required=True, help="capture file to write")
+    parser.add_argument("--out", type=path_option, required=True, help="capture file to write")
     parser.add_argument("--baud", type=int, default=115200, help="serial rate (the firmware's)")
     parser.add_argument("--duration", type=float, default=None, metavar="S",
                         help="stop after S seconds (default: at Ctrl-C)")  # fmt: skip

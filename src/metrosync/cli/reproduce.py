@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..errors import ParameterError
-from ._options import add_aliases
+from ._options import add_aliases, path_option
 
 
 def register(subparsers) -> None:
@@ -40,18 +40,18 @@ def register(subparsers) -> None:
     )
     parser.set_defaults(mode="quick")
     parser.add_argument(
-        "--out", type=Path, default=Path("results"), help="output folder (default: results)"
+        "--out", type=path_option, default=Path("results"), help="output folder (default: results)"
     )
     parser.add_argument(
         "--experiment",
-        type=Path,
+        type=path_option,
         default=None,
         metavar="DIR",
         help="light-gate logs, one folder per ω₀ named by its BPM (adds Fig. 9)",
     )
     parser.add_argument(
         "--large-n",
-        type=Path,
+        type=path_option,
         nargs="+",
         default=(),
         metavar="SWEEP",

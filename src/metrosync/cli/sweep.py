@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from .._words import plural
 from ..errors import ParameterError
 from ._io import NETCDF, check_output
-from ._options import HelpFormatter, add_aliases, add_platform_option, group_spec
+from ._options import HelpFormatter, add_aliases, add_platform_option, group_spec, path_option
 
 #: Options that take a value or a grid (``a:b:step`` or ``x,y,z``), and their parameter.
 GRID_OPTIONS = {
@@ -43,7 +42,9 @@ def register(subparsers) -> None:
         ),
         formatter_class=HelpFormatter,
     )
-    parser.add_argument("grid", nargs="?", type=Path, help="TOML grid file ([grid], [fixed])")
+    parser.add_argument(
+        "grid", nargs="?", type=path_option, help="TOML grid file ([grid], [fixed])"
+    )
     g = parser.add_argument_group("parameters (VALUE or START:STOP:STEP or A,B,C)")
     for name, text in GRID_OPTIONS.items():
         g.add_argument(f"--{name}", metavar="SPEC", default=None, help=text)
@@ -72,8 +73,8 @@ def register(subparsers) -> None:
         help="most runs a point grows to with --target-error (default: 8 x --runs)",
     )
     o = parser.add_argument_group("run")
-    o.add_argument("--out", type=Path, required=True, help="merged result, FILE.nc")
-    o.add_argument("--store", type=Path, default=None,
+    o.add_argument("--out", type=path_option, required=True, help="merged result, FILE.nc")
+    o.add_argument("--store", type=path_option, default=None,
                    help="finished points directory (default: OUT with suffix .points)")  # fmt: skip
     o.add_argument("--keep-r", action="store_true", help="also keep r(t) of every run")
     o.add_argument("--scheduler", default=None, metavar="local|tcp://HOST:PORT",

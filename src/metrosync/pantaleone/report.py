@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .._files import save_figure, write_netcdf, write_text
 from .._words import plural
 from ..model import Metronome, get_preset
 from ..model.metronome import bpm_to_omega, omega_to_bpm
@@ -106,8 +107,8 @@ def _bob_removed():
 
 def run_report(out: Path, sizes: Sizes = QUICK, *, say: Callable[[str], None] = print) -> Path:
     """Run every observation at ``sizes`` and write the report into ``out``; returns
-    the path of PANTALEONE.md."""
-    out.mkdir(parents=True, exist_ok=True)
+    the path of PANTALEONE.md. Each file appears whole or not at all, and ``out`` is
+    made only when the first of them is written (`metrosync._files`)."""
     began = time.perf_counter()
     found: dict = {}
 
@@ -141,11 +142,9 @@ def run_report(out: Path, sizes: Sizes = QUICK, *, say: Callable[[str], None] = 
     data = _dataset(found, lags, detunings, theory, seven, sizes)
     data.attrs["fast_tick_bpm"] = obs.steady_tick_bpm(bob)
     data.attrs["wall_seconds"] = time.perf_counter() - began
-    data.to_netcdf(out / "pantaleone.nc")
+    write_netcdf(data, out / "pantaleone.nc")
     _figure(data, out / "pantaleone.png")
-    path = out / "PANTALEONE.md"
-    path.write_text(_markdown(data), encoding="utf-8")
-    return path
+    return write_text(_markdown(data), out / "PANTALEONE.md")
 
 
 def _dataset(found, lags, detunings, theory, seven, sizes) -> xr.Dataset:
@@ -229,8 +228,10 @@ def _figure(data: xr.Dataset, path: Path) -> None:
     time_ax.set(xlabel="time to lock in phase (s)", ylabel="starts",
                 title="Two metronomes at 208 BPM")  # fmt: skip
     time_ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)
 
 
 def _count(data, key) -> tuple[int, int, int]:
@@ -293,8 +294,8 @@ def _markdown(data: xr.Dataset) -> str:
         f"BPM, board {a['long_board_mass']:g} kg: r_eq {np.min(seven):.4f} to "
         f"{np.max(seven):.4f} over {plural(seven.size, 'run')} | {verdict(np.min(seven) > 0.95)} |",
         "",
-        "Where the model and he differ, and why, is discussed in the README (the board on "
-        "rollers) and docs/model.md §9.",
+        "Where the model and he differ, and why, is discussed in docs/beyond.md (metronomes "
+        "on a board on rollers) and docs/model.md §9.",
         "",
     ]
     return "\n".join(lines)
@@ -305,4 +306,8 @@ def _median(values: np.ndarray) -> str:
 
 
 def _range(values: np.ndarray) -> str:
-    return f"{np.min(values):.0f}–{np.max(values):.0f}" if values.size else "–"
+    """``low–high`` in whole units, or one number where both round alike (not ``168–168``)."""
+    if not values.size:
+        return "–"
+    low, high = f"{np.min(values):.0f}", f"{np.max(values):.0f}"
+    return low if low == high else f"{low}–{high}"
