@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import synth
 
-from metrosync.audio.order import acoustic_order, ticks_per_beat_heard
+from metrosync.audio.order import acoustic_order, no_common_beat, ticks_per_beat_heard
 
 
 def ensemble(offsets, bpms, duration=120.0, jitter=0.0, rng=None):
@@ -72,3 +72,33 @@ def test_clusters_count_the_distinct_ticks_per_beat(offsets, clusters):
     assert np.median(counts) == clusters
     o = acoustic_order(times, 0.4)
     assert np.all(o.clusters == clusters)
+
+
+def test_a_common_beat_needs_tempi_closer_than_a_beat_per_window():
+    # 16 beats a window: 6.25 % apart gains one beat in each.
+    assert no_common_beat([184.0], 16) == ""
+    assert no_common_beat([184.0, 190.0, 186.0], 16) == ""  # 3.2 %: half a beat
+    apart = no_common_beat([183.99, 207.92], 16)
+    assert "12 % apart" in apart and "gains 2.0 beats" in apart
+    assert no_common_beat([183.99, 207.92], 8) == ""  # a window of 8 beats: 0.98 of a beat
+    assert no_common_beat([100.0, 104.0], 16) == ""
+
+
+def test_metronomes_at_distant_tempi_get_no_common_beat_and_no_r(tmp_path):
+    """Two metronomes at 184 and 208 BPM: R and the ticks per beat are not invented."""
+    from test_audio_separation import recording
+
+    from metrosync.audio.summary import summary_text
+
+    ds, _ = recording(tmp_path, 2, 3, bpms=[184.0, 208.0], phone=False)
+    assert sorted(np.round(ds.bpm.values)) == [184, 208]
+    assert "12 % apart" in ds.attrs["no_common_beat"]
+    assert np.isnan(ds.r_acoustic.values).all() and np.isnan(ds.clusters.values).all()
+    text = summary_text(ds)
+    assert "no common beat" in text.splitlines()[1] and "BPM" not in text.splitlines()[1]
+    assert "R and distinct ticks per beat: not computed: the metronomes keep tempi" in text
+    assert "sound alike and keep the same tempo" not in text
+    near, _ = recording(tmp_path, 2, 4, bpms=[184.0, 186.0], phone=False)
+    assert near.attrs["no_common_beat"] == ""
+    assert np.isfinite(near.r_acoustic.values).any()
+    assert "beat " in summary_text(near).splitlines()[1]

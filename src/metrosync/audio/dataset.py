@@ -54,7 +54,7 @@ from .fills import given_back
 from .hidden import followers, hidden_count, hidden_trains
 from .interleaved import join_interleaved
 from .metronome import beat_statistics
-from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess
+from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess, no_common_beat
 from .reader import open_recording
 from .recovery import nearer_another, recover
 from .separation import separate, sureness, tick_length_words
@@ -159,6 +159,7 @@ def analyze_audio(
     if trains and not behind:
         # the median of the metronomes' tempi; where the trains may have gone wrong (a
         # very noisy recording), from all the ticks, as without trains
+        heard = float(np.median([60.0 / t.period for t in trains]))
         period, tempo_source = 60.0 / heard, "the median of the metronomes' own tempi"
         near = bpm is not None and abs(heard / bpm - 1) <= HINT_RANGE
         if sep.confidence < MIN_CONFIDENCE or near:
@@ -181,9 +182,17 @@ def analyze_audio(
     span = ticks.time[-1] - ticks.time[0]
     per_beat = ticks.time.size * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
+    apart = no_common_beat([60.0 / t.period for t in trains], acoustic.window / period)
+    if apart:
+        # Nothing measured on a beat nobody keeps is kept (`no_common_beat`).
+        nan = np.full(acoustic.r.shape, np.nan)
+        acoustic = replace(acoustic, r=nan, ticks_per_beat=nan, clusters=nan)
+        per_beat = math.nan
+        tempo_source = "the median of the metronomes' own tempi; no common beat"
     # Synchronized metronomes tick as one; the windows where they were least together
     # count them best.
-    busiest = max(1, round(float(np.nanpercentile(acoustic.ticks_per_beat, 95))))
+    heard_at_once = len(trains) if apart else np.nanpercentile(acoustic.ticks_per_beat, 95)
+    busiest = max(1, round(float(heard_at_once)))
     note = sep.note
     if metronomes is not None:
         n = int(metronomes)
@@ -204,7 +213,7 @@ def analyze_audio(
     elif trains and n != len(trains):
         note = (f"{plural(len(trains), 'metronome')} told apart, {n} expected"
                 + (f"; {note}" if note else ""))  # fmt: skip
-    elif trains and busiest > len(trains):
+    elif trains and busiest > len(trains) and not apart:
         note = (f"up to {busiest} ticks per beat are heard but only "
                 f"{plural(len(trains), 'metronome')} "
                 f"told apart; the others sound alike and keep the same tempo")  # fmt: skip
@@ -277,6 +286,7 @@ def analyze_audio(
         attribution_sureness=sureness(sep.confidence) if trains else "",
         attribution_note=note,
         metronomes_hidden=behind["metronomes"] if behind else 0,
+        no_common_beat=apart,
         metrosync_version=__version__,
     )
     if behind:

@@ -118,6 +118,32 @@ def acoustic_order(
     return AcousticOrder(centres, r, floor, excess, per_beat, clusters, local, window, step)
 
 
+def no_common_beat(tempi_bpm, window_beats: float) -> str:
+    """Why metronomes of these tempi share no beat for R to measure, or ``""`` if they do.
+
+    R asks whether ticks fall together on one beat over a window of ``window_beats``
+    beats. Where, over one window, the fastest metronome gains a whole beat or more on
+    the slowest, their ticks slide through every phase of any beat: R then measures
+    how far apart the tempi are, not whether the metronomes keep together, and the
+    distinct ticks of a beat are no count of anything.
+
+    tempi_bpm : (M,) the metronomes' own tempi, BPM.
+    window_beats : the length of R's window, in beats.
+    """
+    tempi = np.sort(np.asarray(tempi_bpm, dtype=float))
+    if tempi.size < 2:
+        return ""
+    spread = (tempi[-1] - tempi[0]) / float(np.median(tempi))
+    gained = spread * window_beats
+    if gained < 1.0:
+        return ""
+    return (
+        f"the metronomes keep tempi {100 * spread:.0f} % apart: over one window of R "
+        f"({window_beats:.0f} beats) the fastest gains {gained:.1f} beats on the slowest, "
+        f"so their ticks share no beat to fall together on"
+    )
+
+
 def floor_and_excess(r: np.ndarray, metronomes) -> tuple[np.ndarray, np.ndarray]:
     """R_floor = 1/√N and R_excess (NaN where N < 1.5) for R (W,) and N (scalar or (W,))."""
     n = np.broadcast_to(np.asarray(metronomes, dtype=float), r.shape)

@@ -53,9 +53,9 @@ def plot_audio(ds, path: Path | str | None = None):
     ax.set_ylabel("waveform")
     ax.legend(loc="upper right", fontsize="small")
     sure = f", attribution {a['attribution_sureness']}" if a.get("attribution_sureness") else ""
+    tempo = "no common beat" if a.get("no_common_beat") else f"{a['bpm_ensemble']:.2f} BPM"
     ax.set_title(
-        f"{Path(a['path']).name}: {a['bpm_ensemble']:.2f} BPM, "
-        f"{plural(int(a['metronomes']), 'metronome')}{sure}"
+        f"{Path(a['path']).name}: {tempo}, {plural(int(a['metronomes']), 'metronome')}{sure}"
     )
 
     ax = axes[1]
@@ -75,16 +75,13 @@ def plot_audio(ds, path: Path | str | None = None):
     ax.legend(loc="upper right", fontsize="small", ncol=2)
 
     ax = axes[2]
-    w = ds.window.values
-    ax.plot(w, ds.r_acoustic.values, color="C0", label="acoustic order parameter R")
-    ax.plot(w, ds.r_floor.values, "--", color="0.4", lw=1, label="floor: independent metronomes")
-    ax.set_ylim(0, 1.05)
-    ax.set_ylabel("R")
-    twin = ax.twinx()
-    twin.step(w, ds.clusters.values, where="mid", color="C1", lw=0.8, alpha=0.8)
-    twin.set_ylabel("distinct ticks per beat", color="C1")
-    twin.set_ylim(0, max(2.0, float(np.nanmax(ds.clusters.values)) + 1))
-    ax.legend(loc="lower right", fontsize="small")
+    if a.get("no_common_beat"):
+        ax.text(0.5, 0.5, "R not computed: the metronomes keep different tempi, so "
+                "their ticks share no beat", ha="center", va="center",
+                transform=ax.transAxes)  # fmt: skip
+        ax.set_yticks([])
+    else:
+        _plot_order(ax, ds)
 
     if with_phase:
         ax = axes[3]
@@ -118,3 +115,17 @@ def _columns(ds, most: int):
         parts.append((t[cut:].mean(keepdims=True), lo[cut:].min(keepdims=True),
                       hi[cut:].max(keepdims=True)))  # fmt: skip
     return tuple(np.concatenate(p) for p in zip(*parts, strict=True))
+
+
+def _plot_order(ax, ds) -> None:
+    """R over the windows with its floor, and the distinct ticks per beat."""
+    w = ds.window.values
+    ax.plot(w, ds.r_acoustic.values, color="C0", label="acoustic order parameter R")
+    ax.plot(w, ds.r_floor.values, "--", color="0.4", lw=1, label="floor: independent metronomes")
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("R")
+    twin = ax.twinx()
+    twin.step(w, ds.clusters.values, where="mid", color="C1", lw=0.8, alpha=0.8)
+    twin.set_ylabel("distinct ticks per beat", color="C1")
+    twin.set_ylim(0, max(2.0, float(np.nanmax(ds.clusters.values)) + 1))
+    ax.legend(loc="lower right", fontsize="small")

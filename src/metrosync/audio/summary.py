@@ -20,11 +20,17 @@ def summary_text(ds) -> str:
     a = ds.attrs
     k = ds.sizes["tick"]
     n = int(a["metronomes"])
+    apart = a.get("no_common_beat", "")
+    beat = (
+        "no common beat (each metronome's tempo is below)"
+        if apart
+        else f"beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
+        f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat"
+    )
     lines = [
         f"metrosync analyze: {a['path']} ({a['format']}, {plural(int(a['channels']), 'channel')}, "
         f"{a['sample_rate']} Hz, {a['duration']:.1f} s)",
-        f"  ticks: {k}, beat {1e3 * a['beat_period']:.2f} ms = {a['bpm_ensemble']:.2f} BPM "
-        f"({a['tempo_source']}); {a['ticks_per_beat']:.2f} ticks per beat",
+        f"  ticks: {k}, {beat}",
         f"  impacts heard: {a['impacts']}, {a['tick_structure']}"
         + (
             f"; {plural(int(a['ticks_recovered']), 'tick')} hidden by others found again "
@@ -76,7 +82,11 @@ def summary_text(ds) -> str:
             f"  sigma = {a['sigma_bpm']:.4f} BPM; equilibrium r of the pendulums (last quarter, "
             f"ticks as passes one way) {a['r_eq']:.3f}"
         )
-    if n > 1 or k and "metronome" not in ds.dims:
+    if apart:
+        lines.append(
+            f"  acoustic order parameter R and distinct ticks per beat: not computed: {apart}"
+        )
+    elif n > 1 or k and "metronome" not in ds.dims:
         r0, r1 = _quarter_mean(ds.r_acoustic, False), _quarter_mean(ds.r_acoustic, True)
         f1 = _quarter_mean(ds.r_floor, True)
         c0, c1 = _quarter_mean(ds.clusters, False), _quarter_mean(ds.clusters, True)
