@@ -9,7 +9,8 @@
    parameter against the one computed from the crossings (merged at the detector's
    refractory time, and raw), clean and with reverberation and noise at several SNRs.
 
-3. Real-sounding metronomes (the test corpus, tests/audio/corpus.py): ten minutes of
+3. Real-sounding metronomes (`metrosync.synthetic`, as the tests draw them; the frozen
+   benchmark corpus is benchmarks/audio_corpus.py's): ten minutes of
    four metronomes of different makes (112, 138, 161 and 187 BPM, speeding up by 0.05
    BPM a minute) heard through a phone (reverberation, noise, bumps, band limits,
    compression), timed as `metrosync analyze FILE.wav` in a fresh process; and over
@@ -38,16 +39,14 @@ from pathlib import Path
 import numpy as np
 import soundfile as sf
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "audio"))
-
-import synth  # noqa: E402
-
-import metrosync  # noqa: E402
-from metrosync.audio import analyze_audio  # noqa: E402
-from metrosync.audio.order import acoustic_order  # noqa: E402
-from metrosync.audio.tempo import beat_period  # noqa: E402
-from metrosync.show.recording import RecordedRun  # noqa: E402
-from metrosync.show.sound import crossing_times, write_wav  # noqa: E402
+import metrosync
+from metrosync import synthetic
+from metrosync.audio import analyze_audio
+from metrosync.audio.order import acoustic_order
+from metrosync.audio.tempo import beat_period
+from metrosync.show.recording import RecordedRun
+from metrosync.show.sound import crossing_times, write_wav
+from metrosync.synthetic import clicks, score
 
 
 def simulated(n, duration, folder, seed=4):
@@ -91,17 +90,17 @@ def accuracy(folder: Path) -> None:
         x = clean
         if snr is not None:
             rng = np.random.default_rng(15)
-            x = synth.add_noise(synth.add_reverb(clean, rng, rate), snr, crossings, rng, rate)
-        noisy = synth.write(folder / "noisy.wav", x, rate)
+            x = clicks.add_noise(clicks.add_reverb(clean, rng, rate), snr, crossings, rng, rate)
+        noisy = clicks.write(folder / "noisy.wav", x, rate)
         try:
             ds = analyze_audio(noisy, metronomes=3)
         except metrosync.MetrosyncError as error:
             print(f"{label:22s}  failed: {error}")
             continue
         found = ds.tick_time.values
-        times, alone = synth.resolvable(crossings, ds.attrs["resolution"])
-        recall, _, errors = synth.match(times[alone], found)
-        _, precision, _ = synth.match(times, found)
+        times, alone = score.resolvable(crossings, ds.attrs["resolution"])
+        recall, _, errors = score.match(times[alone], found)
+        _, precision, _ = score.match(times, found)
         diffs = []
         for merge in (True, False):
             t = truth[np.concatenate([[True], np.diff(truth) > ds.attrs["resolution"]])] \
@@ -118,18 +117,15 @@ def accuracy(folder: Path) -> None:
 
 def corpus_recording(n, seed, folder, duration=40.0, bpms=None, drift=0.1):
     """A phone recording of n metronomes of different makes, and the true tick times."""
-    import corpus
-
-    from metrosync.show.ticks import voices
-
     rng = np.random.default_rng(seed)
     bpms = list(rng.uniform(100, 200, n)) if bpms is None else bpms
-    sounds = voices(n, seed)
-    trains = [corpus.steady_train(b, duration, phase=rng.uniform(), limp=0.05 * rng.uniform(),
-                                  voice=sounds[i], seed=10 * seed + i, jitter_s=0.5e-3,
-                                  drift_bpm_per_min=drift)  # fmt: skip
+    sounds = synthetic.voices(n, seed)
+    trains = [synthetic.steady_train(b, duration, phase=rng.uniform(),
+                                     limp=0.05 * rng.uniform(), voice=sounds[i],
+                                     seed=10 * seed + i, jitter_s=0.5e-3,
+                                     drift_bpm_per_min=drift)  # fmt: skip
               for i, b in enumerate(bpms)]  # fmt: skip
-    rec = corpus.make_recording(trains, impairments=corpus.Impairments.phone(), seed=seed)
+    rec = synthetic.make_recording(trains, impairments=synthetic.Impairments.phone(), seed=seed)
     return rec.write(folder / f"corpus{n}_{seed}.wav"), [t.times for t in rec.truth]
 
 
@@ -187,7 +183,7 @@ def seeds_option(default: range = range(6)) -> list[int]:
 def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
     import warnings
 
-    from test_audio_separation import hearable, scores
+    from metrosync.synthetic.score import hearable, scores
 
     if timed:
         timed_analysis(folder)

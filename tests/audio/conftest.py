@@ -10,7 +10,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import synth  # noqa: E402
+from metrosync.synthetic import clicks as synth  # noqa: E402
 
 
 @pytest.fixture(scope="session")

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio.attribution import phase_difference
+from metrosync.synthetic import clicks
 
 
 def assigned_right(ds, trains):
@@ -43,11 +43,11 @@ def test_stereo_recording_gives_each_metronome_its_ticks(pair_recording):
 
 
 def test_mono_pair_of_different_loudness_is_told_apart(tmp_path, rng):
-    trains = [synth.metronome_train(184, 40, phase=0.0),
-              synth.metronome_train(184.6, 40, phase=0.3)]  # fmt: skip
-    x = synth.render(trains, 40, gains=[0.6, 0.2])
-    x = synth.add_noise(x, 15.0, trains, rng)
-    ds = analyze_audio(synth.write(tmp_path / "mono.wav", x))
+    trains = [clicks.metronome_train(184, 40, phase=0.0),
+              clicks.metronome_train(184.6, 40, phase=0.3)]  # fmt: skip
+    x = clicks.render(trains, 40, gains=[0.6, 0.2])
+    x = clicks.add_noise(x, 15.0, trains, rng)
+    ds = analyze_audio(clicks.write(tmp_path / "mono.wav", x))
     assert ds.attrs["attribution"] == "sound"  # metronome 0 is the louder
     right, share = assigned_right(ds, trains)
     assert right == 1.0 and share > 0.95
@@ -61,10 +61,10 @@ def test_mono_pair_of_different_loudness_is_told_apart(tmp_path, rng):
 
 
 def test_the_same_click_at_two_tempi_is_told_apart_by_tempo(tmp_path):
-    trains = [synth.metronome_train(184, 30, phase=0.0),
-              synth.metronome_train(187, 30, phase=0.3)]  # fmt: skip
-    x = synth.render(trains, 30, pitches=[2000.0, 2000.0])  # the same click, as loud
-    ds = analyze_audio(synth.write(tmp_path / "same.wav", x))
+    trains = [clicks.metronome_train(184, 30, phase=0.0),
+              clicks.metronome_train(187, 30, phase=0.3)]  # fmt: skip
+    x = clicks.render(trains, 30, pitches=[2000.0, 2000.0])  # the same click, as loud
+    ds = analyze_audio(clicks.write(tmp_path / "same.wav", x))
     assert ds.attrs["attribution"] == "tempo"
     order = np.argsort(ds.bpm.values)
     assert ds.bpm.values[order] == pytest.approx([184, 187], abs=0.1)
@@ -75,10 +75,10 @@ def test_the_same_click_at_two_tempi_is_told_apart_by_tempo(tmp_path):
 def test_the_same_click_at_one_tempo_half_a_beat_apart_is_two(tmp_path):
     """Two identical metronomes locked half a beat apart: one metronome at twice the
     tempo (368 BPM) is beyond any metronome, so they are two, each its own train."""
-    a = synth.metronome_train(184, 30, phase=0.0)
-    b = synth.metronome_train(184, 30, phase=0.5)
-    x = synth.render([a, b], 30, pitches=[2000.0, 2000.0])
-    ds = analyze_audio(synth.write(tmp_path / "locked.wav", x))
+    a = clicks.metronome_train(184, 30, phase=0.0)
+    b = clicks.metronome_train(184, 30, phase=0.5)
+    x = clicks.render([a, b], 30, pitches=[2000.0, 2000.0])
+    ds = analyze_audio(clicks.write(tmp_path / "locked.wav", x))
     assert ds.attrs["metronomes"] == 2 and ds.attrs["attribution"] == "tempo"
     right, share = assigned_right(ds, [a, b])
     assert right == 1.0 and share > 0.98
@@ -87,10 +87,10 @@ def test_the_same_click_at_one_tempo_half_a_beat_apart_is_two(tmp_path):
 def test_identical_metronomes_ticking_together_are_not_told_apart_and_say_so(tmp_path):
     """Ticks that fall together sound as one: told that two metronomes sound, the
     analysis says it told one apart and reports what needs no identities."""
-    a = synth.metronome_train(184, 30, phase=0.0)
+    a = clicks.metronome_train(184, 30, phase=0.0)
     b = a + 0.5e-3
-    x = synth.render([a, b], 30, pitches=[2000.0, 2000.0])
-    ds = analyze_audio(synth.write(tmp_path / "together.wav", x), metronomes=2)
+    x = clicks.render([a, b], 30, pitches=[2000.0, 2000.0])
+    ds = analyze_audio(clicks.write(tmp_path / "together.wav", x), metronomes=2)
     assert ds.attrs["attribution"] == "none"
     assert "1 metronome told apart, 2 expected" in ds.attrs["attribution_note"]
     assert (
@@ -128,9 +128,9 @@ def test_listen_pair_told_apart(tmp_path):
 def test_loudness_that_drifts_over_time_is_not_taken_for_more_metronomes(tmp_path):
     """Two equal metronomes whose loudness fades together: early loud and late soft ticks
     differ in loudness, but they are two metronomes, told apart by tempo."""
-    trains = [synth.metronome_train(184, 40, phase=0.0),
-              synth.metronome_train(187, 40, phase=0.3)]  # fmt: skip
-    x = synth.render(trains, 40, pitches=[2000.0, 2000.0])
+    trains = [clicks.metronome_train(184, 40, phase=0.0),
+              clicks.metronome_train(187, 40, phase=0.3)]  # fmt: skip
+    x = clicks.render(trains, 40, pitches=[2000.0, 2000.0])
     x *= np.where(np.arange(x.shape[0]) < x.shape[0] // 2, 1.0, 0.1)[:, None]
-    out = analyze_audio(synth.write(tmp_path / "fade.wav", x))
+    out = analyze_audio(clicks.write(tmp_path / "fade.wav", x))
     assert out.attrs["metronomes"] == 2 and out.attrs["attribution"] == "tempo"

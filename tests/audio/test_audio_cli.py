@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import synth
 import xarray as xr
 
 import metrosync
 from metrosync.cli import main
+from metrosync.synthetic import clicks
 
 
 def run(capsys, *argv):
@@ -75,10 +75,10 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, setup, 
     elif setup == "m4a":
         (tmp_path / "phone.m4a").write_bytes(b"\0\0\0\x18ftypM4A ")
     elif setup == "silent":
-        synth.write(tmp_path / "s.wav", np.zeros((44100, 1)))
+        clicks.write(tmp_path / "s.wav", np.zeros((44100, 1)))
     elif setup in ("two", "mixed"):
-        synth.write(tmp_path / "a.wav", np.zeros((44100, 1)))
-        synth.write(tmp_path / "b.wav", np.zeros((44100, 1)))
+        clicks.write(tmp_path / "a.wav", np.zeros((44100, 1)))
+        clicks.write(tmp_path / "b.wav", np.zeros((44100, 1)))
         (tmp_path / "run.log").write_text("0 1\n")
     code, out, err = run(capsys, "analyze", *argv)
     assert code == 2

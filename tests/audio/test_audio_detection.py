@@ -2,17 +2,16 @@
 
 from __future__ import annotations
 
-import corpus
 import numpy as np
 import pytest
-import synth
 
+from metrosync import synthetic
 from metrosync.audio import analyze_audio
 from metrosync.audio import detection as det
 from metrosync.audio.dataset import REFRACTORY
 from metrosync.audio.reader import BLOCK_FRAMES as BLOCK
 from metrosync.audio.reader import open_recording
-from metrosync.show.ticks import voices
+from metrosync.synthetic import clicks, score, voices
 
 
 def scored(path, trains, **options):
@@ -20,20 +19,20 @@ def scored(path, trains, **options):
     metronome within its resolution), and the timing errors."""
     ds = analyze_audio(path, **options)
     found = ds.tick_time.values
-    times, alone = synth.resolvable(trains, ds.attrs["resolution"])
-    recall, _, errors = synth.match(times[alone], found)
+    times, alone = score.resolvable(trains, ds.attrs["resolution"])
+    recall, _, errors = score.match(times[alone], found)
     # a detection is right when it lies within 1 ms of any tick (merged ones included)
-    _, precision, _ = synth.match(times, found)
+    _, precision, _ = score.match(times, found)
     return recall, precision, errors, ds
 
 
 @pytest.mark.parametrize("noisy", [False, True], ids=["clean", "noise+reverb 10 dB"])
 def test_one_metronome_every_tick_found_within_a_millisecond(tmp_path, rng, noisy):
-    train = synth.metronome_train(176, 30, phase=0.3, asymmetry=0.03, jitter=2e-4, rng=rng)
-    x = synth.render([train], 30)
+    train = clicks.metronome_train(176, 30, phase=0.3, asymmetry=0.03, jitter=2e-4, rng=rng)
+    x = clicks.render([train], 30)
     if noisy:
-        x = synth.add_noise(synth.add_reverb(x, rng), 10.0, [train], rng)
-    recall, precision, errors, _ = scored(synth.write(tmp_path / "one.wav", x), [train])
+        x = clicks.add_noise(clicks.add_reverb(x, rng), 10.0, [train], rng)
+    recall, precision, errors, _ = scored(clicks.write(tmp_path / "one.wav", x), [train])
     assert recall == 1.0 and precision == 1.0
     assert np.abs(errors).max() <= 1e-3
     assert np.abs(errors).max() <= 0.2e-3  # in fact a few samples
@@ -41,12 +40,12 @@ def test_one_metronome_every_tick_found_within_a_millisecond(tmp_path, rng, nois
 
 @pytest.mark.parametrize("noisy", [False, True], ids=["clean", "noise+reverb 10 dB"])
 def test_two_metronomes_recall_and_precision_above_99_percent(tmp_path, rng, noisy):
-    trains = [synth.metronome_train(192, 40, phase=0.1),
-              synth.metronome_train(185, 40, phase=0.55)]  # fmt: skip
-    x = synth.render(trains, 40, gains=[0.5, 0.3])
+    trains = [clicks.metronome_train(192, 40, phase=0.1),
+              clicks.metronome_train(185, 40, phase=0.55)]  # fmt: skip
+    x = clicks.render(trains, 40, gains=[0.5, 0.3])
     if noisy:
-        x = synth.add_noise(synth.add_reverb(x, rng), 10.0, trains, rng)
-    recall, precision, errors, ds = scored(synth.write(tmp_path / "two.wav", x), trains)
+        x = clicks.add_noise(clicks.add_reverb(x, rng), 10.0, trains, rng)
+    recall, precision, errors, ds = scored(clicks.write(tmp_path / "two.wav", x), trains)
     assert recall >= 0.99 and precision >= 0.99
     assert np.abs(errors).max() <= 1e-3
 
@@ -56,12 +55,12 @@ def _knocked(tmp_path, seed, lead):
     ``lead`` (s, a (low, high) range drawn from) before its tick: (recording, true
     onsets, indices of the knocked ticks)."""
     rng = np.random.default_rng(seed)
-    train = corpus.steady_train(150.0, 30.0, voice=voices(1, seed)[0], seed=seed,
-                                jitter_s=0.5e-3)  # fmt: skip
+    train = synthetic.steady_train(150.0, 30.0, voice=voices(1, seed)[0], seed=seed,
+                                   jitter_s=0.5e-3)  # fmt: skip
     knocked = np.sort(rng.choice(np.arange(4, train.times.size - 4), 12, replace=False))
     knocks = tuple(train.times[knocked] - rng.uniform(*lead, knocked.size))
-    impairments = corpus.Impairments.phone(bumps=0, bump_times=knocks)
-    made = corpus.make_recording([train], impairments=impairments, seed=seed)
+    impairments = synthetic.Impairments.phone(bumps=0, bump_times=knocks)
+    made = synthetic.make_recording([train], impairments=impairments, seed=seed)
     recording = open_recording(made.write(tmp_path / f"knocks{seed}_{lead[0]}.wav"))
     return recording, made.truth[0].times, knocked
 
@@ -120,7 +119,7 @@ def test_detection_curve_and_threshold_are_kept_for_inspection(pair_recording):
 
 
 def test_white_noise_alone_gives_no_ticks(tmp_path, rng):
-    path = synth.write(tmp_path / "noise.wav", rng.normal(0, 0.05, (44100 * 60, 1)))
+    path = clicks.write(tmp_path / "noise.wav", rng.normal(0, 0.05, (44100 * 60, 1)))
     scan = det.scan(open_recording(path))
     assert det.pick_ticks(scan, 20).size <= 1  # fewer than one false tick a minute
 

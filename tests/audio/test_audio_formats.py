@@ -9,13 +9,14 @@ from __future__ import annotations
 import av
 import numpy as np
 import pytest
-import synth
+import soundfile as sf
 import xarray as xr
 
 from metrosync.audio import AudioFileError
 from metrosync.audio.decode import _Writer
 from metrosync.audio.reader import open_recording
 from metrosync.cli import main
+from metrosync.synthetic import clicks, score
 
 RATE = 44100
 
@@ -69,9 +70,9 @@ def analysed(capsys, tmp_path, path):
 @pytest.fixture(scope="module")
 def one_metronome(tmp_path_factory):
     """A 160 BPM metronome, 20 s, as a 16-bit WAV, and its tick times."""
-    train = synth.metronome_train(160, 20, phase=0.2)
+    train = clicks.metronome_train(160, 20, phase=0.2)
     path = tmp_path_factory.mktemp("formats") / "tick.wav"
-    synth.write(path, synth.render([train], 20))
+    clicks.write(path, clicks.render([train], 20))
     return path, train
 
 
@@ -82,13 +83,13 @@ def same_analysis(wav, other, train):
     # Every tick heard in both, at the same time: AAC's 1024 priming samples (23 ms)
     # are cut, so the only difference left is the coder's smearing of the attack.
     a, b = wav.tick_time.values, other.tick_time.values
-    assert a.size == b.size == synth.match(train, a)[2].size
+    assert a.size == b.size == score.match(train, a)[2].size
     assert np.abs(b - a).max() < 1e-3
 
 
 def test_a_phones_m4a_is_analysed_as_its_wav(capsys, tmp_path, one_metronome):
     wav, train = one_metronome
-    samples, _ = synth.sf.read(str(wav), always_2d=True)
+    samples, _ = sf.read(str(wav), always_2d=True)
     m4a = encode(tmp_path / "Voice 001.m4a", samples)
     out_wav, ds_wav = analysed(capsys, tmp_path, wav)
     out_m4a, ds_m4a = analysed(capsys, tmp_path, m4a)
@@ -98,7 +99,7 @@ def test_a_phones_m4a_is_analysed_as_its_wav(capsys, tmp_path, one_metronome):
 
 def test_a_videos_sound_track_is_analysed(capsys, tmp_path, one_metronome):
     wav, train = one_metronome
-    samples, _ = synth.sf.read(str(wav), always_2d=True)
+    samples, _ = sf.read(str(wav), always_2d=True)
     stereo = samples * np.array([[1.0, 0.6]])
     film = encode(tmp_path / "film.mp4", stereo, video=True)
     with av.open(str(film)) as container:
@@ -112,7 +113,7 @@ def test_raw_adts_aac_keeps_its_priming_and_is_read_whole(tmp_path, one_metronom
     """ADTS records no encoder delay: the sound comes 1024 samples late, and its stated
     length is a guess from the bit rate, which the decoder outgrows."""
     wav, _ = one_metronome
-    samples, _ = synth.sf.read(str(wav), always_2d=True)
+    samples, _ = sf.read(str(wav), always_2d=True)
     m4a = open_recording(encode(tmp_path / "a.m4a", samples))
     adts = open_recording(encode(tmp_path / "a.aac", samples))
     assert (m4a.format, adts.format) == ("M4A", "AAC")
@@ -179,7 +180,7 @@ def test_a_damaged_file_is_one_clear_line(capsys, tmp_path, name, content):
 
 def test_an_m4a_cut_short_is_refused(tmp_path, one_metronome):
     wav, _ = one_metronome
-    samples, _ = synth.sf.read(str(wav), always_2d=True)
+    samples, _ = sf.read(str(wav), always_2d=True)
     whole = encode(tmp_path / "whole.m4a", samples).read_bytes()
     (tmp_path / "cut.m4a").write_bytes(whole[: len(whole) // 2])
     with pytest.raises(AudioFileError, match="cannot read .*cut.m4a.* as audio"):

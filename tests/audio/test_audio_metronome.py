@@ -4,20 +4,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio.metronome import beat_statistics
+from metrosync.synthetic import clicks
 
 
 @pytest.mark.parametrize("asymmetry", [0.0, 0.012, 0.04, 0.10])
 @pytest.mark.parametrize("noisy", [False, True], ids=["clean", "noise+reverb 10 dB"])
 def test_asymmetry_from_the_sound_within_half_a_percentage_point(tmp_path, rng, asymmetry, noisy):
-    train = synth.metronome_train(152, 40, phase=0.2, asymmetry=asymmetry, jitter=5e-4, rng=rng)
-    x = synth.render([train], 40)
+    train = clicks.metronome_train(152, 40, phase=0.2, asymmetry=asymmetry, jitter=5e-4, rng=rng)
+    x = clicks.render([train], 40)
     if noisy:
-        x = synth.add_noise(synth.add_reverb(x, rng), 10.0, [train], rng)
-    ds = analyze_audio(synth.write(tmp_path / "m.wav", x))
+        x = clicks.add_noise(clicks.add_reverb(x, rng), 10.0, [train], rng)
+    ds = analyze_audio(clicks.write(tmp_path / "m.wav", x))
     assert ds.attrs["metronomes"] == 1
     assert abs(float(ds.asymmetry[0]) - 100 * asymmetry) <= 0.5
     if asymmetry >= 0.01:
@@ -29,7 +29,7 @@ def test_asymmetry_from_the_sound_within_half_a_percentage_point(tmp_path, rng, 
 
 def test_words_a_musician_would_use(rng):
     def verdict(asymmetry):
-        t = synth.metronome_train(120, 60, asymmetry=asymmetry, jitter=2e-4, rng=rng)
+        t = clicks.metronome_train(120, 60, asymmetry=asymmetry, jitter=2e-4, rng=rng)
         return beat_statistics(t, 0.5).verdict()
 
     assert verdict(0.0).startswith("in beat")
@@ -41,14 +41,14 @@ def test_tempo_uncertainty_covers_the_truth(rng):
     """Over many recordings with period jitter, |BPM − true| < 2 SE about 95 % of the time."""
     inside = 0
     for _ in range(200):
-        t = synth.metronome_train(100, 60, jitter=2e-3, rng=rng)
+        t = clicks.metronome_train(100, 60, jitter=2e-3, rng=rng)
         s = beat_statistics(t, 0.6)
         inside += abs(s.bpm - 100) < 2 * s.bpm_error
     assert 0.88 <= inside / 200 <= 1.0
 
 
 def test_missed_ticks_keep_tick_and_tock_apart(rng):
-    t = synth.metronome_train(120, 60, asymmetry=0.05)
+    t = clicks.metronome_train(120, 60, asymmetry=0.05)
     kept = np.delete(t, [7, 30, 31, 64])  # a lone miss and two in a row
     s = beat_statistics(kept, 0.5)
     assert s.missed == 4
@@ -57,7 +57,7 @@ def test_missed_ticks_keep_tick_and_tock_apart(rng):
 
 
 def test_the_louder_kind_of_tick_is_called_the_tick(rng):
-    t = synth.metronome_train(120, 30, asymmetry=0.05)
+    t = clicks.metronome_train(120, 30, asymmetry=0.05)
     loud = np.where(np.arange(t.size) % 2 == 1, -10.0, -16.0)  # the 2nd, 4th, ... louder
     s = beat_statistics(t, 0.5, loud)
     assert s.tick_is_louder and not s.is_tock[1] and s.is_tock[0]

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import synth
 
 from metrosync.audio.order import acoustic_order, no_common_beat, ticks_per_beat_heard
+from metrosync.synthetic import clicks
 
 
 def ensemble(offsets, bpms, duration=120.0, jitter=0.0, rng=None):
-    trains = [synth.metronome_train(b, duration, phase=o, jitter=jitter, rng=rng)
+    trains = [clicks.metronome_train(b, duration, phase=o, jitter=jitter, rng=rng)
               for o, b in zip(offsets, bpms, strict=True)]  # fmt: skip
     return np.sort(np.concatenate(trains)), trains
 

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import pytest
-import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio.plots import MAX_COLUMNS, _columns, colour, plot_audio
+from metrosync.synthetic import clicks
 
 
 @pytest.mark.parametrize(
@@ -18,8 +18,8 @@ from metrosync.audio.plots import MAX_COLUMNS, _columns, colour, plot_audio
     ],
 )
 def test_panels(tmp_path, trains, pans, panels):
-    times = [synth.metronome_train(b, 30, phase=p, asymmetry=a) for b, p, a in trains]
-    ds = analyze_audio(synth.write(tmp_path / "r.wav", synth.render(times, 30, pans=pans)))
+    times = [clicks.metronome_train(b, 30, phase=p, asymmetry=a) for b, p, a in trains]
+    ds = analyze_audio(clicks.write(tmp_path / "r.wav", clicks.render(times, 30, pans=pans)))
     fig = plot_audio(ds, tmp_path / "r.png")
     axes = [ax for ax in fig.axes if ax.get_ylabel() != "distinct ticks per beat"]
     assert len(axes) == panels

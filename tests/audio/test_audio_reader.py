@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import soundfile as sf
-import synth
 
 from metrosync.audio import AudioFileError, analyze_audio
 from metrosync.audio.reader import open_recording
 from metrosync.errors import AnalysisError
+from metrosync.synthetic import clicks, score
 
 
 def ticks_recovered(path, train, tolerance=1e-3):
     ds = analyze_audio(path)
-    recall, precision, errors = synth.match(train, ds.tick_time.values, tolerance)
+    recall, precision, errors = score.match(train, ds.tick_time.values, tolerance)
     return recall == 1.0 and precision == 1.0 and np.abs(errors).max() <= tolerance
 
 
@@ -29,8 +29,8 @@ def ticks_recovered(path, train, tolerance=1e-3):
     ],
 )
 def test_formats_rates_and_channels(tmp_path, suffix, rate, channels, subtype):
-    train = synth.metronome_train(160, 12, phase=0.2)
-    x = synth.render([train], 12, rate=rate)
+    train = clicks.metronome_train(160, 12, phase=0.2)
+    x = clicks.render([train], 12, rate=rate)
     x = np.repeat(x, channels, axis=1) * np.linspace(1.0, 0.5, channels)
     path = tmp_path / f"rec{suffix}"
     sf.write(str(path), x, rate, subtype=subtype)
@@ -42,9 +42,9 @@ def test_formats_rates_and_channels(tmp_path, suffix, rate, channels, subtype):
 @pytest.mark.parametrize(("suffix", "subtype"), [(".ogg", "VORBIS"), (".mp3", "MPEG_LAYER_III")])
 def test_lossy_formats_find_every_tick_a_few_milliseconds_early(tmp_path, suffix, subtype):
     """Lossy coders smear a click's attack ahead of it (pre-echo): within 5 ms."""
-    train = synth.metronome_train(160, 12, phase=0.2)
+    train = clicks.metronome_train(160, 12, phase=0.2)
     path = tmp_path / f"rec{suffix}"
-    sf.write(str(path), synth.render([train], 12, rate=48000), 48000, subtype=subtype)
+    sf.write(str(path), clicks.render([train], 12, rate=48000), 48000, subtype=subtype)
     assert ticks_recovered(path, train, tolerance=5e-3)
 
 
@@ -86,34 +86,34 @@ def test_a_damaged_m4a_says_so_and_how_to_convert(tmp_path):
 
 
 def test_silent_file(tmp_path):
-    path = synth.write(tmp_path / "silent.wav", np.zeros((44100 * 5, 1)))
+    path = clicks.write(tmp_path / "silent.wav", np.zeros((44100 * 5, 1)))
     with pytest.raises(AudioFileError, match="silent: every sample is 0"):
         analyze_audio(path)
 
 
 def test_noise_without_ticks(tmp_path, rng):
-    path = synth.write(tmp_path / "hiss.wav", rng.normal(0, 0.05, (44100 * 10, 1)))
+    path = clicks.write(tmp_path / "hiss.wav", rng.normal(0, 0.05, (44100 * 10, 1)))
     with pytest.raises(AnalysisError, match="ticks"):
         analyze_audio(path)
 
 
 def test_clipped_file_warns_and_still_times_the_ticks(tmp_path):
-    train = synth.metronome_train(160, 12, phase=0.2)
-    x = np.clip(3.0 * synth.render([train], 12), -1, 1)
-    path = synth.write(tmp_path / "loud.wav", x)
+    train = clicks.metronome_train(160, 12, phase=0.2)
+    x = np.clip(3.0 * clicks.render([train], 12), -1, 1)
+    path = clicks.write(tmp_path / "loud.wav", x)
     with pytest.warns(UserWarning, match="clipped: .* record with a lower input gain"):
         assert ticks_recovered(path, train)
 
 
 def test_very_quiet_file_warns(tmp_path):
-    train = synth.metronome_train(160, 12, phase=0.2)
-    path = synth.write(tmp_path / "quiet.wav", 5e-4 * synth.render([train], 12), subtype="FLOAT")
+    train = clicks.metronome_train(160, 12, phase=0.2)
+    path = clicks.write(tmp_path / "quiet.wav", 5e-4 * clicks.render([train], 12), subtype="FLOAT")
     with pytest.warns(UserWarning, match="very quiet"):
         assert ticks_recovered(path, train)
 
 
 def test_too_short_warns(tmp_path):
-    train = synth.metronome_train(160, 3.5, phase=0.2)
-    path = synth.write(tmp_path / "short.wav", synth.render([train], 3.5))
+    train = clicks.metronome_train(160, 3.5, phase=0.2)
+    path = clicks.write(tmp_path / "short.wav", clicks.render([train], 3.5))
     with pytest.warns(UserWarning, match="too short for steady figures"):
         analyze_audio(path)

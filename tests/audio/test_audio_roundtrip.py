@@ -13,11 +13,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import soundfile as sf
-import synth
 
 from metrosync.audio import analyze_audio
 from metrosync.audio.order import acoustic_order
 from metrosync.audio.tempo import beat_period
+from metrosync.synthetic import clicks, score
 
 
 def merged(times, gap):
@@ -41,17 +41,17 @@ def analysed(request, listen_run, tmp_path_factory):
     if request.param != "clean":
         x, rate = sf.read(str(path))
         rng = np.random.default_rng(15)
-        x = synth.add_noise(synth.add_reverb(x, rng, rate), 10.0, crossings, rng, rate)
-        path = synth.write(tmp_path_factory.mktemp("noisy") / "noisy.wav", x, rate)
+        x = clicks.add_noise(clicks.add_reverb(x, rng, rate), 10.0, crossings, rng, rate)
+        path = clicks.write(tmp_path_factory.mktemp("noisy") / "noisy.wav", x, rate)
     return analyze_audio(path, metronomes=3), crossings
 
 
 def test_clicks_found_within_a_millisecond(analysed):
     ds, crossings = analysed
     found = ds.tick_time.values
-    times, alone = synth.resolvable(crossings, ds.attrs["resolution"])
-    recall, _, errors = synth.match(times[alone], found)
-    _, precision, _ = synth.match(times, found)
+    times, alone = score.resolvable(crossings, ds.attrs["resolution"])
+    recall, _, errors = score.match(times[alone], found)
+    _, precision, _ = score.match(times, found)
     assert recall >= 0.99 and precision >= 0.99
     assert np.abs(errors).max() <= 1e-3
     assert ds.attrs["beat_period"] == pytest.approx(beat_period(np.sort(times)), rel=1e-3)

@@ -1,45 +1,28 @@
 """Several metronomes on one channel, on the realistic corpus: a tick of several impacts
 is one tick, metronomes are told apart by their sound or their tempo, none is doubled.
 
-Recall counts the ticks a single microphone can hear on their own: no other
-metronome's tick began in the 40 ms before (its impacts and the loudest of its ring)
-nor within the detector's resolution after, and the file had begun at least that long
-before (the detector reads a tick as a rise over what came before it). Precision
-counts every tick given to a metronome against all of that metronome's ticks.
+Scored with `metrosync.synthetic.score`: recall counts the ticks a single microphone
+can hear on their own (no other metronome's tick began in the 40 ms before, its impacts
+and the loudest of its ring, nor within 5 ms after, and the file had begun at least
+that long before: a tick is read as a rise over what came before it). Precision counts
+every tick given to a metronome against all of that metronome's ticks.
 """
 
 from __future__ import annotations
 
 import warnings
 
-import corpus
 import numpy as np
 import pytest
 import soundfile as sf
-import synth
 
+from metrosync import synthetic
 from metrosync.audio import analyze_audio
-from metrosync.audio import detection as det
 from metrosync.audio.separation import _all_voices_carry
 from metrosync.audio.trains import Train
 from metrosync.audio.voices import Voices
-from metrosync.show.ticks import voices
-
-#: A tick is heard on its own when no other began this long before it, s.
-HIDDEN_BEFORE = 0.04
-
-
-def hearable(truth: list[np.ndarray], k: int) -> np.ndarray:
-    """(K,) True for the ticks of train k that no other train's tick hides."""
-    mine = truth[k]
-    begun = mine > det.RESOLUTION
-    if len(truth) == 1:
-        return begun
-    others = np.sort(np.concatenate([t for j, t in enumerate(truth) if j != k]))
-    j = np.searchsorted(others, mine)
-    before = np.where(j > 0, mine - others[np.maximum(j - 1, 0)], np.inf)
-    after = np.where(j < others.size, others[np.minimum(j, others.size - 1)] - mine, np.inf)
-    return begun & (before > HIDDEN_BEFORE) & (after > det.RESOLUTION)
+from metrosync.synthetic import clicks, voices
+from metrosync.synthetic.score import hearable, scores
 
 
 def recording(tmp_path, n, seed, *, same_voice=False, bpms=None, duration=40.0, phone=True):
@@ -47,7 +30,7 @@ def recording(tmp_path, n, seed, *, same_voice=False, bpms=None, duration=40.0, 
     sounds = [voices(1, seed)[0]] * n if same_voice else voices(n, seed)
     bpms = list(rng.uniform(100, 200, n)) if bpms is None else bpms
     trains = [
-        corpus.steady_train(
+        synthetic.steady_train(
             b,
             duration,
             phase=rng.uniform(),
@@ -59,36 +42,13 @@ def recording(tmp_path, n, seed, *, same_voice=False, bpms=None, duration=40.0, 
         )  # fmt: skip
         for i, b in enumerate(bpms)
     ]
-    impairments = corpus.Impairments.phone() if phone else corpus.Impairments()
-    rec = corpus.make_recording(trains, impairments=impairments, seed=seed)
+    impairments = synthetic.Impairments.phone() if phone else synthetic.Impairments()
+    rec = synthetic.make_recording(trains, impairments=impairments, seed=seed)
     path = rec.write(tmp_path / f"r{n}_{seed}.wav")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "too short" for a 40 s recording
         ds = analyze_audio(path)
     return ds, [t.times for t in rec.truth]
-
-
-def scores(ds, truth, tolerance=1e-3):
-    """Per true train: (recall over hearable ticks, precision, largest timing error (s),
-    BPM error) of the analysed metronome that holds most of its ticks; a tick is found
-    within ``tolerance`` (s)."""
-    found, label = ds.tick_time.values, ds.tick_metronome.values
-    out = []
-    for k, times in enumerate(truth):
-        ok = hearable(truth, k)
-        best = (0.0, 0.0, np.inf, np.inf)
-        for m in range(ds.sizes.get("metronome", 0)):
-            mine = found[label == m]
-            if mine.size == 0:
-                continue
-            recall, _, errors = synth.match(times[ok], mine, tolerance)
-            _, precision, _ = synth.match(times, mine, tolerance)
-            bpm = 60 * (times.size - 1) / (times[-1] - times[0])
-            if recall > best[0]:
-                timing = np.abs(errors).max() if errors.size else np.inf
-                best = (recall, precision, timing, abs(float(ds.bpm[m]) - bpm))
-        out.append(best)
-    return np.array(out)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -517,10 +477,10 @@ def test_two_free_running_metronomes_4_bpm_apart_are_two(tmp_path, same_voice):
 def test_one_metronome_is_never_two(tmp_path, seed):
     """Through a phone, with bumps, reverberation and clipping."""
     rng = np.random.default_rng(seed)
-    train = corpus.steady_train(rng.uniform(60, 208), 30, limp=0.08 * rng.uniform(),
-                                voice=voices(1, seed)[0], seed=seed, jitter_s=1e-3)  # fmt: skip
-    impairments = corpus.Impairments.phone(clipping=0.7, bumps=4)
-    rec = corpus.make_recording([train], impairments=impairments, seed=seed)
+    train = synthetic.steady_train(rng.uniform(60, 208), 30, limp=0.08 * rng.uniform(),
+                                   voice=voices(1, seed)[0], seed=seed, jitter_s=1e-3)  # fmt: skip
+    impairments = synthetic.Impairments.phone(clipping=0.7, bumps=4)
+    rec = synthetic.make_recording([train], impairments=impairments, seed=seed)
     path = tmp_path / "one.wav"
     rec.write(path)
     with warnings.catch_warnings():
@@ -534,12 +494,12 @@ def test_two_microphones_in_two_files_recorded_together(tmp_path):
     0 s into the session; aligned, the metronomes are told apart by their level at each
     microphone, every hearable tick in its own metronome."""
     sound = voices(1, 4)[0]
-    trains = [corpus.steady_train(b, 40, phase=p, voice=sound, seed=i, jitter_s=0.5e-3)
+    trains = [synthetic.steady_train(b, 40, phase=p, voice=sound, seed=i, jitter_s=0.5e-3)
               for i, (b, p) in enumerate([(150.0, 0.1), (152.0, 0.6)])]  # fmt: skip
-    near = [corpus.Microphone((1.0, 0.25), (0.0, 0.001)),
-            corpus.Microphone((0.25, 1.0), (0.001, 0.0))]  # fmt: skip
-    rec = corpus.make_recording(trains, microphones=near,
-                                impairments=corpus.Impairments.phone(), seed=4)  # fmt: skip
+    near = [synthetic.Microphone((1.0, 0.25), (0.0, 0.001)),
+            synthetic.Microphone((0.25, 1.0), (0.001, 0.0))]  # fmt: skip
+    rec = synthetic.make_recording(trains, microphones=near,
+                                   impairments=synthetic.Impairments.phone(), seed=4)  # fmt: skip
     late = round(0.73 * rec.sample_rate)
     a, b = tmp_path / "a.wav", tmp_path / "b.wav"
     sf.write(str(a), rec.samples[late:, 0], rec.sample_rate)
@@ -559,10 +519,10 @@ def test_two_microphones_in_two_files_recorded_together(tmp_path):
 
 
 def test_files_not_recorded_together_draw_a_warning(tmp_path):
-    a = synth.metronome_train(150, 30, phase=0.1)
-    b = synth.metronome_train(97, 30, phase=0.4)
-    pa = synth.write(tmp_path / "a.wav", synth.render([a], 30))
-    pb = synth.write(tmp_path / "b.wav", synth.render([b], 30, pitches=[2400.0]))
+    a = clicks.metronome_train(150, 30, phase=0.1)
+    b = clicks.metronome_train(97, 30, phase=0.4)
+    pa = clicks.write(tmp_path / "a.wav", clicks.render([a], 30))
+    pb = clicks.write(tmp_path / "b.wav", clicks.render([b], 30, pitches=[2400.0]))
     with pytest.warns(UserWarning, match="hardly match at any offset"):
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message="the recording holds only")

@@ -3,16 +3,16 @@ and how much a sound is like a metronome's tick."""
 
 from __future__ import annotations
 
-import corpus
 import numpy as np
 import pytest
 
+from metrosync import synthetic
 from metrosync.audio import detection as det
 from metrosync.audio import recovery
 from metrosync.audio import templates as tp
 from metrosync.audio.reader import open_recording
 from metrosync.audio.trains import Train
-from metrosync.show.ticks import voices
+from metrosync.synthetic import voices
 
 
 @pytest.fixture(scope="module")
@@ -21,9 +21,9 @@ def overlapping(tmp_path_factory):
     minute the second's ticks sweep through the first's ring. Returns the recording,
     its scan, the true onsets (sorted), the trains over them and the truth per train."""
     v = voices(2, 3)
-    trains = [corpus.steady_train(100.0, 60.0, phase=0.0, voice=v[0], seed=1),
-              corpus.steady_train(101.0, 60.0, phase=0.02, voice=v[1], seed=2)]  # fmt: skip
-    rec = corpus.make_recording(trains, impairments=corpus.Impairments.phone(), seed=3)
+    trains = [synthetic.steady_train(100.0, 60.0, phase=0.0, voice=v[0], seed=1),
+              synthetic.steady_train(101.0, 60.0, phase=0.02, voice=v[1], seed=2)]  # fmt: skip
+    rec = synthetic.make_recording(trains, impairments=synthetic.Impairments.phone(), seed=3)
     path = rec.write(tmp_path_factory.mktemp("templates") / "two.wav")
     recording = open_recording(path)
     scan = det.scan(recording)

@@ -212,7 +212,7 @@ def test_a_metronome_out_of_beat_clicks_where_its_escapement_acts():
 
 
 def test_realistic_ticks_start_on_the_crossings_tick_up_and_tock_down(pair_ds):
-    from metrosync.show.ticks import voices
+    from metrosync.synthetic.ticks import voices
 
     run = RecordedRun.from_dataset(pair_ds)
     track = click_track(run, start=1.0, end=11.0, tick_sound="realistic")
@@ -262,7 +262,7 @@ def test_the_cli_offers_the_tick_sounds_the_library_knows():
 
 def test_the_overlap_bound_holds_for_any_train_at_least_that_far_apart(rng):
     from metrosync.show.sound import _overlap_peak
-    from metrosync.show.ticks import Voice
+    from metrosync.synthetic.ticks import Voice
 
     wave = Voice.draw(2).waveform(44100)
     for spacing in (200, 700, 3000, 10000):

@@ -20,15 +20,16 @@ has a pitch of its own so that the ear can tell them apart. Each click has the g
 0.9/N, so the file never clips and a synchronized ensemble sounds louder, as it does
 in the room.
 
-Two tick sounds (``tick_sound``, see `TICK_SOUNDS`): ``"click"``, a 6 ms decaying
-cosine burst, and ``"realistic"``, the tick of a real metronome
-(`metrosync.show.ticks`): a main impact, secondary impacts 15–35 ms later and a ring
-of about 80 ms through resonances of its own (metronome i gets voice i of
-``ticks.voices(N)``). A realistic tick starts at the crossing; an upward crossing
-sounds a tick, a downward one the tock, which sounds different and softer. Its gain
-is 0.9/N over a bound on one metronome's loudest sum (its ticks overlap when sped up:
-the k-th latest began at least k times the shortest interval ago and adds at most its
-waveform's largest value from then on), so the file never clips either.
+Two tick sounds (``tick_sound``, see `TICK_SOUNDS`), both from
+`metrosync.synthetic.ticks`: ``"click"``, a 6 ms decaying cosine burst
+(`click_waveform`), and ``"realistic"``, the tick of a real metronome (a `Voice`): a
+main impact, secondary impacts 15–35 ms later and a ring of about 80 ms through
+resonances of its own (metronome i gets voice i of ``voices(N)``). A realistic tick
+starts at the crossing; an upward crossing sounds a tick, a downward one the tock,
+which sounds different and softer. Its gain is 0.9/N over a bound on one metronome's
+loudest sum (its ticks overlap when sped up: the k-th latest began at least k times the
+shortest interval ago and adds at most its waveform's largest value from then on), so
+the file never clips either.
 
 The audio is rendered and written in blocks of `BLOCK_SAMPLES`, so memory does not
 depend on its length. Refused before any sample is made: a speed-up that brings a
@@ -50,11 +51,9 @@ from .. import interrupts
 from .._files import atomic_path
 from ..budget import Budget, format_seconds
 from ..errors import ParameterError
+from ..synthetic.ticks import CLICK_LENGTH, check_sample_rate, click_waveform, voices
 from .recording import RecordedRun
 
-#: Click length and decay time, s.
-CLICK_LENGTH = 0.006
-CLICK_DECAY = 0.001
 #: Pitches (Hz) of the clicks span this range across the metronomes.
 PITCH_RANGE = (1800.0, 2600.0)
 #: Samples rendered and written at a time: memory does not grow with the length.
@@ -197,13 +196,6 @@ def _hermite_root(y0, d0, y1, d1, iterations: int = 52) -> np.ndarray:
     return 0.5 * (lo + hi)
 
 
-def click_waveform(pitch: float, sample_rate: int) -> np.ndarray:
-    """(L,) one click: a decaying cosine burst whose first sample is its peak, 1."""
-    u = np.arange(int(round(CLICK_LENGTH * sample_rate))) / sample_rate
-    taper = np.cos(0.5 * np.pi * u / CLICK_LENGTH) ** 2
-    return np.exp(-u / CLICK_DECAY) * np.cos(2 * np.pi * pitch * u) * taper
-
-
 def pan_gains(pan) -> tuple[np.ndarray, np.ndarray]:
     """Constant-power gains (left, right) for pan in [−1 (left), 1 (right)]."""
     angle = (np.clip(pan, -1.0, 1.0) + 1.0) * np.pi / 4
@@ -257,8 +249,6 @@ def click_track(
             is_tock.append(run.theta_dot_at(times)[:, i] < 0)
     tock_waveforms = None
     if tick_sound == "realistic":
-        from .ticks import voices
-
         sounds = voices(run.n)
         waveforms = [v.waveform(sample_rate) for v in sounds]
         tock_waveforms = [v.waveform(sample_rate, tock=True) for v in sounds]
@@ -288,8 +278,6 @@ def check_sound(speedup: float, sample_rate: int) -> None:
     simulating, too)."""
     if not (isinstance(speedup, int | float) and math.isfinite(speedup) and speedup > 0):
         raise ParameterError(f"`speedup` must be a number > 0, got {speedup!r}.")
-    from .ticks import check_sample_rate
-
     check_sample_rate(sample_rate)
 
 

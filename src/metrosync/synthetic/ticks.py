@@ -32,6 +32,9 @@ a seed (`Voice.draw`, or `voices` for several that differ from each other;
 
 The waveform is a pure function of the voice and the sample rate. The noise of the
 transient comes from the voice's own ``seed``, so a voice sounds the same every time.
+
+The simplest tick, `click_waveform`, is no metronome's: a 6 ms decaying cosine burst of
+one pitch, which `metrosync listen` plays by default and the detector's tests use.
 """
 
 from __future__ import annotations
@@ -64,6 +67,9 @@ REFERENCE_RMS = 0.09
 MAX_VOICES = 10000
 #: Highest resonance drawn, Hz.
 MAX_RESONANCE = 9000.0
+#: Length and decay time of `click_waveform`, s.
+CLICK_LENGTH = 0.006
+CLICK_DECAY = 0.001
 
 
 @dataclass(frozen=True)
@@ -258,6 +264,13 @@ def voices(n: int, seed: int = 0) -> list[Voice]:
                                       np.log(lo) * 0.2 + np.log(hi) * 0.8)))  # fmt: skip
         out.append(Voice.draw(int(seed) * MAX_VOICES + i, main_resonance=f0))
     return out
+
+
+def click_waveform(pitch: float, sample_rate: int) -> np.ndarray:
+    """(L,) one click: a decaying cosine burst whose first sample is its peak, 1."""
+    u = np.arange(int(round(CLICK_LENGTH * sample_rate))) / sample_rate
+    taper = np.cos(0.5 * np.pi * u / CLICK_LENGTH) ** 2
+    return np.exp(-u / CLICK_DECAY) * np.cos(2 * np.pi * pitch * u) * taper
 
 
 def check_sample_rate(sample_rate) -> None:

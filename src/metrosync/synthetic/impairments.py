@@ -1,16 +1,49 @@
-"""What the room, the phone and the hand do to a recording of the test corpus
-(`corpus`): reverberation, noise, bumps, the phone's band, compression, level and
-clipping. See `corpus` for the order and the definitions."""
+"""What the room, the phone and the hand do to a synthetic recording
+(`metrosync.synthetic.recording`): reverberation, noise, bumps, the phone's band,
+compression, level and clipping, and the file's format.
+
+`Impairments` holds them, each switchable and all off by default;
+`Impairments.phone()` turns on a realistic set. `impair` applies them in this order,
+each microphone separately, every draw from the recording's generator:
+
+1. reverberation (``reverb_rt60`` s): convolution with the direct sound plus an
+   exponentially decaying Gaussian-noise tail (−60 dB after rt60, starting 2 ms
+   after the direct sound, ``reverb_drr_db`` dB below it in energy);
+2. background noise at ``snr_db``: ``noise`` ("pink" or "white") Gaussian noise
+   whose power is ``snr_db`` dB below the mean power of the signal so far (whole
+   recording, each microphone);
+3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
+   sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
+   height; peak 0.5–2 times the signal's peak) at uniform random times, and one
+   at each of ``bump_times`` (s), each on one random microphone;
+4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
+   and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
+   high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay
+   the tick's rise by well under 0.5 ms);
+5. compression (``compression``): a feed-forward compressor on the signal's level
+   (instant peak detection with exponential release ``compression_release_s``,
+   smoothed by the attack ``compression_attack_s``), gain reduction
+   (1 − 1/ratio)·(level − threshold) above ``compression_threshold_db`` (dB
+   relative to the signal's peak);
+6. level: the peak is scaled to 0.9 of full scale; with ``clipping`` = c in (0, 1)
+   it is scaled to 1/c instead and clipped at ±1 (full scale);
+7. format: with ``resample_from`` = R the recording is made at R Hz and resampled
+   (polyphase, linear phase: no delay) to ``sample_rate``; with ``quantize_bits``
+   it is rounded to that many bits.
+
+Step 7 is `make_recording`'s, after `impair`.
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import signal
 
-from metrosync.errors import ParameterError
+from ..errors import ParameterError
 
 OUTPUT_PEAK = 0.9
 #: Samples per level measurement of the compressor.
@@ -86,8 +119,9 @@ class Impairments:
         """A phone on a table in a room, everything on: RT60 0.4 s, noise at 30 dB,
         two bumps, the phone's band, compression, 48 kHz resampled, 16 bits (no
         clipping: add ``clipping=0.8`` for a recording made too loud)."""
-        base = dict(reverb_rt60=0.4, snr_db=30.0, bumps=2, phone_band=True,
-                    compression=True, resample_from=48000, quantize_bits=16)  # fmt: skip
+        base: dict[str, Any] = dict(reverb_rt60=0.4, snr_db=30.0, bumps=2, phone_band=True,
+                                    compression=True, resample_from=48000,
+                                    quantize_bits=16)  # fmt: skip
         base.update(changes)
         return cls(**base)
 
@@ -164,6 +198,7 @@ def _thump(rate: int, rng) -> np.ndarray:
 def _room_response(imp: Impairments, rate: int, rng) -> np.ndarray:
     """The direct sound (1) and a noise tail that falls 60 dB in rt60 (cut at −90 dB)."""
     rt60 = imp.reverb_rt60
+    assert rt60 is not None  # called only with reverberation on
     t = np.arange(int(1.5 * rt60 * rate)) / rate
     tail = rng.normal(0.0, 1.0, t.size) * 10 ** (-3 * t / rt60)
     tail[: int(0.002 * rate)] = 0.0

@@ -7,7 +7,7 @@ import pytest
 from scipy import signal
 
 from metrosync.errors import ParameterError
-from metrosync.show.ticks import LOUDNESS_WINDOW, REFERENCE_RMS, Voice, voices
+from metrosync.synthetic.ticks import LOUDNESS_WINDOW, REFERENCE_RMS, Voice, voices
 
 RATE = 44100
 SEEDS = range(16)

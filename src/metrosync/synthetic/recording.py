@@ -1,45 +1,13 @@
-"""A realistic test corpus: recordings of metronomes as a phone hears them, with the
-ground truth of every tick.
+"""A recording of metronomes as a phone hears them, with the truth of every tick.
 
 Entry point::
 
     make_recording(trains, *, sample_rate=44100, microphones=1,
                    impairments=Impairments(), duration=None, seed=0) -> Recording
 
-trains : sequence of `TickTrain`, one per metronome (1 to 8):
-    ``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)`` —
-    the onsets (s, at the metronome) of each tick's FIRST impact, which ticks are
-    tocks, the metronome's sound (`metrosync.show.ticks.Voice`), its loudness,
-    optional per-tick level factors (K,), and how much (s, std) the secondary impacts
-    of each tick wander about the voice's delays. Build them with
-
-    - ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
-      jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
-      bounce_jitter_s=0)``:
-      a free-running metronome; ``bpm`` ticks per minute (tick and tock each count),
-      the first tick at ``phase`` beats (0 ≤ phase < 1), beats alternating
-      (1 ± limp/2)·T (limp = (long − short)/mean beat, a fraction, as
-      `metrosync.audio.metronome` measures it), the tempo rising by
-      ``drift_bpm_per_min`` BPM per minute as the spring unwinds, each tick displaced
-      by independent Gaussian jitter (s, std), each tick's level by Gaussian dB.
-      Locked metronomes: the same ``bpm`` (and drift) with the phases you want;
-    - ``simulated_trains(ds, *, run=0, voices=None, start=None, end=None)``: the ticks
-      of a run of `metrosync.simulate(..., trajectories=True)`: every crossing of θ_i
-      through its escapement angle, upward a tick, downward a tock (audio time 0 at
-      ``start``);
-    - ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
-      phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
-      drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
-      bounce_jitter_s=0, same_make=False)``: n metronomes drawn from the seed,
-      free-running (tempos at least ``min_bpm_gap`` apart) or ``locked`` (one tempo,
-      phases within ``phase_spread`` beats), distinct voices unless ``same_make``
-      (siblings of one voice, `Voice.sibling`) or ``same_voice`` (one voice): for
-      tests over many recordings;
-    - ``metrosync.show.ticks.voices(n, seed)``: n voices that differ from each other.
-      A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
-      ``voice=`` from `voices` to metronomes that should sound different, the same
-      voice to metronomes of one make.
-
+trains : sequence of `TickTrain` (`metrosync.synthetic.trains`), one per metronome (1
+    to 8): when each tick sounds, which are tocks, and the metronome's sound (a
+    `metrosync.synthetic.ticks.Voice`).
 sample_rate : 44100 or 48000 (any integer in [8000, 192000]) Hz, of the output.
 microphones : an int C (1 to 8), or a sequence of C `Microphone(gains, delays)`, one
     gain and one delay (s, ≥ 0) per train. With C = 1 (the default) the microphone
@@ -48,47 +16,24 @@ microphones : an int C (1 to 8), or a sequence of C `Microphone(gains, delays)`,
     0.35–0.8 m from its centre, 0.1–0.3 m above it: delay = distance / 343 m/s
     rounded to whole samples, gain = (nearest microphone's distance / distance), so
     each metronome is loudest (gain 1) at its nearest microphone.
-impairments : `Impairments`, each switchable; `Impairments.phone()` turns on a
-    realistic set. Applied in this order, each microphone separately:
-    1. reverberation (``reverb_rt60`` s): convolution with the direct sound plus an
-       exponentially decaying Gaussian-noise tail (−60 dB after rt60, starting 2 ms
-       after the direct sound, ``reverb_drr_db`` dB below it in energy);
-    2. background noise at ``snr_db``: ``noise`` ("pink" or "white") Gaussian noise
-       whose power is ``snr_db`` dB below the mean power of the signal so far (whole
-       recording, each microphone);
-    3. handling bumps (``bumps``: how many): low-frequency thumps (a damped 40–150 Hz
-       sinusoid, 50–150 ms, opened by a 1 ms broadband crack at 0.2–0.5 of its
-       height; peak 0.5–2 times the signal's peak) at uniform random times, and one
-       at each of ``bump_times`` (s), each on one random microphone;
-    4. phone band limits (``phone_band``: True draws a high-pass corner in 100–300 Hz
-       and a low-pass corner in 4–8 kHz; or give (low, high) Hz): Butterworth
-       high-pass of order 2 and low-pass of order 4, causal as in a phone (they delay
-       the tick's rise by well under 0.5 ms);
-    5. compression (``compression``): a feed-forward compressor on the signal's level
-       (instant peak detection with exponential release ``compression_release_s``,
-       smoothed by the attack ``compression_attack_s``), gain reduction
-       (1 − 1/ratio)·(level − threshold) above ``compression_threshold_db`` (dB
-       relative to the signal's peak);
-    6. level: the peak is scaled to 0.9 of full scale; with ``clipping`` = c in (0, 1)
-       it is scaled to 1/c instead and clipped at ±1 (full scale);
-    7. format: with ``resample_from`` = R the recording is made at R Hz and resampled
-       (polyphase, linear phase: no delay) to ``sample_rate``; with ``quantize_bits``
-       it is rounded to that many bits.
-    Every draw comes from ``seed``: the same arguments give the same samples.
+impairments : `Impairments` (`metrosync.synthetic.impairments`: the room, the phone,
+    the hand), applied to each microphone separately after the trains are summed.
 duration : length, s (default: the last tick + 1 s). A tick at or after the end is
     refused.
 
-Layout: the trains are in `corpus_trains`, the impairments in `corpus_impairments`,
-the recording here; import everything from here (``from corpus import ...``).
+The model: each microphone hears the sum of the metronomes' ticks, each tick its
+voice's waveform placed at the nearest sample to its time (plus the microphone's
+delay), scaled by the train's gain and the tick's level; then the impairments. Every
+draw comes from ``seed``: the same arguments give the same samples.
 
 Returns `Recording`:
     samples : float32, (S,) for one microphone, (S, C) for several, in [−1, 1].
     sample_rate : Hz.
-    truth : one `TrainTruth` per train, in order: ``times`` (K,) the onset of each
-        tick's first impact at microphone 0, s (rendered at the nearest sample: within
-        half a sample); ``is_tock`` (K,) bool; ``voice``; ``gains`` (C,) and
-        ``delays`` (C,) of that metronome at each microphone; ``arrivals(c)`` the
-        onsets at microphone c.
+    truth : one `TrainTruth` per train, in order: ``times`` (K,) the time of each
+        tick at microphone 0, s, which is the onset of its loud (main) impact,
+        rendered at the nearest sample (within half a sample); ``is_tock`` (K,)
+        bool; ``voice``; ``gains`` (C,) and ``delays`` (C,) of that metronome at each
+        microphone; ``arrivals(c)`` the ticks' times at microphone c.
     applied : what the impairments drew (band corners, bump times and microphones, …).
     ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
     ``Recording.files(starts, clock_ppm)`` splits several microphones into one mono
@@ -105,26 +50,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from corpus_impairments import COMPRESSOR_BLOCK, OUTPUT_PEAK, Impairments, impair
-from corpus_trains import (
-    BOUNCE_VARIANTS,
-    MAX_TRAINS,
-    TickTrain,
-    check_seed,
-    random_trains,
-    simulated_trains,
-    steady_train,
-)
 from scipy import signal
 
-from metrosync.errors import ParameterError
-from metrosync.show.ticks import Voice, check_sample_rate
+from ..errors import ParameterError
+from .impairments import Impairments, impair
+from .ticks import Voice, check_sample_rate
+from .trains import BOUNCE_VARIANTS, MAX_TRAINS, TickTrain, check_seed
 
-__all__ = [
-    "BOUNCE_VARIANTS", "COMPRESSOR_BLOCK", "MAX_MICROPHONES", "MAX_TRAINS", "OUTPUT_PEAK",
-    "Impairments", "Microphone", "Recording", "TickTrain", "TrainTruth", "make_recording",
-    "random_trains", "simulated_trains", "steady_train",
-]  # fmt: skip
+__all__ = ["MAX_MICROPHONES", "Microphone", "Recording", "TrainTruth", "make_recording"]
 
 SPEED_OF_SOUND = 343.0  # m/s
 DISK_RADIUS = 0.27  # m, as in the experiment
@@ -154,7 +87,7 @@ class Microphone:
 class TrainTruth:
     """The truth about one train in a recording.
 
-    times : (K,) onset of each tick's first impact at microphone 0, s.
+    times : (K,) time of each tick at microphone 0 (the onset of its loud, main impact), s.
     is_tock : (K,) True for the tocks.
     voice : the metronome's sound.
     gains, delays : (C,) its gain and delay (s) at each microphone.
@@ -375,7 +308,7 @@ def _bounced(voice: Voice, jitter: float, rng) -> Voice:
     """The voice with its secondary-impact delays moved by Gaussian ``jitter`` (s),
     kept at least 5 ms after the main impact and 2 ms after each other."""
     moved = np.sort(np.asarray(voice.sub_delays) + rng.normal(0.0, jitter, len(voice.sub_delays)))
-    delays = []
+    delays: list[float] = []
     for d in moved:
         delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
     return dataclasses.replace(voice, sub_delays=tuple(delays))

@@ -1,23 +1,24 @@
-"""The test corpus itself: its truth is where the sound is, and each impairment does
-what it says."""
+"""Synthetic recordings themselves: their truth is where the sound is, and each
+impairment does what it says."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from corpus import (
+from scipy import signal
+
+from metrosync.errors import ParameterError
+from metrosync.synthetic import (
     Impairments,
     Microphone,
     TickTrain,
+    Voice,
     make_recording,
     random_trains,
     simulated_trains,
     steady_train,
+    voices,
 )
-from scipy import signal
-
-from metrosync.errors import ParameterError
-from metrosync.show.ticks import Voice, voices
 
 
 def first_rise(x, t, rate, *, fraction=0.05, window=0.005):

@@ -1,5 +1,39 @@
-"""Tick trains for the test corpus (`corpus`): when each metronome ticks, which ticks
-are tocks, and how each sounds. See `corpus` for the whole interface."""
+"""Tick trains: when each metronome of a synthetic recording ticks, which ticks are
+tocks, and how each sounds.
+
+``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)``: the
+time of each tick (s, at the metronome: the onset of its loud, main impact), which
+ticks are tocks, the metronome's sound (`metrosync.synthetic.ticks.Voice`), its
+loudness, optional per-tick level factors (K,), and how much (s, std) the secondary
+impacts of each tick wander about the voice's delays. Build them with
+
+- ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
+  jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
+  bounce_jitter_s=0)``:
+  a free-running metronome; ``bpm`` ticks per minute (tick and tock each count),
+  the first tick at ``phase`` beats (0 ≤ phase < 1), beats alternating
+  (1 ± limp/2)·T (limp = (long − short)/mean beat, a fraction, as
+  `metrosync.audio.metronome` measures it), the tempo rising by
+  ``drift_bpm_per_min`` BPM per minute as the spring unwinds, each tick displaced
+  by independent Gaussian jitter (s, std), each tick's level by Gaussian dB.
+  Locked metronomes: the same ``bpm`` (and drift) with the phases you want;
+- ``simulated_trains(ds, *, run=0, voices=None, start=None, end=None)``: the ticks
+  of a run of `metrosync.simulate(..., trajectories=True)`: every crossing of θ_i
+  through its escapement angle, upward a tick, downward a tock (audio time 0 at
+  ``start``);
+- ``random_trains(n, duration, *, seed=0, bpm_range=(90, 200), locked=False,
+  phase_spread=0.1, min_bpm_gap=2, same_voice=False, limp_max=0.04,
+  drift_max_bpm_per_min=1, jitter_s=0.0002, level_jitter_db=0.5,
+  bounce_jitter_s=0, same_make=False)``: n metronomes drawn from the seed,
+  free-running (tempos at least ``min_bpm_gap`` apart) or ``locked`` (one tempo,
+  phases within ``phase_spread`` beats), distinct voices unless ``same_make``
+  (siblings of one voice, `Voice.sibling`) or ``same_voice`` (one voice): for
+  tests over many recordings;
+- ``metrosync.synthetic.ticks.voices(n, seed)``: n voices that differ from each other.
+  A train built by `steady_train` without a voice gets ``Voice.draw(seed)``; give
+  ``voice=`` from `voices` to metronomes that should sound different, the same
+  voice to metronomes of one make.
+"""
 
 from __future__ import annotations
 
@@ -9,8 +43,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from metrosync.errors import ParameterError
-from metrosync.show.ticks import Voice
+from ..errors import ParameterError
+from .ticks import Voice
+from .ticks import voices as draw_voices
 
 MAX_TRAINS = 8
 #: Variants of a tick (and of a tock) rendered for a train with bounce jitter.
@@ -21,7 +56,8 @@ BOUNCE_VARIANTS = 16
 class TickTrain:
     """The ticks of one metronome.
 
-    times : (K,) increasing onsets of each tick's first impact at the metronome, s, ≥ 0.
+    times : (K,) increasing times of the ticks at the metronome (the onset of each
+        tick's loud, main impact), s, ≥ 0.
     is_tock : (K,) True where the tick is a tock.
     voice : the metronome's sound.
     gain : its loudness (the tick's peak is ``gain · voice.level`` before impairments).
@@ -169,8 +205,6 @@ def random_trains(
         )
     if not 0 <= phase_spread < 1:
         raise ParameterError(f"`phase_spread` must be in [0, 1) beats, got {phase_spread!r}.")
-    from metrosync.show.ticks import voices as draw_voices
-
     rng = np.random.default_rng([29, check_seed(seed)])
     if locked:
         bpms = np.full(n, rng.uniform(low, high))
@@ -215,7 +249,6 @@ def simulated_trains(
     tocks; times from ``start`` (default: the first record) to ``end``."""
     from metrosync.show.recording import RecordedRun
     from metrosync.show.sound import crossing_times
-    from metrosync.show.ticks import voices as draw_voices
 
     recorded = RecordedRun.from_dataset(ds, run)
     start, end = recorded.window(start, end)

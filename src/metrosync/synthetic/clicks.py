@@ -1,4 +1,18 @@
-"""Synthetic recordings for the audio tests: click trains, noise, reverberation, matching."""
+"""Click-track recordings: short clicks at known times, for tests of the detector.
+
+The simplest synthetic recording, where the truth is exact by construction:
+
+- ``metronome_train(bpm, duration, *, phase, asymmetry, jitter, rng)``: tick times (s)
+  of one metronome, beats alternating (1 ± asymmetry/2)·T, with optional white jitter;
+- ``render(trains, duration, *, rate, gains, pitches, pans)``: (S, C) samples, one
+  click (`metrosync.synthetic.ticks.click_waveform`: a 6 ms decaying cosine burst)
+  at the nearest sample to each time, mono or panned in stereo;
+- ``add_noise``, ``add_reverb``: white noise at an SNR measured while the clicks sound,
+  and an exponentially decaying noise tail (a room);
+- ``write(path, samples)``: a 16-bit WAV.
+
+Recordings as a phone hears real metronomes are `metrosync.synthetic.recording`'s.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +20,7 @@ import numpy as np
 import soundfile as sf
 from scipy import signal
 
-from metrosync.show.sound import click_waveform
+from .ticks import click_waveform
 
 RATE = 44100
 
@@ -78,26 +92,3 @@ def add_reverb(samples, rng, rate=RATE, rt60=0.5, drr_db=0.0):
 def write(path, samples, rate=RATE, subtype="PCM_16"):
     sf.write(str(path), samples, rate, subtype=subtype)
     return path
-
-
-def match(truth, found, tolerance=1e-3):
-    """(recall, precision, errors (s) of the matched): each true onset is matched to
-    the nearest detection within ``tolerance``, each detection used once at most."""
-    truth, found = np.sort(truth), np.sort(found)
-    j = np.clip(np.searchsorted(found, truth), 1, max(found.size - 1, 1))
-    nearest = np.where(np.abs(found[j - 1] - truth) < np.abs(found[j] - truth), j - 1, j)
-    err = found[nearest] - truth
-    ok = np.abs(err) <= tolerance
-    used = np.unique(nearest[ok])
-    return ok.sum() / truth.size, used.size / found.size, err[ok]
-
-
-def resolvable(trains, gap):
-    """All onsets, and a mask of those with no onset of another train within ``gap``."""
-    times = np.concatenate(trains)
-    owner = np.concatenate([np.full(len(t), i) for i, t in enumerate(trains)])
-    order = np.argsort(times)
-    times, owner = times[order], owner[order]
-    d_prev = np.concatenate([[np.inf], np.diff(times)])
-    d_next = np.concatenate([np.diff(times), [np.inf]])
-    return times, (d_prev > gap) & (d_next > gap)
