@@ -78,7 +78,8 @@ ROUNDS = 3
 SIDE = 3
 #: Beats of a kind heard with both beside them that measure the train's limp, at least.
 MIN_LIMP_SAMPLES = 4
-#: How long after a tick its later impacts and ring can move another's onset, s.
+#: How long after a tick its later impacts and ring can move another's onset, s (the
+#: analysis's assumption `templates.LATER_IMPACTS`).
 RING = tp.LATER_IMPACTS
 #: Beats sought by their sound beyond each end of a train, a step of the walk.
 END_BEATS = 2

@@ -100,7 +100,11 @@ BUMP_LIKENESS = 0.15
 #: another's (corpus seeds 4/24, 4/138). Among the later impacts a tick that unlike
 #: may be timed by them (1.2-1.6 ms off 32-35 ms after another's: seeds 3/99, 4/75).
 RING_LIKENESS = 0.2
-#: How long after a tick its later impacts last, s (15-35 ms in real ticks).
+#: How long after a tick its later impacts last, s. The analysis's own assumption about
+#: a tick, not a measurement: it was set just past the 15-35 ms of the later impacts
+#: the synthetic voices are drawn with (`metrosync.synthetic.ticks.SUB_DELAY_RANGE`),
+#: and says nothing of an impact before the loud one (a real Neewer's comes 10-45 ms
+#: early). The coming timing model is to learn a metronome's impacts from the recording.
 LATER_IMPACTS = 0.04
 #: A tick whose own sound fits this much away from its detected onset is timed by the
 #: fit, in a ring or not, s: a tick alone fits within 0.2 ms of its onset (0.6 ms at

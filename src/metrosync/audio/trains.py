@@ -75,6 +75,10 @@ from itertools import pairwise
 
 import numpy as np
 
+#: Longest a tick's later impacts are sought after its first one, s. The analysis's
+#: own assumption about a tick (the lags are read from the recording up to it), set
+#: for the synthetic voices' later impacts (15-35 ms) and ring (70-90 ms); the coming
+#: timing model is to learn a metronome's impacts, before the loud one too.
 MAX_TICK_LENGTH = 0.09
 LAG_BIN = 2e-3
 MIN_SHARE_LATE = 0.05
