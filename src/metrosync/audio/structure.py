@@ -1,0 +1,340 @@
+"""A metronome's tick as the recording shows it: its impacts, learned, and its timing.
+
+The model (docs/sound.md, "The timing model"). A tick is several impacts: the pallet
+striking, a quieter one before it on some makes (10–45 ms ahead, wandering from tick to
+tick), bounces after it. Relative to the metronome's beat (`timing.Timing`), impact j of
+a tick falls at offset o_j with spread s_j, and is heard in a share p_j of the beats;
+onsets that belong to no impact are clutter, spread evenly over the beat. So the offsets
+d = t − τ_k of the onsets near a metronome's beats τ_k are a one-dimensional mixture:
+Gaussians N(o_j, s_j²) weighted p_j, plus a uniform component. It is fitted by
+expectation–maximisation, with the number of impacts chosen by the Bayesian
+information criterion (BIC); nothing about how many impacts a tick has, in which order
+or how far apart, is assumed.
+
+The tick's time is the time of its most regular impact, the one of smallest spread
+among those heard in at least `MIN_PRESENCE` of the beats: the escapement's impact,
+whose timing is the metronome's; a precursor or a bounce wanders more. The timing
+model is refitted to those impacts alone, and the two steps repeat.
+
+Contract: `follow(times, bpm)` finds, from a candidate tempo, the metronome whose ticks
+best explain the onsets ``times``: its `Timing`, its `Structure`, and for each onset
+which beat and impact explain it (or none). Times in seconds.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import t as student_t
+
+from ..errors import AnalysisError
+from .timing import DOF, Timing, fit_timing
+
+#: Share of the beats an impact must be heard in to time the tick.
+MIN_PRESENCE = 0.5
+#: Most impacts a tick is fitted with (more cost more parameters than they explain).
+MAX_IMPACTS = 4
+#: Reach of a tick about its beat, as a share of the beat: onsets farther off are
+#: another beat's, or clutter.
+REACH = 0.45
+#: Refits of the timing on the ticks' main impacts, and of the impacts on the timing.
+ROUNDS = 4
+#: Length of the first stretch the timing is fitted on, s; each next one doubles it, so
+#: that a tempo known to the periodicity search's resolution never loses count of beats.
+FIRST_STRETCH = 10.0
+#: ... and at least this many beats, so that each kind of beat has enough ticks to fit.
+FIRST_BEATS = 24
+#: Bin and window of the offsets' density where the main impact is sought, s: finer
+#: than the gap between two impacts, wider than an escapement's jitter.
+BIN, WINDOW = 0.5e-3, 3e-3
+#: How far from a candidate's beat (a share) and in how many trials the first timing
+#: is sought: a few times the periodicity search's resolution.
+PERIOD_SEARCH, PERIOD_TRIALS = 5e-3, 41
+#: Fewest onsets per impact fitted: with fewer, a mixture splits one impact's jitter
+#: into narrow impacts of its own, each fitting a handful of onsets.
+ONSETS_PER_IMPACT = 5
+#: Narrowest spread of an impact, s: the onset detector's own timing noise.
+MIN_SPREAD = 0.2e-3
+#: Two impacts are told apart when their offsets differ by more than this many times
+#: the larger spread (two Gaussians that close make one bump, not two).
+SEPARATION = 2.0
+
+
+@dataclass(frozen=True)
+class Impact:
+    """One impact of a tick: ``offset`` (s, from the beat; negative: before),
+    ``spread`` (s, its std tick to tick), ``presence`` (share of beats heard in)."""
+
+    offset: float
+    spread: float
+    presence: float
+
+
+@dataclass(frozen=True)
+class Structure:
+    """A tick's impacts, by offset, and which of them is the main one (the tick's time)."""
+
+    impacts: tuple[Impact, ...]
+    main: int
+    clutter: float  # share of the onsets near the beats that no impact explains
+
+    @property
+    def main_impact(self) -> Impact:
+        return self.impacts[self.main]
+
+
+@dataclass(frozen=True)
+class Followed:
+    """A metronome found from a candidate tempo.
+
+    timing : its timing model, fitted to the main impacts, whose offset is 0.
+    structure : the impacts of its tick and of its tock (even and odd beats), offsets
+        relative to that timing.
+    beat : (K,) for each onset, the beat it lies nearest (−1 beyond `REACH`).
+    impact : (K,) the impact that most probably explains it, −1 for clutter or beyond.
+    main : (K,) True for the onset that times its beat (one a beat at most).
+    """
+
+    timing: Timing
+    structure: tuple[Structure, Structure]
+    beat: np.ndarray
+    impact: np.ndarray
+    main: np.ndarray
+
+    @property
+    def ticks(self) -> np.ndarray:
+        """Indices of the onsets that time the ticks."""
+        return np.flatnonzero(self.main)
+
+
+def learn_structure(offsets, beats, reach: float) -> tuple[Structure, np.ndarray]:
+    """The impacts that explain ``offsets`` (s, onsets about their beats, within ±reach)
+    at beat numbers ``beats``; and (K,) each offset's impact (−1: clutter).
+
+    The main impact is found first, as the sharpest bump of the offsets heard in at
+    least `MIN_PRESENCE` of the beats (`_main_bump`); the mixture starts from it, so
+    that a few ticks cannot split its jitter, and fits the other impacts around it.
+    """
+    d = np.asarray(offsets, dtype=float)
+    b = np.asarray(beats)
+    span = int(b.max() - b.min()) // 2 + 1 if b.size else 0  # beats of this kind
+    centre, width = _main_bump(d, b, span)
+    best = None
+    for count in range(1, MAX_IMPACTS + 1):
+        if d.size < ONSETS_PER_IMPACT * count:
+            break
+        fitted = _mixture(d, count, reach, centre, width)
+        if count > 1 and not _apart(fitted[1], fitted[2]):
+            continue  # two impacts closer than their spreads are one, drawn twice
+        if best is None or fitted[0] < best[0]:
+            best = fitted
+    if best is None:
+        raise AnalysisError(f"too few onsets ({d.size}) to learn a tick's impacts")
+    _, means, spreads, shares, resp = best
+    presence = shares * d.size / max(span, 1)
+    order = np.argsort(means)
+    means, spreads, presence = means[order], spreads[order], presence[order]
+    resp = resp[:, np.append(order, means.size)]
+    # the mixture, started on the bump, has the last word: of its impacts heard in
+    # enough beats, the most regular (a first timing locked on a bounce corrects itself)
+    heard = np.flatnonzero(presence >= MIN_PRESENCE)
+    main = (
+        int(heard[np.argmin(spreads[heard])])
+        if heard.size
+        else int(np.argmin(np.abs(means - centre)))
+    )
+    impacts = tuple(
+        Impact(float(m), float(s), float(min(p, 1.0)))
+        for m, s, p in zip(means, spreads, presence, strict=True)
+    )
+    label = np.argmax(resp, axis=1)
+    label[label == means.size] = -1
+    clutter = float(resp[:, -1].mean())
+    return Structure(impacts, main, clutter), label
+
+
+def _main_bump(d: np.ndarray, beats: np.ndarray, span: int) -> tuple[float, float]:
+    """Offset and spread (s) of the most regular impact heard in `MIN_PRESENCE` of the
+    beats: of the bumps of the offsets' density (a histogram of `BIN` smoothed over
+    `WINDOW`), those that hold an onset in enough beats, the one of smallest robust
+    spread."""
+    if not d.size:
+        raise AnalysisError("no onset near the beats: not a metronome's beat")
+    edges = np.arange(d.min() - WINDOW, d.max() + WINDOW + BIN, BIN)
+    count, _ = np.histogram(d, edges)
+    smooth = np.convolve(count, np.ones(round(WINDOW / BIN)), mode="same")
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    peaks = np.flatnonzero((smooth >= np.roll(smooth, 1)) & (smooth > np.roll(smooth, -1)))
+    best = None
+    for p in peaks:
+        near = np.abs(d - centres[p]) <= WINDOW
+        heard = np.unique(beats[near]).size / max(span, 1)
+        if heard < MIN_PRESENCE:
+            continue
+        centre = float(np.median(d[near]))
+        spread = max(1.4826 * float(np.median(np.abs(d[near] - centre))), MIN_SPREAD)
+        if best is None or spread < best[1]:
+            best = (centre, spread)
+    if best is None:
+        raise AnalysisError("no impact is heard in half the beats: not a metronome's beat")
+    return best
+
+
+def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: float,
+             iterations: int = 60):  # fmt: skip
+    """EM of ``count`` Gaussians and a uniform on [−reach, reach] over the offsets ``d``,
+    the first started on the main impact (``centre``, ``width``), the others at the
+    quantiles of the rest: (BIC, means, spreads, shares, responsibilities (K, count+1))."""
+    rest = d[np.abs(d - centre) > 3 * width]
+    others = (
+        np.quantile(rest, (np.arange(count - 1) + 0.5) / max(count - 1, 1)) if rest.size else []
+    )
+    means = np.array([centre, *others][:count], dtype=float)
+    if means.size < count:
+        means = np.append(means, np.linspace(-reach, reach, count - means.size))
+    spreads = np.full(count, max(float(np.std(rest)) / count if rest.size else width, width))
+    spreads[0] = width
+    shares = np.full(count + 1, 1.0 / (count + 1))
+    uniform = 1.0 / (2.0 * reach)
+    for _ in range(iterations):
+        dens = np.empty((d.size, count + 1))
+        dens[:, :count] = shares[:count] * _normal(d[:, None], means, spreads)
+        dens[:, count] = shares[count] * uniform
+        total = dens.sum(axis=1, keepdims=True)
+        resp = dens / np.maximum(total, 1e-300)
+        weight = resp.sum(axis=0)
+        shares = np.maximum(weight / d.size, 1e-9)
+        held = weight[:count] > 1e-9
+        safe = np.where(held, weight[:count], 1.0)
+        means = np.where(held, (resp[:, :count] * d[:, None]).sum(axis=0) / safe, means)
+        var = (resp[:, :count] * (d[:, None] - means) ** 2).sum(axis=0) / safe
+        spreads = np.maximum(np.sqrt(var), MIN_SPREAD)
+    loglik = float(np.log(np.maximum(total[:, 0], 1e-300)).sum())
+    parameters = 3 * count  # mean, spread, share each (the clutter's share is the rest)
+    bic = -2.0 * loglik + parameters * math.log(d.size)
+    return bic, means, spreads, shares[:count], resp
+
+
+def _apart(means: np.ndarray, spreads: np.ndarray) -> bool:
+    """Whether every two impacts lie further apart than `SEPARATION` times the larger
+    spread: nearer, no recording tells them apart, and the mixture merely splits one."""
+    order = np.argsort(means)
+    gaps = np.diff(means[order])
+    wider = np.maximum(spreads[order][1:], spreads[order][:-1])
+    return bool(np.all(gaps > SEPARATION * wider))
+
+
+def _normal(x, mean, spread):
+    return np.exp(-0.5 * ((x - mean) / spread) ** 2) / (spread * math.sqrt(2 * math.pi))
+
+
+def follow(times, bpm: float, *, drift: bool = True) -> Followed:
+    """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``.
+
+    The timing is first fitted on the first `FIRST_STRETCH` seconds, then on stretches
+    twice as long, each numbered by the last fit's prediction; on each, the impacts of
+    the tick and of the tock (even and odd beats: struck by different pallets, they
+    sound and fall differently) are learned and the timing refitted to the main ones
+    (`ROUNDS` times).
+    """
+    t = np.asarray(times, dtype=float)
+    timing = _start(t, 60.0 / float(bpm))
+    end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
+    while True:
+        inside = np.flatnonzero(t <= end)
+        for _ in range(ROUNDS):
+            explained = _explain(t[inside], timing)
+            mains = inside[explained[2]]
+            timing = fit_timing(t[mains], explained[0][explained[2]],
+                                drift=drift and end - t[0] > 60)  # fmt: skip
+        if end >= t[-1]:
+            break
+        end = t[0] + 2.0 * (end - t[0])
+    beat, impact, main, structures = _explain(t, timing)
+    return Followed(timing, structures, beat, impact, main)
+
+
+def _explain(t: np.ndarray, timing: Timing):
+    """For onsets ``t`` about ``timing``'s beats: (K,) beat (−1 beyond reach), impact
+    (−1: none), main (bool), and the (tick, tock) `Structure`s."""
+    beat, offset = _nearest_beats(t, timing)
+    reach = REACH * timing.period
+    near = np.abs(offset) <= reach
+    impact = np.full(t.size, -1)
+    main = np.zeros(t.size, dtype=bool)
+    structures = []
+    for kind in (0, 1):
+        mine = np.flatnonzero(near & (np.mod(beat, 2) == kind))
+        structure, label = learn_structure(offset[mine], beat[mine], reach)
+        chosen = mine[_mains(offset[mine], beat[mine], structure, reach)]
+        main[chosen] = True
+        label[np.isin(mine, chosen)] = structure.main
+        impact[mine] = label
+        structures.append(structure)
+    return np.where(near, beat, -1), impact, main, tuple(structures)
+
+
+def _start(t: np.ndarray, period: float) -> Timing:
+    """A first timing near ``period``: of trial beats within ±`PERIOD_SEARCH` of it, the
+    one at which the onsets of the first stretch, folded at the swing (two beats), put
+    an onset within ±`WINDOW` of one phase in the most swings; that phase is beat 0's.
+
+    A candidate tempo is known to about a tenth of a per cent (`periodicity`); over the
+    first stretch that error alone would smear the main impact's offsets over more
+    than its jitter, where the structure could not find it.
+    """
+    stretch = t[t <= t[0] + max(FIRST_STRETCH, FIRST_BEATS * period)]
+    best = (-1, 0.0, period)
+    for trial in period * (1 + np.linspace(-PERIOD_SEARCH, PERIOD_SEARCH, PERIOD_TRIALS)):
+        swing = 2.0 * trial
+        fold = np.mod(stretch - stretch[0], swing)
+        edges = np.arange(0.0, swing + BIN, BIN)
+        for shift in (0.0, swing / 2):  # a bump across the fold's ends is whole in one
+            phase = np.sort(np.mod(fold + shift, swing))
+            lo = np.searchsorted(phase, edges - WINDOW)
+            hi = np.searchsorted(phase, edges + WINDOW)
+            held = hi - lo  # onsets within ±WINDOW: about one a swing on the main impact
+            at = int(np.argmax(held))
+            if held[at] > best[0]:
+                centre = float(np.median(phase[lo[at] : hi[at]])) - shift
+                best = (int(held[at]), float(stretch[0] + np.mod(centre, swing)), trial)
+    _, phase, trial = best
+    phase -= trial * math.floor((phase - t[0]) / trial)
+    return Timing(phase, trial, 0.0, 0.0, 0.0, (0.0,) * 4, 0)
+
+
+def _nearest_beats(t: np.ndarray, timing: Timing) -> tuple[np.ndarray, np.ndarray]:
+    """(K,) the beat number whose predicted time is nearest each onset, and the offset."""
+    guess = np.round((t - timing.phase) / timing.period).astype(np.int64)
+    best = guess
+    offset = t - timing.predict(guess)
+    for step in (-1, 1):  # the drift and the limp can move the nearest beat by one
+        other = guess + step
+        off = t - timing.predict(other)
+        closer = np.abs(off) < np.abs(offset)
+        best = np.where(closer, other, best)
+        offset = np.where(closer, off, offset)
+    return best, offset
+
+
+def _mains(offset: np.ndarray, beat: np.ndarray, structure: Structure, reach: float):
+    """Indices of the onsets that time their beats: in each beat, the onset likeliest to
+    be the main impact against every other impact and the clutter, if it is more likely
+    the main impact than anything else. The main impact's timing is taken as Student-t
+    (`timing.DOF`), as the timing model takes it: an escapement's rare large error
+    should not hand a tick to a precursor. A beat holds one main impact at most."""
+    main = structure.main_impact
+    z = (offset - main.offset) / main.spread
+    own = main.presence * student_t.pdf(z, DOF) / main.spread
+    other = np.full(offset.size, max(structure.clutter, 1e-3) / (2.0 * reach))
+    for j, impact in enumerate(structure.impacts):
+        if j != structure.main:
+            other += impact.presence * _normal(offset, impact.offset, impact.spread)
+    ratio = own / other
+    mine = np.flatnonzero(ratio > 1.0)
+    order = mine[np.lexsort((-ratio[mine], beat[mine]))]
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = beat[order][1:] != beat[order][:-1]
+    return np.sort(order[first])
