@@ -4,7 +4,9 @@ from the analysis they test.
 The modules, each a part of one generative model:
 
 - `ticks`: the sound of one tick (`Voice`, drawn from a seed; `voices` for several
-  that differ; `click_waveform`, a plain click);
+  that differ; a `Precursor` before the loud impact; `click_waveform`, a plain click);
+- `structures`: what different makes' ticks are made of (`STRUCTURES`: "classic",
+  "uneven", "precursor");
 - `trains`: when each metronome ticks (`TickTrain`; `steady_train`, `random_trains`,
   `simulated_trains`);
 - `impairments`: what the room, the phone and the hand do (`Impairments`);
@@ -25,7 +27,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from .impairments import Impairments
     from .recording import MAX_MICROPHONES, Microphone, Recording, TrainTruth, make_recording
-    from .ticks import Voice, click_waveform, voices
+    from .structures import STRUCTURES, TickStructure, widen
+    from .ticks import Precursor, Voice, click_waveform, voices
     from .trains import MAX_TRAINS, TickTrain, random_trains, simulated_trains, steady_train
 
 #: Where each public name lives. They are loaded when first asked for, so that
@@ -37,6 +40,10 @@ _HOME = {
     "Recording": "recording",
     "TrainTruth": "recording",
     "make_recording": "recording",
+    "STRUCTURES": "structures",
+    "TickStructure": "structures",
+    "widen": "structures",
+    "Precursor": "ticks",
     "Voice": "ticks",
     "click_waveform": "ticks",
     "voices": "ticks",
@@ -48,9 +55,9 @@ _HOME = {
 }
 
 __all__ = [
-    "MAX_MICROPHONES", "MAX_TRAINS", "Impairments", "Microphone", "Recording", "TickTrain",
-    "TrainTruth", "Voice", "click_waveform", "make_recording", "random_trains",
-    "simulated_trains", "steady_train", "voices",
+    "MAX_MICROPHONES", "MAX_TRAINS", "STRUCTURES", "Impairments", "Microphone", "Precursor",
+    "Recording", "TickStructure", "TickTrain", "TrainTruth", "Voice", "click_waveform",
+    "make_recording", "random_trains", "simulated_trains", "steady_train", "voices", "widen",
 ]  # fmt: skip
 
 

@@ -23,8 +23,11 @@ duration : length, s (default: the last tick + 1 s). A tick at or after the end 
 
 The model: each microphone hears the sum of the metronomes' ticks, each tick its
 voice's waveform placed at the nearest sample to its time (plus the microphone's
-delay), scaled by the train's gain and the tick's level; then the impairments. Every
-draw comes from ``seed``: the same arguments give the same samples.
+delay), scaled by the train's gain and the tick's level, and, for a voice with a
+precursor (`metrosync.synthetic.structures`), its precursor's sound placed its lead
+before it (the train's leads, or drawn from the voice's `Precursor`); then the
+impairments. Every draw comes from ``seed``: the same arguments give the same samples,
+and a recording of voices without precursors is what it was before they existed.
 
 Returns `Recording`:
     samples : float32, (S,) for one microphone, (S, C) for several, in [−1, 1].
@@ -33,7 +36,9 @@ Returns `Recording`:
         tick at microphone 0, s, which is the onset of its loud (main) impact,
         rendered at the nearest sample (within half a sample); ``is_tock`` (K,)
         bool; ``voice``; ``gains`` (C,) and ``delays`` (C,) of that metronome at each
-        microphone; ``arrivals(c)`` the ticks' times at microphone c.
+        microphone; ``arrivals(c)`` the ticks' times at microphone c; ``precursors``
+        (K,) the onset of each tick's precursor at microphone 0, s (NaN where none
+        sounded; None for a voice without precursors).
     applied : what the impairments drew (band corners, bump times and microphones, …).
     ``Recording.write(path)`` writes it (16-bit PCM by default) with soundfile.
     ``Recording.files(starts, clock_ppm)`` splits several microphones into one mono
@@ -48,6 +53,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy import signal
@@ -91,6 +97,8 @@ class TrainTruth:
     is_tock : (K,) True for the tocks.
     voice : the metronome's sound.
     gains, delays : (C,) its gain and delay (s) at each microphone.
+    precursors : (K,) onset of the precursor before each tick at microphone 0, s, NaN
+        where none sounded (None: the voice has no precursor).
     """
 
     times: np.ndarray
@@ -98,6 +106,7 @@ class TrainTruth:
     voice: Voice
     gains: np.ndarray
     delays: np.ndarray
+    precursors: np.ndarray | None = None
 
     def arrivals(self, channel: int) -> np.ndarray:
         """(K,) the onsets at microphone ``channel``, s."""
@@ -160,8 +169,13 @@ class Recording:
             for t in self.truth:
                 times = t.arrivals(c) - k / self.sample_rate
                 keep = times >= 0
+                before = None
+                if t.precursors is not None:
+                    before = (t.precursors - t.times + times)[keep] * stretch
+                    before[before < 0] = np.nan
                 truth.append(TrainTruth(times[keep] * stretch, t.is_tock[keep], t.voice,
-                                        t.gains[c : c + 1], t.delays[c : c + 1]))  # fmt: skip
+                                        t.gains[c : c + 1], t.delays[c : c + 1],
+                                        before))  # fmt: skip
             applied = dict(self.applied, start=k / self.sample_rate, clock_ppm=ppm[c])
             out.append(Recording(x.copy(), self.sample_rate, truth, applied))
         return out
@@ -211,8 +225,10 @@ def make_recording(
     gains = np.array([m.gains for m in mics]).T  # (N, C)
     shifts = np.round(np.array([m.delays for m in mics]).T * rate).astype(np.int64)
     x = np.zeros((n, len(mics)), dtype=np.float32)
+    leads: list[np.ndarray | None] = []
     for i, train in enumerate(trains):
-        dry = _render_train(train, rate, n, np.random.default_rng([30, seed, i]))
+        leads.append(_precursor_leads(train, np.random.default_rng([35, seed, i])))
+        dry = _render_train(train, rate, n, np.random.default_rng([30, seed, i]), leads[-1])
         for c in range(len(mics)):
             s = shifts[i, c]
             x[s:, c] += gains[i, c] * dry[: n - s]
@@ -234,6 +250,7 @@ def make_recording(
             t.voice,
             gains[i].copy(),
             shifts[i] / rate,
+            None if leads[i] is None else t.times - leads[i] + shifts[i, 0] / rate,
         )  # fmt: skip
         for i, t in enumerate(trains)
     ]
@@ -276,10 +293,32 @@ def _microphones(microphones, n_trains: int, rng) -> list[Microphone]:
     return mics
 
 
-def _render_train(train: TickTrain, rate: int, n: int, rng) -> np.ndarray:
+def _precursor_leads(train: TickTrain, rng) -> np.ndarray | None:
+    """(K,) the lead of the precursor before each tick, s, NaN where none sounds (none
+    before the recording's start): the train's, or drawn from its voice's precursors,
+    the ticks' then the tocks'; None for a voice without precursors."""
+    voice = train.voice
+    if voice.precursor is None and voice.tock_precursor is None:
+        return None
+    if train.precursor_leads is not None:
+        leads = train.precursor_leads.copy()
+    else:
+        leads = np.full(train.times.size, np.nan)
+        for tock in (False, True):
+            precursor = voice.precursor_of(tock=tock)
+            which = train.is_tock == tock
+            if precursor is not None and which.any():
+                leads[which] = precursor.leads(int(which.sum()), rng)
+    leads[train.times - leads < 0] = np.nan
+    return leads
+
+
+def _render_train(
+    train: TickTrain, rate: int, n: int, rng, leads: np.ndarray | None = None
+) -> np.ndarray:
     """(n,) the train's ticks and tocks at the metronome, each placed at its nearest
     sample; with bounce jitter, each tick one of `BOUNCE_VARIANTS` variants drawn
-    from ``rng``."""
+    from ``rng``; the precursors ``leads`` (K,) s before their ticks (NaN: none)."""
     out = np.zeros(n, dtype=np.float32)
     onsets = np.round(train.times * rate).astype(np.int64)
     levels = train.gain * (np.ones(onsets.size) if train.levels is None else train.levels)
@@ -301,14 +340,38 @@ def _render_train(train: TickTrain, rate: int, n: int, rng) -> np.ndarray:
                 out[index[inside]] += values[inside]  # no two overlap: each index once
             else:
                 np.add.at(out, index[inside], values[inside])
+    if leads is not None:
+        _add_precursors(out, train, rate, levels, leads)
     return out
+
+
+def _add_precursors(out, train: TickTrain, rate: int, levels, leads) -> None:
+    """Add to ``out`` each tick's precursor, ``leads`` (K,) s before it (NaN: none),
+    at its nearest sample, as loud against its tick as the voice says."""
+    for tock in (False, True):
+        which = (train.is_tock == tock) & np.isfinite(leads)
+        if not which.any():
+            continue
+        wave = train.voice.precursor_waveform(rate, tock=tock)
+        onsets = np.round((train.times[which] - leads[which]) * rate).astype(np.int64)
+        index = onsets[:, None] + np.arange(wave.size)[None, :]
+        values = levels[which, None] * wave[None, :]
+        inside = (index >= 0) & (index < out.size)
+        np.add.at(out, index[inside], values[inside])
 
 
 def _bounced(voice: Voice, jitter: float, rng) -> Voice:
     """The voice with its secondary-impact delays moved by Gaussian ``jitter`` (s),
     kept at least 5 ms after the main impact and 2 ms after each other."""
-    moved = np.sort(np.asarray(voice.sub_delays) + rng.normal(0.0, jitter, len(voice.sub_delays)))
+    changes: dict[str, Any] = {"sub_delays": _moved(voice.sub_delays, jitter, rng)}
+    if voice.tock_sub_delays:
+        changes["tock_sub_delays"] = _moved(voice.tock_sub_delays, jitter, rng)
+    return dataclasses.replace(voice, **changes)
+
+
+def _moved(sub_delays: tuple[float, ...], jitter: float, rng) -> tuple[float, ...]:
+    moved = np.sort(np.asarray(sub_delays) + rng.normal(0.0, jitter, len(sub_delays)))
     delays: list[float] = []
     for d in moved:
         delays.append(max(float(d), delays[-1] + 0.002 if delays else 0.005))
-    return dataclasses.replace(voice, sub_delays=tuple(delays))
+    return tuple(delays)

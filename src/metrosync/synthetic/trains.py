@@ -1,11 +1,14 @@
 """Tick trains: when each metronome of a synthetic recording ticks, which ticks are
 tocks, and how each sounds.
 
-``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0)``: the
-time of each tick (s, at the metronome: the onset of its loud, main impact), which
-ticks are tocks, the metronome's sound (`metrosync.synthetic.ticks.Voice`), its
-loudness, optional per-tick level factors (K,), and how much (s, std) the secondary
-impacts of each tick wander about the voice's delays. Build them with
+``TickTrain(times, is_tock, voice, gain=1.0, levels=None, bounce_jitter_s=0.0,
+precursor_leads=None)``: the time of each tick (s, at the metronome: the onset of its
+loud, main impact), which ticks are tocks, the metronome's sound
+(`metrosync.synthetic.ticks.Voice`), its loudness, optional per-tick level factors
+(K,), how much (s, std) the secondary impacts of each tick wander about the voice's
+delays, and, for a voice with a precursor, how long before each tick it comes (K,) s,
+NaN where it does not (None: drawn by the recording from the voice's `Precursor`).
+Build them with
 
 - ``steady_train(bpm, duration, *, phase=0, limp=0, drift_bpm_per_min=0,
   jitter_s=0, level_jitter_db=0, tock_first=False, voice=None, gain=1, seed=0,
@@ -65,6 +68,9 @@ class TickTrain:
     bounce_jitter_s : standard deviation of each tick's secondary-impact delays about
         the voice's, s (the pallet bounces a little differently each time; rendered
         from `BOUNCE_VARIANTS` variants of the tick and of the tock).
+    precursor_leads : (K,) optional lead of the precursor before each tick, s (NaN:
+        none before that tick), for a voice with a precursor; None: drawn from the
+        voice's `Precursor` by the recording.
     """
 
     times: np.ndarray
@@ -73,6 +79,7 @@ class TickTrain:
     gain: float = 1.0
     levels: np.ndarray | None = None
     bounce_jitter_s: float = 0.0
+    precursor_leads: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if not (0 <= self.bounce_jitter_s <= 0.005):
@@ -104,6 +111,15 @@ class TickTrain:
                     f"`levels` must be {times.shape} positive factors, got {levels!r}."
                 )
             object.__setattr__(self, "levels", levels)
+        if self.precursor_leads is not None:
+            leads = np.asarray(self.precursor_leads, dtype=float)
+            heard = leads[np.isfinite(leads)]
+            if leads.shape != times.shape or np.any(heard <= 0) or np.any(heard >= 0.1):
+                raise ParameterError(
+                    f"`precursor_leads` must be {times.shape} leads in (0, 0.1) s or NaN, got "
+                    f"{leads!r}."
+                )
+            object.__setattr__(self, "precursor_leads", leads)
 
 
 def steady_train(
