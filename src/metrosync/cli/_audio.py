@@ -114,9 +114,9 @@ def _changed(args, defaults: dict, names: dict) -> list[str]:
     return [names[d] for d, v in defaults.items() if getattr(args, d, v) != v]
 
 
-def audio_requested(args) -> bool:
+def audio_requested(args, *, others: str = "light-gate logs") -> bool:
     """True when the inputs are recordings; refuses a mix of recordings and logs, and
-    warns about audio options given with logs."""
+    warns about audio options given with logs (or what ``others`` names instead)."""
     from ..audio.reader import is_audio_path
 
     audio = [is_audio_path(p) for p in args.logs]
@@ -128,7 +128,7 @@ def audio_requested(args) -> bool:
     if not any(audio):
         ignored = _changed(args, args._audio_defaults, AUDIO_OPTIONS)
         if ignored:
-            warnings.warn(f"light-gate logs ignore {', '.join(ignored)} (options for sound "
+            warnings.warn(f"{others} ignore {', '.join(ignored)} (options for sound "
                           f"recordings).", UserWarning, stacklevel=2)  # fmt: skip
         return False
     return True

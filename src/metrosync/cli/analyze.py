@@ -1,4 +1,8 @@
-"""``metrosync analyze``: light-gate logs → r(t), frequencies, σ and the cleaning report."""
+"""``metrosync analyze``: light-gate logs → r(t), frequencies, σ and the cleaning report.
+
+The same command reads a sound recording or a video's sound (`_audio`) and angle
+tables of other instruments (`_angles`); `run` tells the inputs apart and hands them on.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +11,7 @@ from pathlib import Path
 
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
+from ._angles import add_angle_options, run_tables, tables_requested
 from ._audio import add_audio_options, audio_requested, run_audio
 from ._io import FIGURE, NETCDF, check_output, write_outputs
 from ._options import HelpFormatter, add_aliases, int_list
@@ -29,15 +34,18 @@ def counter_bits_arg(text: str):
 def register(subparsers) -> None:
     parser = subparsers.add_parser(
         "analyze",
-        help="analyse light-gate logs (real or virtual) or a sound recording",
+        help="analyse light-gate logs (real or virtual), a sound recording or angle tables",
         description="Read light-gate logs, clean them, and measure r(t), the metronomes' "
         "frequencies and their spread. Several logs are repeated runs and are averaged. "
         "A sound recording (.wav, .flac, .ogg, .mp3, a phone's .m4a) or a video (.mp4, .mov) "
-        "is analysed for its ticks instead.",
+        "is analysed for its ticks instead. Tables of a pendulum's angle in time (a rotary "
+        "encoder's CSV, Tracker's exported data) are analysed as light-gate logs are, their "
+        "passes through the vertical taken as the gate's.",
         formatter_class=HelpFormatter,
     )
     parser.add_argument("logs", nargs="+", type=Path, metavar="LOG",
-                        help="light-gate log files, or one sound recording")  # fmt: skip
+                        help="light-gate log files, one sound recording or video, or angle "
+                        "tables")  # fmt: skip
     g = parser.add_argument_group("reading")
     g.add_argument("--tick", type=float, default=DEFAULT_TICK, help="seconds per logger tick")
     g.add_argument("--counter-bits", type=counter_bits_arg, default="auto",
@@ -70,12 +78,16 @@ def register(subparsers) -> None:
                      "--out/--plot and exit 130")  # fmt: skip
     add_aliases(parser, equilibrium_window="--window", grid_dt="--grid-dt", channels="--channels")
     add_audio_options(parser)
+    add_angle_options(parser)
     parser.set_defaults(func=run)
 
 
 def run(args) -> int:
-    if audio_requested(args):
+    tables = tables_requested(args)
+    if audio_requested(args, others="angle tables" if tables else "light-gate logs"):
         return run_audio(args)
+    if tables:
+        return run_tables(args)
     from ..lightgate import analyze
     from ..lightgate.plots import plot_analysis
     from ..lightgate.summary import summary_text
