@@ -28,10 +28,19 @@ import numpy as np
 
 from .._input_files import check_input_file
 from .._words import plural
+from ..budget import format_bytes
 from ..errors import MetrosyncError
 
 #: Default longest side of the pictures analysed, pixels.
 DEFAULT_MAX_SIDE = 640
+#: Fewest bytes in which a container can store a video frame: its entry in the index
+#: (an MP4's 4-byte sample size, an AVI's 16-byte idx1 entry, a Matroska block's header)
+#: beside a coded picture of a few bytes at least. A header that counts more frames
+#: than its file's bytes can hold this way is damaged.
+MIN_FRAME_BYTES = 4
+#: Most the stated frame count and the one the length × average rate make may differ by,
+#: as a ratio, before the header is taken as contradicting itself.
+FRAME_COUNT_RATIO = 2.0
 
 
 class VideoFileError(MetrosyncError, ValueError):
@@ -148,6 +157,44 @@ class Video:
             self.loss = f"{self.loss}; {note}" if self.loss else note
 
 
+def _frame_count(path: Path, stated: int, duration: float, fps: float, average: float) -> int:
+    """The frames to expect: the count the header states, else its length × rate (0:
+    unknown); a `VideoFileError` when the header cannot be right.
+
+    A damaged header can state billions of frames for a clip of seconds, and every
+    size and time planned from it would be as wrong. Two counts are checked against the
+    file: the stated one and the one its length and average rate make (the same frames
+    counted twice, so they agree whatever the timestamps do; the rate FFmpeg guesses
+    for a variable-rate file need not, and is not compared). Neither may exceed what
+    the file's bytes can hold at `MIN_FRAME_BYTES` a frame.
+    """
+    size = path.stat().st_size
+    room = size // MIN_FRAME_BYTES
+    implied = duration * average if np.isfinite(duration * average) and duration > 0 else None
+    by_rate = duration * fps if np.isfinite(duration * fps) and duration > 0 else None
+    contradicted = (
+        stated > 0
+        and implied is not None
+        and abs(stated - implied) > 2
+        and max(stated, implied) > FRAME_COUNT_RATIO * min(stated, implied)
+    )
+    too_many = max(stated, by_rate or 0) > room
+    if contradicted or too_many:
+        said = f"states {plural(stated, 'frame')}" if stated > 0 else "states no frame count"
+        if by_rate is not None:
+            rate = average if implied is not None else fps
+            said += f", but {duration:.4g} s at {rate:.4g} fps make about {round(duration * rate)}"
+        said += f", and its {format_bytes(size)} can hold at most {plural(room, 'frame')}"
+        raise VideoFileError(
+            f"{str(path)!r} has a damaged header: it {said}. Copy its streams into "
+            f"a new file, which writes the header again from the frames themselves (`ffmpeg "
+            f"-i {path.name} -c copy fixed{path.suffix}`), and track that."
+        )
+    if stated > 0:
+        return stated
+    return int(by_rate) if by_rate is not None else 0
+
+
 def _open(path: Path):
     import av
 
@@ -198,7 +245,8 @@ def open_video(path: str | Path) -> Video:
             duration = container.duration / av.time_base
         else:
             duration = float("nan")
-        estimate = stream.frames or (int(duration * fps) if np.isfinite(duration * fps) else 0)
+        average = float(stream.average_rate) if stream.average_rate else float("nan")
+        estimate = _frame_count(path, int(stream.frames or 0), duration, fps, average)
         try:
             first = next(container.decode(stream), None)
         except av.error.FFmpegError as error:
