@@ -265,29 +265,33 @@ def _behind(region: Region, x: float, y: float) -> bool:
     return bool(4.0 <= radius <= 0.5 * region.r_outer and abs(off) <= region.half_width + 0.15)
 
 
-def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> list[Region]:
+def regions_given(
+    regions: list[tuple[float, ...]], pictures: np.ndarray, *, scale: float = 1.0
+) -> list[Region]:
     """Regions for metronomes given by hand, in the pictures' pixels: a pivot ``(x, y)``
-    gets the sector of the rod seen about it (upward ± 45° when none is seen); a box
-    ``(x0, y0, x1, y1)`` is searched for one metronome."""
+    gets the sector of the rod seen about it (upward ± 45° when none is seen inside the
+    picture; a `DetectionError` outside it); a box ``(x0, y0, x1, y1)`` is searched for
+    one metronome. ``scale`` : the pictures' pixels per video pixel, for messages."""
     pictures = np.asarray(pictures, dtype=np.float32)
     f, h, w = pictures.shape
     bg, gain = background(pictures)
     lines = _stack(rod_lines(pictures, bg, gain))
     out = []
     for given in regions:
+        shown = "(" + ", ".join(f"{v / scale:.0f}" for v in given) + ")"  # the video's pixels
         if len(given) == 4:
             x0, y0 = int(max(0, given[0])), int(max(0, given[1]))
             x1, y1 = int(min(w, np.ceil(given[2]))), int(min(h, np.ceil(given[3])))
             if x1 - x0 < 8 or y1 - y0 < 8:
                 raise DetectionError(
-                    f"the box {given} is smaller than 8 pixels or outside the picture "
+                    f"the box {shown} is smaller than 8 pixels or outside the picture "
                     f"({w}x{h} as analysed); check the regions file."
                 )
             try:
                 (found,) = find_metronomes(pictures[:, y0:y1, x0:x1], count=1)
             except DetectionError:
                 raise DetectionError(
-                    f"no rod swings about a fixed pivot inside the box {given}; give its "
+                    f"no rod swings about a fixed pivot inside the box {shown}; give its "
                     f"pivot instead ('x y')."
                 ) from None
             px, py = found.pivot
@@ -296,6 +300,14 @@ def regions_given(regions: list[tuple[float, ...]], pictures: np.ndarray) -> lis
             continue
         x, y = given
         region = _region((x, y), lines, f)
+        if region is None and not (0 <= x <= w - 1 and 0 <= y <= h - 1):
+            # the guess below looks up from the pivot, which outside the picture sees nothing
+            raise DetectionError(
+                f"no rod is seen swinging about the pivot {shown}, "
+                f"outside the video's picture: a pivot out of view needs its rod to swing in "
+                f"view in the first seconds; check its coordinates, or give a box round the "
+                f"swing instead."
+            )
         if region is None:
             region = Region((float(x), float(y)), 0.0, np.pi / 4, 3.0, 0.2 * max(h, w), 0.0)
         out.append(region)
