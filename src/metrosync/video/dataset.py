@@ -18,8 +18,13 @@ from .._words import plural
 from ..errors import AnalysisError, ParameterError
 from ..observables import crossings as ph
 from ..observables.order import equilibrium_order
-from ..observables.zorder import z_order
+from ..observables.zorder import extrema_times, z_order
 from .angles import LOST, QUALITY_NAMES
+
+#: Frames of the smoothing filter z is measured through (a cubic over 7 frames).
+SMOOTH_FRAMES = 7
+#: Periods about a lost stretch in which the second rod's turns are not used for z.
+GAP_MARGIN = 0.6
 
 
 def tracking_dataset(
@@ -81,9 +86,9 @@ def tracking_dataset(
     for j, ((k, _), a) in enumerate(zip(passes, amps, strict=True)):
         crossing[j, : k.size] = k
         amplitude[j, : a.size] = a
-    z = float("nan")
+    z, z_note = float("nan"), "z is defined for two metronomes only"
     if n == 2:
-        z = _z(times, angle, grid[-1] - window)
+        z, z_note = _z(times, angle, grid[-1] - window)
     lost = (quality == LOST).mean(axis=0)
     data = {
         "r": (("time",), r, {"long_name": "Kuramoto order parameter"}),
@@ -137,6 +142,7 @@ def tracking_dataset(
         "equilibrium_window": window,
         "sigma_bpm": ph.frequency_spread(freq),
         "z": z,
+        "z_note": z_note,
         "grid_dt": grid_dt,
         "picture_scale": scale,
         "instrument": "video",
@@ -166,13 +172,43 @@ def tracking_dataset(
     return ds
 
 
-def _z(times: np.ndarray, angle: np.ndarray, start: float) -> float:
-    """z of two metronomes from their smoothed angles after ``start``."""
+def _z(times: np.ndarray, angle: np.ndarray, start: float) -> tuple[float, str]:
+    """z of two metronomes from their smoothed angles after ``start``, and "" or, when
+    z is NaN, why it could not be measured.
+
+    times : (T,); angle : (T, 2), NaN where a rod was lost. Each stretch in which both
+    rods are seen is smoothed on its own (a filter would spread a NaN over its width).
+    Near a gap, the nearest turn of the first rod to a turn of the second may be the
+    one lost, which would count as a whole half-period off: the second rod's turns
+    within `GAP_MARGIN` periods of a gap are left out, not the whole window.
+    """
     from scipy.signal import savgol_filter
 
     keep = times >= start
-    if keep.sum() < 16 or not np.all(np.isfinite(angle[keep])):
-        return float("nan")
-    t = times[keep]
-    smooth = [savgol_filter(angle[keep, j], 7, 3) for j in (0, 1)]
-    return z_order(t, smooth[0], smooth[1])
+    t, a = times[keep], angle[keep]
+    seen = np.all(np.isfinite(a), axis=1)
+    smooth = np.full(a.shape, np.nan)
+    edges = np.flatnonzero(np.diff(np.r_[0, seen.astype(np.int8), 0]))
+    for lo, hi in zip(edges[::2], edges[1::2], strict=True):
+        if hi - lo >= SMOOTH_FRAMES:
+            smooth[lo:hi] = savgol_filter(a[lo:hi], SMOOTH_FRAMES, 3, axis=0)
+    usable = np.isfinite(smooth[:, 0])
+    window = f"the last {float(t[-1] - t[0]) if t.size else 0.0:.1f} s"
+    if usable.sum() < 2 * SMOOTH_FRAMES:
+        return float("nan"), (
+            f"z not measured: both rods are seen together in {plural(int(usable.sum()), 'frame')} "
+            f"of {window}, too few for a swing"
+        )
+    tops = extrema_times(t[usable], smooth[usable, 0])
+    period = float(np.median(np.diff(tops))) if tops.size >= 2 else np.inf
+    second = smooth[:, 1].copy()
+    lost = t[~usable]
+    if lost.size and np.isfinite(period):
+        k = np.clip(np.searchsorted(lost, t), 1, lost.size)
+        after = lost[np.minimum(k, lost.size - 1)]
+        nearest = np.minimum(np.abs(t - lost[k - 1]), np.abs(t - after))
+        second[nearest < GAP_MARGIN * period] = np.nan
+    z = z_order(t, smooth[:, 0], second)
+    if not np.isfinite(z):
+        return float("nan"), f"z not measured: no whole swing of both rods seen in {window}"
+    return z, ""
