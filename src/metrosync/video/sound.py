@@ -13,7 +13,10 @@ picture and sound agree: most ticks fall within `TOLERANCE` of that offset.
 
 from __future__ import annotations
 
+import contextlib
 import tempfile
+import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -89,10 +92,16 @@ def _extract(path: Path, wav: Path) -> float:
 
 
 def sound_check(path: str | Path, passes: list[np.ndarray]) -> SoundCheck:
-    """The video's audio track against the passes (each metronome's, both directions)."""
+    """The video's audio track against the passes (each metronome's, both directions).
+
+    Raises `MetrosyncError` when the track cannot be decoded or gives no ticks; it, and
+    every warning of the analysis, names the video's sound track, not the temporary WAV
+    it was analysed from.
+    """
     from ..audio import analyze_audio
 
     every = np.sort(np.concatenate([np.asarray(p, dtype=float) for p in passes]))
+    name = f"the sound track of {Path(path).name}"
     with tempfile.TemporaryDirectory() as folder:
         wav = Path(folder) / "track.wav"
         import av
@@ -100,11 +109,9 @@ def sound_check(path: str | Path, passes: list[np.ndarray]) -> SoundCheck:
         try:
             shift = _extract(Path(path), wav)
         except (av.error.FFmpegError, RuntimeError, ValueError) as error:
-            raise MetrosyncError(f"the audio track cannot be decoded ({error})") from None
-        try:
+            raise MetrosyncError(f"{name} cannot be decoded ({error}).") from None
+        with _speaking_of(wav, name):
             heard = analyze_audio(wav)
-        except MetrosyncError as error:
-            raise MetrosyncError(f"the audio track gave no ticks to compare ({error})") from None
     ticks = heard.tick_time.values + shift
     if ticks.size == 0 or every.size == 0:
         return SoundCheck(ticks, np.full(ticks.size, np.nan), float("nan"), 0.0, 0.0)
@@ -113,6 +120,28 @@ def sound_check(path: str | Path, passes: list[np.ndarray]) -> SoundCheck:
     agreeing = float(np.mean(np.abs(offset - latency) <= TOLERANCE))
     gap = np.abs(every - _nearest(ticks - latency, every))
     return SoundCheck(ticks, offset, latency, agreeing, float(np.mean(gap <= TOLERANCE)))
+
+
+@contextlib.contextmanager
+def _speaking_of(wav: Path, name: str) -> Iterator[None]:
+    """Say ``name`` wherever the audio analysis inside names the file ``wav`` (its
+    errors and warnings): the user gave a video, and the WAV is gone once it returns."""
+
+    def renamed(text: str) -> str:
+        for said in (f"recording {str(wav)!r}", repr(str(wav)), str(wav)):
+            text = text.replace(said, name)
+        return text
+
+    caught: list[warnings.WarningMessage] = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            yield
+    except MetrosyncError as error:
+        raise MetrosyncError(renamed(str(error))) from None
+    finally:
+        for warning in caught:
+            warnings.warn(renamed(str(warning.message)), warning.category, stacklevel=3)
 
 
 def _nearest(sorted_times: np.ndarray, times: np.ndarray) -> np.ndarray:
