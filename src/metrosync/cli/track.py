@@ -7,7 +7,7 @@ from pathlib import Path
 
 from .._words import plural
 from ._io import FIGURE, NETCDF, check_output, write_outputs
-from ._options import HelpFormatter, add_aliases
+from ._options import HelpFormatter, add_aliases, positive_seconds
 
 
 def register(subparsers) -> None:
@@ -36,7 +36,8 @@ def register(subparsers) -> None:
         default=None,
         metavar="FILE",
         help="metronomes given by hand: a text file, one per line, 'x y' (the "
-        "pivot) or 'x0 y0 x1 y1' (a box round the swing), in the video's pixels",
+        "pivot) or 'x0 y0 x1 y1' (a box round the swing), in the video's pixels; a pivot "
+        "may lie outside the picture (a pendulum hung above it) if its rod swings in view",
     )
     g.add_argument(
         "--learn",
@@ -82,10 +83,15 @@ def register(subparsers) -> None:
         metavar="FRAMES",
         help="longest gap without a clear rod that is interpolated",
     )
-    m.add_argument("--grid-dt", type=float, default=0.1, help="spacing of the r(t) grid, s")
+    m.add_argument(
+        "--grid-dt",
+        type=positive_seconds,
+        default=0.1,
+        help="spacing of the r(t) grid, s (at most half the video's length)",
+    )
     m.add_argument(
         "--window",
-        type=float,
+        type=positive_seconds,
         default=None,
         metavar="S",
         help="final window averaged for r_eq, s (default: the last quarter)",
@@ -183,10 +189,18 @@ def summary(ds) -> str:
     lines.append(f"  sigma = {a['sigma_bpm']:.4f} BPM")
     lines.append(f"  equilibrium r (last {a['equilibrium_window']:.1f} s): {a['r_eq']:.4f}")
     if ds.sizes["metronome"] == 2:
-        lines.append(f"  z = {a['z']:+.3f} (+1 in phase, -1 in anti-phase)")
+        if np.isfinite(a["z"]):
+            lines.append(f"  z = {a['z']:+.3f} (+1 in phase, -1 in anti-phase)")
+        else:
+            lines.append(f"  {a.get('z_note') or 'z not measured'}")
     if a.get("loss"):
         lines.append(f"  lost: {a['loss']}")
-    lines.append(f"  rolling shutter: {a['readout'] * 1e3:.1f} ms ({a['readout_source']})")
+    source = a["readout_source"]
+    if source == "given" or np.isfinite(a.get("readout_error", np.nan)):
+        lines.append(f"  rolling shutter: {a['readout'] * 1e3:.1f} ms ({source})")
+    else:  # no number was measured: say so, and what was assumed instead
+        lines.append(f"  rolling shutter: {source}; taken as 0 (a global shutter), or give "
+                     f"--readout")  # fmt: skip
     if a.get("sound"):
         lines.append(f"  sound: {a['sound']}")
     return "\n".join(lines)
