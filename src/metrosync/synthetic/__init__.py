@@ -12,6 +12,8 @@ The modules, each a part of one generative model:
 - `impairments`: what the room, the phone and the hand do (`Impairments`);
 - `recording`: the sum heard by one or more microphones, with the truth of every
   tick (`make_recording` → `Recording`);
+- `corpus`: the frozen benchmark corpus, versioned, in a development and a held-out
+  split (`corpus.SPLITS`, `corpus.entries`; scored by benchmarks/audio_corpus.py);
 - `clicks`: click-track recordings for tests of the detector;
 - `score`: the yardstick an analysis is scored with against the truth.
 
