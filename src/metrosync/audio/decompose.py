@@ -1,0 +1,169 @@
+"""The onsets of a recording explained as metronomes and clutter.
+
+The model. A recording's onsets are the impacts of M metronomes' ticks, each metronome
+a timing model with its learned tick (`structure`), plus clutter. M and the metronomes
+are found by matching pursuit: the periodicity search (`periodicity`) proposes tempi
+among the onsets not yet explained; the metronome at the likeliest tempo is followed
+(`structure.follow`); it is kept if it explains enough of the recording to be a
+metronome (its main impact heard in `MIN_HEARD` of its beats, over at least `MIN_BEATS`
+beats), its onsets are set aside, and the search runs again on the rest, until no
+tempo is left above the false-alarm threshold. Then each metronome is followed again
+with the others' onsets set aside (the onsets go to whichever metronome explains them
+best), so that the order in which they were found does not decide who holds a tick.
+
+A harmonic (twice a tempo) is rejected by the model itself: half its beats hold no
+impact of their kind. A precursor or a bounce at the tempo of a metronome is that
+metronome's impact (`structure`), not a metronome of its own.
+
+Contract: `decompose(times)` returns the `Heard` metronomes, slowest first, and (K,)
+the owner of each onset (−1: clutter).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import AnalysisError
+from .periodicity import BPM_RANGE, candidate_tempi
+from .structure import Followed, follow
+
+#: Share of its beats a metronome's main impact must be heard in.
+MIN_HEARD = 0.5
+#: Fewest beats a metronome must span to be one.
+MIN_BEATS = 16
+#: Most metronomes sought (a bound on the search, not an assumption of the model).
+MAX_METRONOMES = 8
+#: Share of a metronome's ticks that another explains, beyond which it is no metronome.
+REDUNDANT = 0.5
+#: Passes of refollowing every metronome with the others' onsets set aside.
+PASSES = 2
+
+
+@dataclass(frozen=True)
+class Heard:
+    """One metronome of the recording: its `Followed` model, fitted on the onsets
+    ``pool`` (indices into the recording's onsets), and the indices of its ticks."""
+
+    followed: Followed
+    pool: np.ndarray
+
+    @property
+    def ticks(self) -> np.ndarray:
+        """Indices (into the recording's onsets) of the onsets that time its ticks."""
+        return self.pool[self.followed.main]
+
+    @property
+    def beats(self) -> np.ndarray:
+        """The beat number of each of `ticks`."""
+        return self.followed.beat[self.followed.main]
+
+
+def decompose(times, bpm_range=BPM_RANGE) -> tuple[list[Heard], np.ndarray]:
+    """Metronomes that explain the sorted onset ``times`` (s), and each onset's owner."""
+    t = np.asarray(times, dtype=float)
+    owner = np.full(t.size, -1)
+    found: list[tuple[float, np.ndarray]] = []  # (tempo, the onsets' indices it explains)
+    while len(found) < MAX_METRONOMES:
+        free = np.flatnonzero(owner < 0)
+        kept = _likeliest(t, free, bpm_range)
+        if kept is None:
+            break
+        bpm, index = kept
+        owner[index] = len(found)
+        found.append((bpm, index))
+    metronomes: list[Heard] = []
+    mains = None
+    for _ in range(PASSES):
+        metronomes, owner = _refollow(t, [bpm for bpm, _ in found], owner, mains)
+        found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
+        metronomes = _without_redundant(metronomes, t.size)
+        found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
+        mains = np.full(t.size, -1)
+        for m, h in enumerate(metronomes):
+            mains[h.ticks] = m
+    order = np.argsort([m.followed.timing.period for m in metronomes])[::-1]
+    relabel = np.full(len(metronomes) + 1, -1)
+    relabel[order] = np.arange(order.size)
+    return [metronomes[i] for i in order], np.where(owner >= 0, relabel[owner], -1)
+
+
+def _without_redundant(heard: list[Heard], k: int) -> list[Heard]:
+    """``heard`` less each metronome whose ticks are mostly another's impacts: it
+    explains nothing the other does not (a harmonic that a limp or a rival's onsets
+    made look like a tempo), and a penalised likelihood keeps no such component.
+    The metronomes with the fewest ticks are judged first."""
+    order = sorted(range(len(heard)), key=lambda m: heard[m].ticks.size)
+    kept = set(order)
+    for m in order:
+        others = np.zeros(k, dtype=bool)
+        for o in kept - {m}:
+            h = heard[o]
+            others[h.pool[h.followed.impact >= 0]] = True
+        if others[heard[m].ticks].mean() > REDUNDANT:
+            kept.discard(m)
+    return [heard[m] for m in sorted(kept)]
+
+
+def _likeliest(t: np.ndarray, free: np.ndarray, bpm_range):
+    """(tempo, indices into ``t`` it explains) of the first candidate among the onsets
+    ``free`` that is a metronome, strongest first; None when none is."""
+    if free.size < MIN_BEATS:
+        return None
+    for candidate in candidate_tempi(t[free], bpm_range=bpm_range):
+        followed = _metronome(t[free], candidate.bpm)
+        if followed is not None:
+            return followed.timing.bpm, free[followed.impact >= 0]
+    return None
+
+
+def _metronome(t: np.ndarray, bpm: float) -> Followed | None:
+    """The metronome followed from ``bpm`` among onsets ``t``, if it is one."""
+    try:
+        followed = follow(t, bpm)
+    except AnalysisError:
+        return None
+    beats = followed.beat[followed.main]
+    if beats.size < 2:
+        return None
+    span = int(beats.max() - beats.min()) + 1
+    if span < MIN_BEATS or beats.size < MIN_HEARD * span:
+        return None
+    return followed
+
+
+def _refollow(t: np.ndarray, tempi: list[float], owner: np.ndarray, mains=None):
+    """Each metronome followed again on every onset but the other metronomes' ticks
+    (``mains``: (K,) the metronome whose tick each onset is, −1 for none); an onset two
+    metronomes explain goes to the one whose learned tick makes it likelier
+    (`_density`)."""
+    heard: list[Heard] = []
+    density = np.zeros((len(tempi), t.size))
+    mains = np.full(t.size, -1) if mains is None else mains
+    for m, bpm in enumerate(tempi):
+        pool = np.flatnonzero((mains < 0) | (mains == m))
+        followed = _metronome(t[pool], bpm)
+        if followed is None:
+            continue
+        density[len(heard), pool] = _density(t[pool], followed)
+        heard.append(Heard(followed, pool))
+    if not heard:
+        return [], np.full(t.size, -1)
+    density = density[: len(heard)]
+    owner = np.where(density.max(axis=0) > 0, np.argmax(density, axis=0), -1)
+    return heard, owner
+
+
+def _density(t: np.ndarray, followed: Followed) -> np.ndarray:
+    """(K,) the density (1/s) of each onset under the impact that explains it, weighted
+    by how often that impact is heard: presence × N(offset; o_j, s_j²); 0 for clutter."""
+    out = np.zeros(t.size)
+    beat = followed.beat
+    for kind, structure in enumerate(followed.structure):
+        for j, impact in enumerate(structure.impacts):
+            mine = (followed.impact == j) & (np.mod(beat, 2) == kind) & (beat >= 0)
+            if mine.any():
+                z = (t[mine] - followed.timing.predict(beat[mine]) - impact.offset) / impact.spread
+                out[mine] = impact.presence * np.exp(-0.5 * z**2) / (impact.spread * 2.5066)
+    return out
