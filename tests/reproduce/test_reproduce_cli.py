@@ -75,7 +75,7 @@ def flat(text: str) -> str:
 
 
 def test_help_docs_and_report_quote_the_same_measured_cost(tiny, capsys):
-    from metrosync.paper.studies import MEASURED_COST
+    from metrosync.paper.names import MEASURED_COST
 
     with pytest.raises(SystemExit):
         main(["reproduce", "--help"])

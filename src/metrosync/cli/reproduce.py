@@ -10,8 +10,7 @@ from ._options import add_aliases, path_option
 
 
 def register(subparsers) -> None:
-    from ..paper.catalogue import STUDIES
-    from ..paper.studies import MEASURED_COST
+    from ..paper.names import MEASURED_COST, STUDY_NAMES
 
     parser = subparsers.add_parser(
         "reproduce",
@@ -64,7 +63,7 @@ def register(subparsers) -> None:
         nargs="+",
         default=None,
         metavar="STUDY",
-        choices=[s.name for s in STUDIES],
+        choices=list(STUDY_NAMES),
         help="run only these studies",
     )
     parser.add_argument(

@@ -16,17 +16,17 @@
 ``pipeline``    `reproduce`, the entry point tying them together
 """
 
-from .catalogue import STUDIES
-from .studies import paper_sigma_to_bpm
-
 __all__ = ["STUDIES", "Reproduction", "paper_sigma_to_bpm", "reproduce"]
+
+# Each of these pulls in scipy, xarray or the simulator; the command line's parser, which
+# every command builds, needs only `names`: each is loaded on first use (PEP 562).
+_HOMES = {"STUDIES": "catalogue", "paper_sigma_to_bpm": "studies",
+          "Reproduction": "pipeline", "reproduce": "pipeline"}  # fmt: skip
 
 
 def __getattr__(name: str):
-    # The pipeline pulls in the simulator, calibration and scipy; the CLI's parser only
-    # needs the study names, so it is loaded on first use.
-    if name in ("Reproduction", "reproduce"):
-        from . import pipeline
+    if name in _HOMES:
+        import importlib
 
-        return getattr(pipeline, name)
+        return getattr(importlib.import_module(f".{_HOMES[name]}", __name__), name)
     raise AttributeError(f"module 'metrosync.paper' has no attribute {name!r}")

@@ -22,10 +22,10 @@ from .claims import Verdict
 from .consistency import markdown_table
 from .large_n import large_n_lines
 from .map_report import claims_map_section, conclusion, sigma_map_section, tuning_bullet
+from .names import MEASURED_COST
 from .studies import (
     ESTIMATION,
     FIG10_SIGMA,
-    MEASURED_COST,
     TABLE1_SIGMA,
     TABLE2_SIGMA,
     paper_sigma_to_bpm,

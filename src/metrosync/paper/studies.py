@@ -49,12 +49,6 @@ MODES = ("quick", "full")
 #: What each mode cost, measured with `python benchmarks/reproduce.py [--full]` on the
 #: 2-core x86-64 development machine. `reproduce --help`, the README and REPORT.md all
 #: quote these words (a test checks that they agree); REPORT.md adds its own timings.
-MEASURED_COST = {
-    "quick": "51 s measured on 2 cores (73 s of CPU) with the kernels compiled, the σ map "
-    "and the claims map included; a first run compiles them too, once (about 32 s of CPU)",
-    "full": "9 min 41 s measured on 2 cores (17 min 26 s of CPU), "
-    "Fig. 10, the claims map and the σ map most of it",
-}
 
 
 def paper_sigma_to_bpm(value):
