@@ -27,6 +27,13 @@ def test_phone_video_and_its_truth(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.mov", "run.truth.json"]
 
 
+def test_phone_refuses_a_negative_seed_as_it_parses(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        main(["animate", "--phone", "--phone-seed", "-1", "--out", str(tmp_path / "a.mp4")])
+    assert "argument --phone-seed: a seed is a whole number from 0 up" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
@@ -35,7 +42,6 @@ def test_phone_video_and_its_truth(tmp_path, capsys):
         (["--speedup", "2"], "`--speedup` does not apply"),
         (["--out", "{tmp}/a.gif"], "must end in .mp4, .mov, .mkv"),
         (["--n", "9"], "`--n` must be at most 8"),
-        (["--phone-seed", "-1"], "`--phone-seed`"),
         (["--fps", "0"], "`fps`"),
     ],
 )

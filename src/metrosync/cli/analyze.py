@@ -7,14 +7,13 @@ tables of other instruments (`_angles`); `run` tells the inputs apart and hands 
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from ..lightgate.cleaning import DEFAULT_GLITCH, DEFAULT_MIN_ASYMMETRY
 from ..lightgate.reader import DEFAULT_TICK
 from ._angles import add_angle_options, run_tables, tables_requested
 from ._audio import add_audio_options, audio_requested, run_audio
 from ._io import FIGURE, NETCDF, check_output, write_outputs
-from ._options import HelpFormatter, add_aliases, int_list
+from ._options import HelpFormatter, add_aliases, int_list, path_option, positive_seconds
 
 
 def counter_bits_arg(text: str):
@@ -43,7 +42,7 @@ def register(subparsers) -> None:
         "passes through the vertical taken as the gate's.",
         formatter_class=HelpFormatter,
     )
-    parser.add_argument("logs", nargs="+", type=Path, metavar="LOG",
+    parser.add_argument("logs", nargs="+", type=path_option, metavar="LOG",
                         help="light-gate log files, one sound recording or video, or angle "
                         "tables")  # fmt: skip
     g = parser.add_argument_group("reading")
@@ -60,17 +59,18 @@ def register(subparsers) -> None:
     c.add_argument("--glitch", type=float, default=DEFAULT_GLITCH, help="shortest real spell, s")
     c.add_argument("--min-asymmetry", type=float, default=DEFAULT_MIN_ASYMMETRY,
                    help="smallest (l-s)/(l+s) that tells the pass directions apart")  # fmt: skip
-    c.add_argument("--grid-dt", type=float, default=0.1, help="spacing of the r(t) grid, s")
+    c.add_argument("--grid-dt", type=positive_seconds, default=0.1,
+                   help="spacing of the r(t) grid, s")  # fmt: skip
     c.add_argument(
         "--window",
-        type=float,
+        type=positive_seconds,
         default=None,
         metavar="S",
         help="final window averaged for r_eq, s (default: the last quarter)",
     )
     out = parser.add_argument_group("output")
-    out.add_argument("--out", type=Path, default=None, help="write the dataset to FILE.nc")
-    out.add_argument("--plot", type=Path, default=None,
+    out.add_argument("--out", type=path_option, default=None, help="write the dataset to FILE.nc")
+    out.add_argument("--plot", type=path_option, default=None,
                      help="write r(t) to FILE.png (or .pdf, .svg, ...)")  # fmt: skip
     out.add_argument("--follow", action="store_true",
                      help="follow a LOG that is still being written (by `metrosync record` or "

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from .._words import plural
 from ._io import FIGURE, NETCDF, check_output, write_outputs
-from ._options import HelpFormatter, add_aliases, positive_seconds
+from ._options import HelpFormatter, add_aliases, path_option, positive_seconds
 
 
 def register(subparsers) -> None:
@@ -21,7 +20,7 @@ def register(subparsers) -> None:
         "sound, its ticks are timed against the picture.",
         formatter_class=HelpFormatter,
     )
-    parser.add_argument("video", type=Path, metavar="VIDEO", help="the video file")
+    parser.add_argument("video", type=path_option, metavar="VIDEO", help="the video file")
     g = parser.add_argument_group("finding the metronomes")
     g.add_argument(
         "--count",
@@ -32,7 +31,7 @@ def register(subparsers) -> None:
     )
     g.add_argument(
         "--regions",
-        type=Path,
+        type=path_option,
         default=None,
         metavar="FILE",
         help="metronomes given by hand: a text file, one per line, 'x y' (the "
@@ -99,18 +98,18 @@ def register(subparsers) -> None:
     m.add_argument("--no-sound", action="store_true", help="ignore the video's audio track")
     out = parser.add_argument_group("output")
     out.add_argument(
-        "--out", type=Path, default=None, metavar="FILE", help="write the dataset to FILE.nc"
+        "--out", type=path_option, default=None, metavar="FILE", help="write the dataset to FILE.nc"
     )
     out.add_argument(
         "--plot",
-        type=Path,
+        type=path_option,
         default=None,
         metavar="FILE",
         help="write r(t) and the last seconds' angles to FILE.png",
     )
     out.add_argument(
         "--preview",
-        type=Path,
+        type=path_option,
         default=None,
         metavar="FILE",
         help="write the first frame with what was found to FILE.png",

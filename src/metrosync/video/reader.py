@@ -227,7 +227,7 @@ def open_video(path: str | Path) -> Video:
             kinds = sorted({s.type for s in container.streams})
             hint = (
                 " It is a sound recording: analyse it with `metrosync analyze FILE` (WAV, "
-                "FLAC, MP3), after converting an .m4a to WAV."
+                "FLAC, MP3 or a phone's .m4a)."
                 if "audio" in kinds
                 else ""
             )
