@@ -4,7 +4,8 @@ A model, integrators, observables and analysis tools for the system of Boda, Né
 Tyukodi and Tunyagi, "The rhythm of coupled metronomes" (2013).
 
 One entry point per job: `simulate` (an ensemble), `analyze` (light-gate logs),
-`analyze_audio` (a sound recording of metronomes), `track` (a video of them),
+`analyze_audio` (a sound recording of metronomes), `analyze_angles` (an encoder's or
+Tracker's table of a pendulum's angle), `track` (a video of them),
 `sweep` (parameter grids), `reproduce` (the paper's studies), `animate`, `write_wav`,
 `write_page`, `plot_run` (seeing and hearing a run), `write_playground` (the model
 live in a browser), and `reduced_theory`, `simulate_reduced` (the phase-model
@@ -50,6 +51,7 @@ _LAZY = {
     "sweep": "sweeps",
     "reproduce": "paper",
     "analyze_audio": "audio",
+    "analyze_angles": "angles",
     "track": "video",
     "reduced_theory": "theory",
     "simulate_reduced": "theory",
@@ -80,6 +82,8 @@ __all__ = [
     "sweep",
     "reproduce",
     "analyze_audio",
+    "analyze_angles",
+    "track",
     "reduced_theory",
     "simulate_reduced",
 ]
