@@ -60,3 +60,9 @@ def test_each_command_given_a_folder_says_it_is_one(tmp_path, capsys, argv, what
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert f"{what} {str(tmp_path)!r} is a directory; give a file inside it" in err
+
+
+def test_a_regions_folder_is_named_as_a_folder(tmp_path, capsys):
+    (tmp_path / "pivots.txt").write_text("100 200\n")
+    assert main(["track", str(tmp_path / "film.mp4"), "--regions", str(tmp_path)]) == 2
+    assert f"`regions` (--regions) file {str(tmp_path)!r} is a directory" in capsys.readouterr().err

@@ -97,6 +97,7 @@ def test_the_report_runs_end_to_end(tmp_path):
     path = run_report(tmp_path, tiny, say=lines.append)
     text = path.read_text()
     assert text.count("**reproduced**") + text.count("**not reproduced**") == 6
+    assert "discussed in docs/beyond.md" in text and "README" not in text
     assert (tmp_path / "pantaleone.png").stat().st_size > 10_000
     import xarray as xr
 

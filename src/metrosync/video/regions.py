@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from .._input_files import check_input_file
 from ..errors import ParameterError
 
 FORMAT = (
@@ -39,7 +40,7 @@ MIN_BOX = 8
 
 def read_regions(path: str | Path) -> list[tuple[float, ...]]:
     """The pivots and boxes in ``path``; see the module docstring."""
-    path = Path(path)
+    path = check_input_file(path, "`regions` file")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
