@@ -29,8 +29,10 @@ run: $(STAMP)
 system-deps:
 	@./tools/system-deps
 
+# On every core (pytest-xdist): the tests of a module that share a module-scoped fixture
+# stay on one worker (loadgroup, tests/conftest.py), the rest are dealt out one by one.
 test: $(STAMP) system-deps
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto --dist loadgroup
 
 # The gate-logger firmware (needs gcc-avr and avr-libc): firmware/gate-logger/build/gate-logger.hex.
 # Options pass through and a changed one rebuilds: make firmware CHANNELS=7; make flash

@@ -1,6 +1,28 @@
-"""Shared fixtures: small ensembles whose constants tests can reuse."""
+"""Shared fixtures: small ensembles whose constants tests can reuse; and what lets
+`make test` run the suite on every core (pytest-xdist, ``-n auto --dist loadgroup``).
 
+Under xdist each worker is a process of its own with its own session. Two things keep
+the work done once per run rather than once per worker:
+
+- `build_once` (a fixture): a session fixture's expensive result (a rendered corpus, a video, a
+  tiny reproduction) is built by the first worker that needs it, into a folder shared
+  by the run's workers, under a file lock; the others wait for it and read it back.
+- `pytest_xdist_make_scheduler`: the tests of a module that defines a module-scoped
+  fixture are one group, run by one worker, which builds that fixture once
+  (``--dist loadgroup``; the other tests are dealt out one by one).
+
+Without xdist (``pytest`` alone) both do what plain fixtures do.
+"""
+
+import functools
+import os
+import pickle
+import re
+import shutil
 import signal
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pytest
@@ -13,6 +35,90 @@ from metrosync.equations import SystemArrays
 # handler here and the default disposition in their children: restore it.
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
+
+T = TypeVar("T")
+
+
+def _build_once(tmp_path_factory, name: str, build: Callable[[Path], T]) -> T:
+    """``build(folder)`` once per test run, for every xdist worker; returns its result.
+
+    ``folder`` is a fresh directory for the files ``build`` writes (they stay in place
+    for the whole run, shared by the workers: tests must only read them). Under xdist
+    the first worker to get here builds, holding a file lock, and leaves the result
+    pickled beside the folder; the others wait on the lock and unpickle it. Without
+    xdist this is ``build(tmp_path_factory.mktemp(name))``."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return build(tmp_path_factory.mktemp(name))
+    from filelock import FileLock
+
+    # getbasetemp() is this worker's folder (.../pytest-N/popen-gw0); its parent is the
+    # run's, shared by its workers and new for each run.
+    root = tmp_path_factory.getbasetemp().parent / "built-once"
+    root.mkdir(exist_ok=True)
+    folder, result = root / name, root / f"{name}.pickle"
+    with FileLock(str(root / f"{name}.lock")):
+        if result.is_file():
+            return pickle.loads(result.read_bytes())
+        shutil.rmtree(folder, ignore_errors=True)  # a build that failed part way
+        folder.mkdir()
+        value = build(folder)
+        result.write_bytes(pickle.dumps(value))
+        return value
+
+
+@pytest.fixture(scope="session")
+def build_once(tmp_path_factory):
+    """``build_once(name, build)``: ``build(folder)`` once per run for all the xdist
+    workers (`_build_once`), for session fixtures whose building takes seconds."""
+    return lambda name, build: _build_once(tmp_path_factory, name, build)
+
+
+#: A test module that defines a fixture of one of these scopes (its simulated runs, the
+#: documentation site, the built wheel): its tests stay on one xdist worker, which
+#: builds the fixture once. An ``xdist_group`` mark in a module groups it by that name.
+_MODULE_FIXTURE = re.compile(
+    r"""@pytest\.fixture\([^)]*scope\s*=\s*["'](module|class|package|session)["']"""
+)
+#: Node ids are relative to it (pyproject.toml's folder).
+ROOTDIR = Path(__file__).resolve().parents[1]
+_GROUP_MARK = re.compile(r"""xdist_group\(\s*(?:name\s*=\s*)?["']([^"']+)["']""")
+
+
+@functools.cache
+def _module_group(path: str) -> str | None:
+    """The group of the tests of module ``path`` (relative to the rootdir), or None to
+    deal them out one by one."""
+    try:
+        text = (ROOTDIR / path).read_text(encoding="utf-8")
+    except OSError:
+        return None
+    names = set(_GROUP_MARK.findall(text))
+    if len(names) == 1:
+        return names.pop()
+    return path if names or _MODULE_FIXTURE.search(text) else None
+
+
+@pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: absent without the plugin
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadgroup`` (what `make test` uses), with the groups found per module.
+
+    xdist's own loadgroup reads the ``xdist_group`` marks through a suffix it adds to
+    each node id, which pytest >= 9.2 no longer lets it change (pytest-xdist#1386): the
+    marks would be ignored. Here the groups come from the test modules' source
+    (`_module_group`): a module with a module-scoped fixture is one group, run by one
+    worker (which builds that fixture once); every other test is dealt out on its own.
+    Groups go out first, the largest first; the single tests fill in after them."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadGroupScheduling
+
+    class ModuleGroups(LoadGroupScheduling):
+        def _split_scope(self, nodeid):
+            if nodeid.rfind("@") > nodeid.rfind("]"):  # a suffix from an older pytest
+                return super()._split_scope(nodeid)
+            return _module_group(nodeid.split("::", 1)[0]) or nodeid
+
+    return ModuleGroups(config, log)
 
 
 @pytest.fixture

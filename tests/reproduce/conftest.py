@@ -67,9 +67,9 @@ def tiny_studies():
 
 
 @pytest.fixture(scope="session")
-def tiny(tmp_path_factory):
-    out = tmp_path_factory.mktemp("tiny-reproduction")
-    return reproduce(out, studies=tiny_studies())
+def tiny(build_once):
+    """The tiny reproduction, run once per test run (by one xdist worker for all)."""
+    return build_once("tiny-reproduction", lambda out: reproduce(out, studies=tiny_studies()))
 
 
 @pytest.fixture

@@ -11,19 +11,20 @@ from system_packages import require
 
 
 @pytest.fixture(scope="session")
-def recorded_ds():
+def recorded_ds(build_once):
     """N = 7, 20 s, every step recorded with trajectories."""
-    return metrosync.simulate(7, 192.0, sigma_bpm=0.3, duration=20.0, record_every=1,
-                              trajectories=True, seed=3)  # fmt: skip
+    return build_once("show-recorded", lambda _: metrosync.simulate(
+        7, 192.0, sigma_bpm=0.3, duration=20.0, record_every=1, trajectories=True, seed=3,
+    ))  # fmt: skip
 
 
 @pytest.fixture(scope="session")
-def pair_ds():
+def pair_ds(build_once):
     """Two metronomes at different rates, every step recorded: one on each side."""
-    return metrosync.simulate(
+    return build_once("show-pair", lambda _: metrosync.simulate(
         None, None, frequencies_bpm=[188.0, 196.0], theta0=[0.3, -0.2], theta_dot0=[0.0, 1.0],
         duration=12.0, record_every=1, trajectories=True,
-    )  # fmt: skip
+    ))  # fmt: skip
 
 
 # -- headless Chromium, for the pages' end-to-end tests ------------------------------
@@ -47,7 +48,8 @@ def browser(chromium_executable, tmp_path):
 
 
 @pytest.fixture(scope="session")
-def board_ds():
+def board_ds(build_once):
     """Pantaleone's two metronomes on his board, 20 s, every step recorded."""
-    return metrosync.simulate(2, 208, preset="pantaleone2002", duration=20, trajectories=True,
-                              record_every=1)  # fmt: skip
+    return build_once("show-board", lambda _: metrosync.simulate(
+        2, 208, preset="pantaleone2002", duration=20, trajectories=True, record_every=1,
+    ))  # fmt: skip

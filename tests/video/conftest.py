@@ -13,17 +13,25 @@ import synth_video  # noqa: E402
 
 
 @pytest.fixture(scope="session")
-def three_rods(tmp_path_factory):
+def three_rods(build_once):
     """Three rods in a row, 20 s at a nominal 30 fps with jittered times and 2 % drops."""
-    path = tmp_path_factory.mktemp("video") / "three.mp4"
-    times, theta, pivots = synth_video.scene(path, n=3, seconds=20, fps=30, jitter=0.3,
-                                             drop=0.02, seed=3)  # fmt: skip
-    return path, times, theta, pivots
+
+    def build(folder):
+        path = folder / "three.mp4"
+        times, theta, pivots = synth_video.scene(path, n=3, seconds=20, fps=30, jitter=0.3,
+                                                 drop=0.02, seed=3)  # fmt: skip
+        return path, times, theta, pivots
+
+    return build_once("video-three-rods", build)
 
 
 @pytest.fixture(scope="session")
-def two_with_sound(tmp_path_factory):
+def two_with_sound(build_once):
     """Two rods and a click at each pass through the vertical, 15 s, AAC audio."""
-    path = tmp_path_factory.mktemp("video") / "sound.mp4"
-    times, theta, pivots = synth_video.scene(path, n=2, seconds=15, audio=True, seed=5)
-    return path, times, theta, pivots
+
+    def build(folder):
+        path = folder / "sound.mp4"
+        times, theta, pivots = synth_video.scene(path, n=2, seconds=15, audio=True, seed=5)
+        return path, times, theta, pivots
+
+    return build_once("video-two-with-sound", build)
