@@ -21,7 +21,8 @@ The figures (targets of the sound model):
     python benchmarks/audio_corpus.py --split dev --limit 10 --json dev.json
 
 --limit K keeps the first K mixed recordings and the first K single ones of each tick
-structure. --json FILE writes every recording's result and the summary.
+structure. --json FILE writes every recording's result and the summary;
+--from-json FILE prints the table of such a file again, analysing nothing.
 """
 
 from __future__ import annotations
@@ -154,6 +155,9 @@ def groups(results: list[dict]) -> dict[str, list[dict]]:
            for n in (1, 2, 3, 4)}  # fmt: skip
     out["mixed, all"] = mixed
     out["mixed, each heard"] = heard
+    precursor = [r for r in mixed if any(m["structure"] == "precursor" for m in r["per_metronome"])]
+    out["mixed, no precursor"] = [r for r in mixed if r not in precursor]
+    out["mixed, a precursor"] = precursor
     for name in STRUCTURES:
         out[f"single, {name}"] = [r for r in results if r["structure"] == name]
     out["single, all"] = [r for r in results if r["kind"] == "single"]
@@ -211,7 +215,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         description="Score the sound analysis on the benchmark corpus's recordings."
     )
-    parser.add_argument("--split", required=True, choices=sorted(SPLITS))
+    parser.add_argument("--split", choices=sorted(SPLITS))
     parser.add_argument(
         "--limit",
         type=int,
@@ -224,7 +228,19 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--json", type=Path, default=None, metavar="FILE",
                         help="write each recording's result and the summary here")  # fmt: skip
+    parser.add_argument("--from-json", type=Path, default=None, metavar="FILE",
+                        help="print the table of a file --json wrote; analyse nothing")  # fmt: skip
     args = parser.parse_args(argv)
+    if args.from_json is not None:
+        document = json.loads(args.from_json.read_text(encoding="utf-8"))
+        print(table(document["results"]))
+        print()
+        print(must_show(document["results"], document["split"]))
+        print(f"\n{document['command']}, {document['date']}, {document['machine']}, "
+              f"{document['minutes']} min with {document['jobs']} jobs")  # fmt: skip
+        return 0
+    if args.split is None:
+        parser.error("--split is needed (or --from-json FILE)")
     if args.limit is not None and args.limit < 1:
         parser.error(f"--limit must be a whole number >= 1, got {args.limit}")
     if args.jobs < 1:
