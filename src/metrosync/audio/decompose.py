@@ -60,14 +60,17 @@ class Heard:
         return self.followed.beat[self.followed.main]
 
 
-def decompose(times, bpm_range=BPM_RANGE) -> tuple[list[Heard], np.ndarray]:
-    """Metronomes that explain the sorted onset ``times`` (s), and each onset's owner."""
+def decompose(times, strengths=None, bpm_range=BPM_RANGE) -> tuple[list[Heard], np.ndarray]:
+    """Metronomes that explain the sorted onset ``times`` (s), with their ``strengths``
+    (dB, optional: they tell a strike from a bounce as regular as it), and each onset's
+    owner."""
     t = np.asarray(times, dtype=float)
+    level = None if strengths is None else np.asarray(strengths, dtype=float)
     owner = np.full(t.size, -1)
     found: list[tuple[float, np.ndarray]] = []  # (tempo, the onsets' indices it explains)
     while len(found) < MAX_METRONOMES:
         free = np.flatnonzero(owner < 0)
-        kept = _likeliest(t, free, bpm_range)
+        kept = _likeliest(t, level, free, bpm_range)
         if kept is None:
             break
         bpm, index = kept
@@ -76,7 +79,7 @@ def decompose(times, bpm_range=BPM_RANGE) -> tuple[list[Heard], np.ndarray]:
     metronomes: list[Heard] = []
     mains = None
     for _ in range(PASSES):
-        metronomes, owner = _refollow(t, [bpm for bpm, _ in found], owner, mains)
+        metronomes, owner = _refollow(t, level, [bpm for bpm, _ in found], owner, mains)
         found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
         metronomes = _without_redundant(metronomes, t.size)
         found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
@@ -106,22 +109,26 @@ def _without_redundant(heard: list[Heard], k: int) -> list[Heard]:
     return [heard[m] for m in sorted(kept)]
 
 
-def _likeliest(t: np.ndarray, free: np.ndarray, bpm_range):
+def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
     """(tempo, indices into ``t`` it explains) of the first candidate among the onsets
     ``free`` that is a metronome, strongest first; None when none is."""
     if free.size < MIN_BEATS:
         return None
     for candidate in candidate_tempi(t[free], bpm_range=bpm_range):
-        followed = _metronome(t[free], candidate.bpm)
+        followed = _metronome(t[free], candidate.bpm, _part(level, free))
         if followed is not None:
             return followed.timing.bpm, free[followed.impact >= 0]
     return None
 
 
-def _metronome(t: np.ndarray, bpm: float) -> Followed | None:
+def _part(level, index):
+    return None if level is None else level[index]
+
+
+def _metronome(t: np.ndarray, bpm: float, level=None) -> Followed | None:
     """The metronome followed from ``bpm`` among onsets ``t``, if it is one."""
     try:
-        followed = follow(t, bpm)
+        followed = follow(t, bpm, level)
     except AnalysisError:
         return None
     beats = followed.beat[followed.main]
@@ -133,7 +140,7 @@ def _metronome(t: np.ndarray, bpm: float) -> Followed | None:
     return followed
 
 
-def _refollow(t: np.ndarray, tempi: list[float], owner: np.ndarray, mains=None):
+def _refollow(t: np.ndarray, level, tempi: list[float], owner: np.ndarray, mains=None):
     """Each metronome followed again on every onset but the other metronomes' ticks
     (``mains``: (K,) the metronome whose tick each onset is, −1 for none); an onset two
     metronomes explain goes to the one whose learned tick makes it likelier
@@ -143,7 +150,7 @@ def _refollow(t: np.ndarray, tempi: list[float], owner: np.ndarray, mains=None):
     mains = np.full(t.size, -1) if mains is None else mains
     for m, bpm in enumerate(tempi):
         pool = np.flatnonzero((mains < 0) | (mains == m))
-        followed = _metronome(t[pool], bpm)
+        followed = _metronome(t[pool], bpm, _part(level, pool))
         if followed is None:
             continue
         density[len(heard), pool] = _density(t[pool], followed)

@@ -55,21 +55,23 @@ PERIOD_SEARCH, PERIOD_TRIALS = 5e-3, 41
 #: Fewest onsets per impact fitted: with fewer, a mixture splits one impact's jitter
 #: into narrow impacts of its own, each fitting a handful of onsets.
 ONSETS_PER_IMPACT = 5
+#: Fewest ticks on which the drift is fitted: a spring unwinding changes the tempo by up
+#: to a BPM a minute, a millisecond's shift in twenty seconds, as much as the jitter.
+DRIFT_TICKS = 24
 #: Narrowest spread of an impact, s: the onset detector's own timing noise.
 MIN_SPREAD = 0.2e-3
-#: Two impacts are told apart when their offsets differ by more than this many times
-#: the larger spread (two Gaussians that close make one bump, not two).
-SEPARATION = 2.0
 
 
 @dataclass(frozen=True)
 class Impact:
     """One impact of a tick: ``offset`` (s, from the beat; negative: before),
-    ``spread`` (s, its std tick to tick), ``presence`` (share of beats heard in)."""
+    ``spread`` (s, its std tick to tick), ``presence`` (share of beats heard in),
+    ``level`` (dB, how loud)."""
 
     offset: float
     spread: float
     presence: float
+    level: float = math.nan  # dB, the mean strength of its onsets (nan: not given)
 
 
 @dataclass(frozen=True)
@@ -109,9 +111,10 @@ class Followed:
         return np.flatnonzero(self.main)
 
 
-def learn_structure(offsets, beats, reach: float) -> tuple[Structure, np.ndarray]:
+def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Structure, np.ndarray]:
     """The impacts that explain ``offsets`` (s, onsets about their beats, within ±reach)
-    at beat numbers ``beats``; and (K,) each offset's impact (−1: clutter).
+    at beat numbers ``beats``, with the onsets' ``strengths`` (dB, optional); and (K,)
+    each offset's impact (−1: clutter).
 
     The main impact is found first, as the sharpest bump of the offsets heard in at
     least `MIN_PRESENCE` of the beats (`_main_bump`); the mixture starts from it, so
@@ -126,8 +129,6 @@ def learn_structure(offsets, beats, reach: float) -> tuple[Structure, np.ndarray
         if d.size < ONSETS_PER_IMPACT * count:
             break
         fitted = _mixture(d, count, reach, centre, width)
-        if count > 1 and not _apart(fitted[1], fitted[2]):
-            continue  # two impacts closer than their spreads are one, drawn twice
         if best is None or fitted[0] < best[0]:
             best = fitted
     if best is None:
@@ -137,22 +138,39 @@ def learn_structure(offsets, beats, reach: float) -> tuple[Structure, np.ndarray
     order = np.argsort(means)
     means, spreads, presence = means[order], spreads[order], presence[order]
     resp = resp[:, np.append(order, means.size)]
-    # the mixture, started on the bump, has the last word: of its impacts heard in
-    # enough beats, the most regular (a first timing locked on a bounce corrects itself)
-    heard = np.flatnonzero(presence >= MIN_PRESENCE)
-    main = (
-        int(heard[np.argmin(spreads[heard])])
-        if heard.size
-        else int(np.argmin(np.abs(means - centre)))
+    levels = (
+        np.full(means.size, np.nan)
+        if strengths is None
+        else (resp[:, :-1] * np.asarray(strengths, dtype=float)[:, None]).sum(axis=0)
+        / np.maximum(resp[:, :-1].sum(axis=0), 1e-12)
     )
+    main = _main(means, spreads, presence, max(span, 1), levels, centre)
     impacts = tuple(
-        Impact(float(m), float(s), float(min(p, 1.0)))
-        for m, s, p in zip(means, spreads, presence, strict=True)
+        Impact(float(m), float(s), float(min(p, 1.0)), float(v))
+        for m, s, p, v in zip(means, spreads, presence, levels, strict=True)
     )
     label = np.argmax(resp, axis=1)
     label[label == means.size] = -1
     clutter = float(resp[:, -1].mean())
     return Structure(impacts, main, clutter), label
+
+
+def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
+    """The main impact: of those heard in `MIN_PRESENCE` of the ``beats``, the most
+    regular; of impacts as regular as it within their sampling error (a bounce rigidly
+    tied to the strike keeps the strike's jitter), the loudest, the strike itself. The
+    mixture, started on the bump at ``centre``, has the last word, so that a first
+    timing locked on a bounce corrects itself."""
+    heard = np.flatnonzero(presence >= MIN_PRESENCE)
+    if not heard.size:
+        return int(np.argmin(np.abs(means - centre)))
+    sharpest = heard[np.argmin(spreads[heard])]
+    # a spread from n onsets is known to about 1/√(2n) of itself
+    onsets = max(float(presence[sharpest]) * beats, 1.0)
+    alike = heard[spreads[heard] <= spreads[sharpest] * (1.0 + 2.0 / math.sqrt(2.0 * onsets))]
+    if alike.size > 1 and np.all(np.isfinite(levels[alike])):
+        return int(alike[np.argmax(levels[alike])])
+    return int(sharpest)
 
 
 def _main_bump(d: np.ndarray, beats: np.ndarray, span: int) -> tuple[float, float]:
@@ -217,21 +235,13 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
     return bic, means, spreads, shares[:count], resp
 
 
-def _apart(means: np.ndarray, spreads: np.ndarray) -> bool:
-    """Whether every two impacts lie further apart than `SEPARATION` times the larger
-    spread: nearer, no recording tells them apart, and the mixture merely splits one."""
-    order = np.argsort(means)
-    gaps = np.diff(means[order])
-    wider = np.maximum(spreads[order][1:], spreads[order][:-1])
-    return bool(np.all(gaps > SEPARATION * wider))
-
-
 def _normal(x, mean, spread):
     return np.exp(-0.5 * ((x - mean) / spread) ** 2) / (spread * math.sqrt(2 * math.pi))
 
 
-def follow(times, bpm: float, *, drift: bool = True) -> Followed:
-    """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``.
+def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed:
+    """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``
+    (their ``strengths``, dB, tell a strike from a bounce as regular as it).
 
     The timing is first fitted on the first `FIRST_STRETCH` seconds, then on stretches
     twice as long, each numbered by the last fit's prediction; on each, the impacts of
@@ -240,23 +250,24 @@ def follow(times, bpm: float, *, drift: bool = True) -> Followed:
     (`ROUNDS` times).
     """
     t = np.asarray(times, dtype=float)
+    level = None if strengths is None else np.asarray(strengths, dtype=float)
     timing = _start(t, 60.0 / float(bpm))
     end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
     while True:
         inside = np.flatnonzero(t <= end)
         for _ in range(ROUNDS):
-            explained = _explain(t[inside], timing)
+            explained = _explain(t[inside], timing, None if level is None else level[inside])
             mains = inside[explained[2]]
             timing = fit_timing(t[mains], explained[0][explained[2]],
-                                drift=drift and end - t[0] > 60)  # fmt: skip
+                                drift=drift and mains.size >= DRIFT_TICKS)  # fmt: skip
         if end >= t[-1]:
             break
         end = t[0] + 2.0 * (end - t[0])
-    beat, impact, main, structures = _explain(t, timing)
+    beat, impact, main, structures = _explain(t, timing, level)
     return Followed(timing, structures, beat, impact, main)
 
 
-def _explain(t: np.ndarray, timing: Timing):
+def _explain(t: np.ndarray, timing: Timing, level=None):
     """For onsets ``t`` about ``timing``'s beats: (K,) beat (−1 beyond reach), impact
     (−1: none), main (bool), and the (tick, tock) `Structure`s."""
     beat, offset = _nearest_beats(t, timing)
@@ -267,7 +278,8 @@ def _explain(t: np.ndarray, timing: Timing):
     structures = []
     for kind in (0, 1):
         mine = np.flatnonzero(near & (np.mod(beat, 2) == kind))
-        structure, label = learn_structure(offset[mine], beat[mine], reach)
+        strengths = None if level is None else level[mine]
+        structure, label = learn_structure(offset[mine], beat[mine], reach, strengths)
         chosen = mine[_mains(offset[mine], beat[mine], structure, reach)]
         main[chosen] = True
         label[np.isin(mine, chosen)] = structure.main
