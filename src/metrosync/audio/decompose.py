@@ -67,22 +67,23 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE) -> tuple[list[Heard], 
     t = np.asarray(times, dtype=float)
     level = None if strengths is None else np.asarray(strengths, dtype=float)
     owner = np.full(t.size, -1)
-    found: list[tuple[float, np.ndarray]] = []  # (tempo, the onsets' indices it explains)
-    while len(found) < MAX_METRONOMES:
+    metronomes: list[Heard] = []
+    starts: list[float] = []  # the tempo each was first followed from, which worked
+    while len(metronomes) < MAX_METRONOMES:
         free = np.flatnonzero(owner < 0)
         kept = _likeliest(t, level, free, bpm_range)
         if kept is None:
             break
-        bpm, index = kept
-        owner[index] = len(found)
-        found.append((bpm, index))
-    metronomes: list[Heard] = []
+        start, heard = kept
+        owner[heard.pool[heard.followed.impact >= 0]] = len(metronomes)
+        metronomes.append(heard)
+        starts.append(start)
     mains = None
     for _ in range(PASSES):
-        metronomes, owner = _refollow(t, level, [bpm for bpm, _ in found], owner, mains)
-        found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
-        metronomes = _without_redundant(metronomes, t.size)
-        found = [(m.followed.timing.bpm, m.pool) for m in metronomes]
+        metronomes, owner = _refollow(t, level, starts, metronomes, mains)
+        kept = _without_redundant(metronomes, t.size)
+        starts = [starts[m] for m in kept]
+        metronomes = [metronomes[m] for m in kept]
         mains = np.full(t.size, -1)
         for m, h in enumerate(metronomes):
             mains[h.ticks] = m
@@ -92,8 +93,8 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE) -> tuple[list[Heard], 
     return [metronomes[i] for i in order], np.where(owner >= 0, relabel[owner], -1)
 
 
-def _without_redundant(heard: list[Heard], k: int) -> list[Heard]:
-    """``heard`` less each metronome whose ticks are mostly another's impacts: it
+def _without_redundant(heard: list[Heard], k: int) -> list[int]:
+    """The indices of ``heard`` less each metronome whose ticks are mostly another's impacts: it
     explains nothing the other does not (a harmonic that a limp or a rival's onsets
     made look like a tempo), and a penalised likelihood keeps no such component.
     The metronomes with the fewest ticks are judged first."""
@@ -106,18 +107,18 @@ def _without_redundant(heard: list[Heard], k: int) -> list[Heard]:
             others[h.pool[h.followed.impact >= 0]] = True
         if others[heard[m].ticks].mean() > REDUNDANT:
             kept.discard(m)
-    return [heard[m] for m in sorted(kept)]
+    return sorted(kept)
 
 
 def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
-    """(tempo, indices into ``t`` it explains) of the first candidate among the onsets
-    ``free`` that is a metronome, strongest first; None when none is."""
+    """(the tempo it was followed from, the `Heard`) of the first candidate among the
+    onsets ``free`` that is a metronome, strongest first; None when none is."""
     if free.size < MIN_BEATS:
         return None
     for candidate in candidate_tempi(t[free], bpm_range=bpm_range):
         followed = _metronome(t[free], candidate.bpm, _part(level, free))
         if followed is not None:
-            return followed.timing.bpm, free[followed.impact >= 0]
+            return candidate.bpm, Heard(followed, free)
     return None
 
 
@@ -140,25 +141,27 @@ def _metronome(t: np.ndarray, bpm: float, level=None) -> Followed | None:
     return followed
 
 
-def _refollow(t: np.ndarray, level, tempi: list[float], owner: np.ndarray, mains=None):
-    """Each metronome followed again on every onset but the other metronomes' ticks
-    (``mains``: (K,) the metronome whose tick each onset is, −1 for none); an onset two
+def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains=None):
+    """Each metronome followed again, from the tempo it was first followed from, on every
+    onset but the other metronomes' ticks (``mains``: (K,) the metronome whose tick each
+    onset is, −1 for none), keeping its last model where that fails; an onset two
     metronomes explain goes to the one whose learned tick makes it likelier
     (`_density`)."""
     heard: list[Heard] = []
-    density = np.zeros((len(tempi), t.size))
+    density = np.zeros((len(starts), t.size))
     mains = np.full(t.size, -1) if mains is None else mains
-    for m, bpm in enumerate(tempi):
+    for m, bpm in enumerate(starts):
         pool = np.flatnonzero((mains < 0) | (mains == m))
         followed = _metronome(t[pool], bpm, _part(level, pool))
-        if followed is None:
-            continue
-        density[len(heard), pool] = _density(t[pool], followed)
-        heard.append(Heard(followed, pool))
+        one = before[m] if followed is None else Heard(followed, pool)
+        density[m, one.pool] = _density(t[one.pool], one.followed)
+        heard.append(one)
     if not heard:
         return [], np.full(t.size, -1)
-    density = density[: len(heard)]
     owner = np.where(density.max(axis=0) > 0, np.argmax(density, axis=0), -1)
+    for m, one in enumerate(heard):  # a tick is its metronome's, however far off its beat
+        ticks = one.ticks
+        owner[ticks[owner[ticks] < 0]] = m
     return heard, owner
 
 

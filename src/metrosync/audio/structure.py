@@ -56,8 +56,9 @@ PERIOD_SEARCH, PERIOD_TRIALS = 5e-3, 41
 #: into narrow impacts of its own, each fitting a handful of onsets.
 ONSETS_PER_IMPACT = 5
 #: Fewest ticks on which the drift is fitted: a spring unwinding changes the tempo by up
-#: to a BPM a minute, a millisecond's shift in twenty seconds, as much as the jitter.
-DRIFT_TICKS = 24
+#: to a BPM a minute, a millisecond's shift in twenty seconds, as much as the jitter,
+#: and a fit without it extrapolates the first stretch's tempo too far.
+DRIFT_TICKS = 12
 #: Narrowest spread of an impact, s: the onset detector's own timing noise.
 MIN_SPREAD = 0.2e-3
 
@@ -243,8 +244,9 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
     """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``
     (their ``strengths``, dB, tell a strike from a bounce as regular as it).
 
-    The timing is first fitted on the first `FIRST_STRETCH` seconds, then on stretches
-    twice as long, each numbered by the last fit's prediction; on each, the impacts of
+    The timing is first fitted on the first `FIRST_STRETCH` seconds, then on longer
+    stretches, each as far as the last fit predicts well (`_reach_of`) and numbered by
+    that prediction; on each, the impacts of
     the tick and of the tock (even and odd beats: struck by different pallets, they
     sound and fall differently) are learned and the timing refitted to the main ones
     (`ROUNDS` times).
@@ -262,9 +264,22 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
                                 drift=drift and mains.size >= DRIFT_TICKS)  # fmt: skip
         if end >= t[-1]:
             break
-        end = t[0] + 2.0 * (end - t[0])
+        end = max(_reach_of(timing, end), t[0] + 1.25 * (end - t[0]))
     beat, impact, main, structures = _explain(t, timing, level)
     return Followed(timing, structures, beat, impact, main)
+
+
+def _reach_of(timing: Timing, end: float) -> float:
+    """How far past ``end`` the timing predicts a beat within a third of `WINDOW`, by its
+    parameters' errors (at most twice as far from the start as ``end``): beyond, the
+    main impact's offsets would smear past the bump that finds it."""
+    sp, st, _, sd = timing.errors
+    k_end = (end - timing.phase) / timing.period
+    for k in np.arange(k_end, 2 * k_end + 1, 1.0):
+        spread = math.sqrt(sp**2 + (k * st) ** 2 + (0.5 * k * k * sd) ** 2)
+        if spread > WINDOW / 3:
+            return float(timing.predict(k))
+    return float(timing.predict(2 * k_end))
 
 
 def _explain(t: np.ndarray, timing: Timing, level=None):
@@ -313,8 +328,21 @@ def _start(t: np.ndarray, period: float) -> Timing:
                 centre = float(np.median(phase[lo[at] : hi[at]])) - shift
                 best = (int(held[at]), float(stretch[0] + np.mod(centre, swing)), trial)
     _, phase, trial = best
+    # refined by a line through the onsets near that phase, swing after swing: the trial
+    # beats' step alone leaves the last swings of the stretch milliseconds off
+    for reach in (4 * WINDOW, 2 * WINDOW):
+        number = np.round((stretch - phase) / (2 * trial))
+        miss = np.abs(stretch - phase - number * 2 * trial)
+        order = np.lexsort((miss, number))  # the nearest onset of each swing first
+        first = np.ones(order.size, dtype=bool)
+        first[1:] = number[order][1:] != number[order][:-1]
+        near = order[first & (miss[order] <= reach)]
+        if near.size < 4:
+            break
+        slope, phase = np.polyfit(number[near], stretch[near], 1)
+        trial = slope / 2
     phase -= trial * math.floor((phase - t[0]) / trial)
-    return Timing(phase, trial, 0.0, 0.0, 0.0, (0.0,) * 4, 0)
+    return Timing(float(phase), float(trial), 0.0, 0.0, 0.0, (0.0,) * 4, 0)
 
 
 def _nearest_beats(t: np.ndarray, timing: Timing) -> tuple[np.ndarray, np.ndarray]:
