@@ -19,6 +19,7 @@ The figures (targets of the sound model):
     python benchmarks/audio_corpus.py --split dev                 # tune on this
     python benchmarks/audio_corpus.py --split heldout --jobs 2    # report this
     python benchmarks/audio_corpus.py --split dev --limit 10 --json dev.json
+    python benchmarks/audio_corpus.py --split dev --analysis timing   # the timing model
 
 --limit K keeps the first K mixed recordings and the first K single ones of each tick
 structure. --json FILE writes every recording's result and the summary;
@@ -55,9 +56,21 @@ from metrosync.synthetic.structures import STRUCTURES  # noqa: E402
 HEARD = 0.5
 
 
-def run_one(entry: Entry) -> dict:
+#: The analyses that can be scored, by name: today's stages, and the timing model that is
+#: to replace them (`metrosync.audio.timing_analysis`).
+ANALYSES = {
+    "stages": ("metrosync.audio", "analyze_audio"),
+    "timing": ("metrosync.audio.timing_analysis", "analyze_timing"),
+}
+
+
+def run_one(task: tuple[Entry, str]) -> dict:
     """Make, analyse and score one recording: a dict of plain values (JSON)."""
-    from metrosync.audio import analyze_audio
+    import importlib
+
+    entry, analysis = task
+    module, name = ANALYSES[analysis]
+    analyze_audio = getattr(importlib.import_module(module), name)
 
     t0 = time.perf_counter()
     plan = entry.plan()
@@ -216,6 +229,9 @@ def main(argv: list[str] | None = None) -> int:
         description="Score the sound analysis on the benchmark corpus's recordings."
     )
     parser.add_argument("--split", choices=sorted(SPLITS))
+    parser.add_argument("--analysis", choices=sorted(ANALYSES), default="stages",
+                        help="which analysis to score: today's stages (analyze_audio) or "
+                        "the timing model (analyze_timing)")  # fmt: skip
     parser.add_argument(
         "--limit",
         type=int,
@@ -253,7 +269,7 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     context = multiprocessing.get_context("spawn")
     with context.Pool(args.jobs) as pool:
-        for r in pool.imap_unordered(run_one, todo):
+        for r in pool.imap_unordered(run_one, [(e, args.analysis) for e in todo]):
             results.append(r)
             elapsed = time.perf_counter() - started
             left = elapsed / len(results) * (len(todo) - len(results))
@@ -275,6 +291,7 @@ def main(argv: list[str] | None = None) -> int:
         document = {
             "corpus_version": VERSION,
             "split": args.split,
+            "analysis": args.analysis,
             "limit": args.limit,
             "command": " ".join(["python", "benchmarks/audio_corpus.py", *sys.argv[1:]]),
             "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
