@@ -35,6 +35,14 @@ def test_the_stated_errors_are_the_scatter_over_recordings():
     assert np.all((spread > 0.8) & (spread < 1.25)), spread
 
 
+def test_the_mean_tempo_counts_the_beats_over_the_time_they_take():
+    k = np.arange(400)
+    truth, t = ticks(k, drift=1e-5, jitter=0.0)  # the beat lengthens by 4 ms over 400
+    fit = fit_timing(t, k)
+    assert fit.mean_bpm(0, 399) == pytest.approx(60 * 399 / (t[-1] - t[0]), rel=1e-9)
+    assert fit.mean_bpm(0, 399) < fit.bpm
+
+
 def test_missed_beats_and_an_odd_first_beat_change_nothing():
     k = np.arange(3, 400)
     k = k[(k % 7 != 0) & (k % 11 != 0)]  # beats nobody heard

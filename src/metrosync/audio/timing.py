@@ -73,6 +73,12 @@ class Timing:
         """The tempo at beat 0 (drift aside), ticks per minute."""
         return 60.0 / self.period
 
+    def mean_bpm(self, first: int, last: int) -> float:
+        """The mean tempo from beat ``first`` to beat ``last``, ticks per minute: beats
+        counted over the time the model puts between them (the drift included)."""
+        span = float(self.predict(last) - self.predict(first))
+        return 60.0 * (last - first) / span
+
     def period_at(self, beats) -> np.ndarray:
         """The mean beat around beat number ``beats``, s (the drift included)."""
         return self.period + self.drift * (np.asarray(beats, dtype=float) + 0.5)

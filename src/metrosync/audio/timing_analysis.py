@@ -43,11 +43,16 @@ def analyze_timing(path: str | Path, *, sensitivity: float = det.DEFAULT_SENSITI
     whose = np.concatenate(label) if heard else np.zeros(0, dtype=np.int64)
     by_time = np.argsort(flat, kind="stable")
     timing = [h.followed.timing for h in heard]
+    # the tempo a listener counts: the mean over the beats heard, drift and all
+    tempo = [
+        t.mean_bpm(int(h.beats.min()), int(h.beats.max()))
+        for t, h in zip(timing, heard, strict=True)
+    ]
     return xr.Dataset(
         {
             "tick_time": ("tick", flat[by_time], {"units": "s"}),
             "tick_metronome": ("tick", whose[by_time]),
-            "bpm": ("metronome", [t.bpm for t in timing], {"units": "1/min"}),
+            "bpm": ("metronome", tempo, {"units": "1/min"}),
             "jitter": ("metronome", [t.jitter for t in timing], {"units": "s"}),
             "limp": ("metronome", [t.limp for t in timing]),
         },
