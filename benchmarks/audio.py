@@ -213,8 +213,10 @@ def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
             f"ms; BPM error max {table[:, 3].max():.3f}"
         )
         both = (table[:, 0] >= 0.99) & (table[:, 1] >= 0.99)
-        print(f"  metronomes at recall and precision >= 0.99: {both.sum()} of {both.size} "
-              f"({both.mean():.1%}), in the {right[use].sum()} recordings counted right")
+        print(
+            f"  metronomes at recall and precision >= 0.99: {both.sum()} of {both.size} "
+            f"({both.mean():.1%}), in the {right[use].sum()} recordings counted right"
+        )
 
 
 def print_failures(n: int, seed: int, found: int, table) -> None:

@@ -85,7 +85,9 @@ def test_claim_4_takes_where_the_transition_sits_from_the_study(quick):
     assert amend_claim_4(unassessed, [study]) is unassessed
 
 
-@pytest.mark.parametrize(("name", "words"), [("nope.nc", "does not exist"), ("junk.nc", "not a NetCDF")])
+@pytest.mark.parametrize(
+    ("name", "words"), [("nope.nc", "does not exist"), ("junk.nc", "not a NetCDF")]
+)
 def test_reproduce_refuses_a_bad_large_n_file_before_any_work(tmp_path, capsys, name, words):
     (tmp_path / "junk.nc").write_text("not a sweep")
     out = tmp_path / "out"

@@ -319,13 +319,13 @@ def _start(t: np.ndarray, period: float) -> Timing:
         fold = np.mod(stretch - stretch[0], swing)
         edges = np.arange(0.0, swing + BIN, BIN)
         for shift in (0.0, swing / 2):  # a bump across the fold's ends is whole in one
-            phase = np.sort(np.mod(fold + shift, swing))
-            lo = np.searchsorted(phase, edges - WINDOW)
-            hi = np.searchsorted(phase, edges + WINDOW)
+            folded = np.sort(np.mod(fold + shift, swing))
+            lo = np.searchsorted(folded, edges - WINDOW)
+            hi = np.searchsorted(folded, edges + WINDOW)
             held = hi - lo  # onsets within ±WINDOW: about one a swing on the main impact
             at = int(np.argmax(held))
             if held[at] > best[0]:
-                centre = float(np.median(phase[lo[at] : hi[at]])) - shift
+                centre = float(np.median(folded[lo[at] : hi[at]])) - shift
                 best = (int(held[at]), float(stretch[0] + np.mod(centre, swing)), trial)
     _, phase, trial = best
     # refined by a line through the onsets near that phase, swing after swing: the trial
