@@ -1,6 +1,7 @@
 """The compile cache: where it lives, how a cold one is announced and kept out of
 throughputs, and the guard that covers every source the compiled kernels depend on."""
 
+import importlib
 import os
 import re
 import subprocess
@@ -104,7 +105,9 @@ def test_a_sweep_point_s_seconds_leave_out_compiling(monkeypatch):
         monkeypatch.setattr(_cache, "_compile_seconds", _cache.compile_seconds() + 0.25)
         raise RuntimeError("a point that fails is timed too")
 
-    monkeypatch.setattr(sys.modules["metrosync.simulate"], "simulate", compiles_then_fails)
+    # the module, loaded here: run alone, nothing has imported it yet
+    module = importlib.import_module("metrosync.simulate")
+    monkeypatch.setattr(module, "simulate", compiles_then_fails)
     spec = SimpleNamespace(key="k", kwargs={"runs": 2}, keep="run_mean_r")
     executors.run_point(spec)  # the first call also imports what a failed point needs
     ds, seconds, _ = executors.run_point(spec)

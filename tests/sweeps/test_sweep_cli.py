@@ -110,7 +110,8 @@ def _scaling_sweep(path, sizes=(64, 256, 1024), seed=0):
     )
 
 
-def test_critical_scaling_collapses_the_sweep(tmp_path, capsys):
+def test_critical_scaling_collapses_the_sweep(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # the default figures go to the working folder
     path = tmp_path / "s.nc"
     _scaling_sweep(path)
     args = ["critical", str(path), "--bootstrap", "20", "--scaling", "kuramoto",

@@ -219,9 +219,10 @@ class MetronomeDesign:
         bpm_arr = np.asarray(bpm, dtype=float)
         if not np.all(np.isfinite(bpm_arr)):
             raise ParameterError(f"`{name}` must be finite, got {describe(bpm)}.")
-        if np.any(bpm_arr <= 0):
+        if what is None and fix is None and np.any(bpm_arr <= 0):
             # Checked apart from the range: no slider position (nor any widening of
             # `l2_bounds` that `out_of_range` could offer) reaches a BPM at or below zero.
+            # Values the caller drew (``what``) get the caller's message below.
             value = float(bpm_arr[bpm_arr <= 0].flat[0])
             raise ParameterError(f"`{name}` = {value:g} BPM: a tempo must be positive.")
         low, high = self.bpm_range()

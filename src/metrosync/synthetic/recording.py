@@ -58,6 +58,7 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
+from .._words import plural
 from ..errors import ParameterError
 from .impairments import Impairments, impair
 from .ticks import Voice, check_sample_rate
@@ -147,8 +148,8 @@ class Recording:
         starts = [0.0] * self.channels if starts is None else [float(s) for s in starts]
         if len(starts) != self.channels or not all(0 <= s < self.duration for s in starts):
             raise ParameterError(
-                f"`starts` must hold {self.channels} times in [0, {self.duration:g}) s, got "
-                f"{starts!r}."
+                f"`starts` must hold {plural(self.channels, 'time')} in "
+                f"[0, {self.duration:g}) s, got {starts!r}."
             )
         ppm = [0.0] * self.channels if clock_ppm is None else [float(p) for p in clock_ppm]
         if len(ppm) != self.channels or not all(abs(p) <= 1000 for p in ppm):
