@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import AnalysisError
 from .periodicity import BPM_RANGE, candidate_tempi
-from .structure import Followed, follow
+from .structure import Followed, follow, normal_density
 
 #: Share of its beats a metronome's main impact must be heard in.
 MIN_HEARD = 0.5
@@ -174,6 +174,6 @@ def _density(t: np.ndarray, followed: Followed) -> np.ndarray:
         for j, impact in enumerate(structure.impacts):
             mine = (followed.impact == j) & (np.mod(beat, 2) == kind) & (beat >= 0)
             if mine.any():
-                z = (t[mine] - followed.timing.predict(beat[mine]) - impact.offset) / impact.spread
-                out[mine] = impact.presence * np.exp(-0.5 * z**2) / (impact.spread * 2.5066)
+                offset = t[mine] - followed.timing.predict(beat[mine])
+                out[mine] = impact.presence * normal_density(offset, impact.offset, impact.spread)
     return out

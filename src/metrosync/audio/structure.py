@@ -219,7 +219,7 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
     uniform = 1.0 / (2.0 * reach)
     for _ in range(iterations):
         dens = np.empty((d.size, count + 1))
-        dens[:, :count] = shares[:count] * _normal(d[:, None], means, spreads)
+        dens[:, :count] = shares[:count] * normal_density(d[:, None], means, spreads)
         dens[:, count] = shares[count] * uniform
         total = dens.sum(axis=1, keepdims=True)
         resp = dens / np.maximum(total, 1e-300)
@@ -236,7 +236,8 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
     return bic, means, spreads, shares[:count], resp
 
 
-def _normal(x, mean, spread):
+def normal_density(x, mean, spread):
+    """The density of N(mean, spread²) at ``x`` (1/s for times in s)."""
     return np.exp(-0.5 * ((x - mean) / spread) ** 2) / (spread * math.sqrt(2 * math.pi))
 
 
@@ -371,7 +372,7 @@ def _mains(offset: np.ndarray, beat: np.ndarray, structure: Structure, reach: fl
     other = np.full(offset.size, max(structure.clutter, 1e-3) / (2.0 * reach))
     for j, impact in enumerate(structure.impacts):
         if j != structure.main:
-            other += impact.presence * _normal(offset, impact.offset, impact.spread)
+            other += impact.presence * normal_density(offset, impact.offset, impact.spread)
     ratio = own / other
     mine = np.flatnonzero(ratio > 1.0)
     order = mine[np.lexsort((-ratio[mine], beat[mine]))]
