@@ -31,8 +31,9 @@ system-deps:
 
 # On every core (pytest-xdist): the tests of a module that share a module-scoped fixture
 # stay on one worker (loadgroup, tests/conftest.py), the rest are dealt out one by one.
+# Each test's time goes to build/test-times.xml: benchmarks/suite_times.py sums it per folder.
 test: $(STAMP) system-deps
-	$(BIN)/python -m pytest -n auto --dist loadgroup
+	$(BIN)/python -m pytest -n auto --dist loadgroup --junitxml=build/test-times.xml
 
 # The gate-logger firmware (needs gcc-avr and avr-libc): firmware/gate-logger/build/gate-logger.hex.
 # Options pass through and a changed one rebuilds: make firmware CHANNELS=7; make flash
