@@ -138,6 +138,8 @@ def smaller(command: str) -> list[str]:
         # `critical` (its collapse fit needs more than 9 points).
         out += ["--bpm", "166:178:2"] if grid_file and "--bpm" not in out else []
         out += ["--n", "16,32"] if grid_file and "--n" not in out else []
+        # a grid file that grows each point to a target error grows it two batches at most
+        out += ["--max-runs", "4"] if grid_file and "--max-runs" not in out else []
         out += ["--no-progress"]
     return [sys.executable, "-m", "metrosync", *out[1:]]
 
@@ -200,4 +202,5 @@ def test_reduction_keeps_the_options_and_shrinks_the_sizes():
     assert argv[4:] == ["--n", "7", "--runs", "2", "--duration", "20", "--out", "r.nc"]
     argv = smaller("metrosync sweep studies/large_n/quick.toml --n 64,256,1024 --out q.nc")
     assert "64,256" in argv and "166:178:2" in argv
+    assert argv[argv.index("--max-runs") + 1] == "4"
     assert np.isin(["--runs", "--duration"], argv).all()

@@ -137,3 +137,26 @@ def test_three_of_our_own_clicks_in_a_mixture_are_three(capsys, tmp_path):
                 if line.startswith("  metronome ") and "BPM" in line]  # fmt: skip
         assert len(bpms) == 3 and all(abs(b - 184.6) < 0.5 for b in bpms)
         assert "= 184." in out
+
+
+def test_the_timing_model_hears_one_metronome_with_a_quiet_impact_before_its_tick(capsys, tmp_path):
+    """`--analysis timing`: one metronome whose tick has a quieter impact 10-45 ms before
+    the loud one is one metronome, with its dataset and plot."""
+    from metrosync import synthetic
+    from metrosync.synthetic.structures import widen
+
+    train = synthetic.steady_train(96.4, 30, phase=0.3, limp=0.039, jitter_s=0.6e-3, seed=5,
+                                   voice=widen(synthetic.voices(1, 5)[0], "precursor"))  # fmt: skip
+    rec = synthetic.make_recording([train], impairments=synthetic.Impairments.phone(), seed=5)
+    path = rec.write(tmp_path / "one.wav")
+    nc, png = tmp_path / "one.nc", tmp_path / "one.png"
+    code, out, err = run(capsys, "analyze", str(path), "--analysis", "timing", "--out", str(nc),
+                         "--plot", str(png))  # fmt: skip
+    assert code == 0, err
+    assert "metronomes: 1 (one tick train)" in out and "its sound: tick: −" in out
+    with xr.open_dataset(nc, engine="h5netcdf") as ds:
+        assert {"tick_time", "tick_metronome", "tick_probability", "bpm", "explained"} <= set(
+            ds.variables
+        )
+        assert abs(float(ds.bpm[0]) - 96.4) < 0.1
+    assert png.stat().st_size > 10_000

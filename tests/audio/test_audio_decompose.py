@@ -44,3 +44,32 @@ def test_a_limping_metronome_is_not_also_its_half_tempo():
 def test_clutter_alone_is_no_metronome():
     rng = np.random.default_rng(5)
     assert decompose(np.sort(rng.uniform(0, 40, 120)))[0] == []
+
+
+def _locked_pair(place_gap_db):
+    """A metronome at 176 BPM and another locked 40 ms after it, each heard on two
+    microphones: the second ``place_gap_db`` louder on the right than the first."""
+    rng = np.random.default_rng(5)
+    first = 0.2 + np.arange(110) * 60 / 176 + rng.normal(0, 0.4e-3, 110)
+    second = first + 0.040 + rng.normal(0, 0.4e-3, 110)
+    times = np.concatenate([first, second])
+    right = np.concatenate([np.zeros(110), np.full(110, place_gap_db)])
+    levels = np.column_stack([np.full(220, -20.0), -20.0 + right]) + rng.normal(0, 0.5, (220, 2))
+    order = np.argsort(times)
+    return times[order], levels[order], np.concatenate([np.zeros(110), np.ones(110)])[order]
+
+
+def test_two_metronomes_locked_at_one_offset_are_two_where_heard_from_two_places():
+    times, levels, truth = _locked_pair(12.0)
+    heard, _ = decompose(times, channel_levels=levels)
+    assert len(heard) == 2
+    held = sorted(set(truth[h.ticks]) for h in heard)
+    assert held == [{0.0}, {1.0}] and all(h.ticks.size >= 105 for h in heard)
+
+
+def test_a_tick_whose_impacts_come_from_one_place_is_one_metronome():
+    """In timing alone the pair above is one tick of two impacts: heard from one place
+    (a strike and its bounce), it is one metronome."""
+    times, levels, _ = _locked_pair(0.0)
+    heard, _ = decompose(times, channel_levels=levels)
+    assert len(heard) == 1 and len(heard[0].followed.structure[0].impacts) == 2

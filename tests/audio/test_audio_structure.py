@@ -75,3 +75,19 @@ def test_a_tick_of_one_impact_is_one_impact():
     offsets = rng.normal(0, 0.5e-3, 200)
     structure, label = learn_structure(offsets, 2 * np.arange(200), 0.2)
     assert len(structure.impacts) == 1 and np.all(label == 0)
+
+
+def test_onsets_of_a_beat_that_slides_past_are_no_impact_of_the_tick():
+    """Another metronome 0.4 beat slower over the recording: its onsets cross this one's
+    beat at every offset. No impact wanders so far: they are clutter, not an impact."""
+    from metrosync.audio.structure import MAX_SPREAD, learn_structure
+
+    rng = np.random.default_rng(9)
+    beats = np.arange(120)
+    main = rng.normal(0.0, 0.4e-3, beats.size)
+    sliding = np.linspace(-0.12, 0.12, beats.size)
+    offsets = np.concatenate([main, sliding])
+    structure, label = learn_structure(offsets, np.concatenate([beats, beats]), 0.15)
+    assert all(i.spread <= MAX_SPREAD for i in structure.impacts)
+    assert structure.main_impact.offset == pytest.approx(0.0, abs=0.3e-3)
+    assert np.mean(label[beats.size :] == -1) > 0.8

@@ -1,26 +1,200 @@
-"""The timing model's analysis end to end, on a recording as a phone hears one."""
+"""The timing model's analysis (`analyze_timing`) end to end on recordings built as the
+world makes them: metronomes of every tick structure (`metrosync.synthetic.structures`),
+through a phone, scored with
+`metrosync.synthetic.score` (recall over the ticks a single microphone can hear,
+precision over every tick given to a metronome). Each test draws its own recordings
+from its own seeds; none is a corpus recording, and none pins one."""
+
+from __future__ import annotations
 
 import warnings
 
 import numpy as np
+import pytest
+import soundfile as sf
 
+from metrosync import synthetic
 from metrosync.audio.timing_analysis import analyze_timing
-from metrosync.synthetic import Impairments, Voice, make_recording, steady_train
-from metrosync.synthetic.score import match
+from metrosync.synthetic import clicks, voices
+from metrosync.synthetic.score import scores
+from metrosync.synthetic.structures import STRUCTURES, widen
 
 
-def test_a_metronome_with_a_precursor_is_one_metronome_timed_by_its_loud_impact(tmp_path):
-    # the real Neewer's structure: a quieter impact 10-45 ms before most loud ones
-    voice = Voice.draw(3, structure="precursor")
-    train = steady_train(96.4, 30.0, limp=0.039, jitter_s=0.5e-3, voice=voice, seed=3)
-    recording = make_recording([train], impairments=Impairments.phone(bumps=1), seed=3)
-    path = recording.write(tmp_path / "one.wav")
+def _trains(n, seed, *, structure="classic", same_voice=False, bpms=None, duration=40.0):
+    rng = np.random.default_rng([48, seed])
+    sounds = [voices(1, seed)[0]] * n if same_voice else voices(n, seed)
+    bpms = list(rng.uniform(90, 210, n)) if bpms is None else bpms
+    return [
+        synthetic.steady_train(
+            b,
+            duration,
+            phase=rng.uniform(),
+            limp=0.05 * rng.uniform(),
+            voice=widen(sounds[i], structure),
+            seed=10 * seed + i,
+            jitter_s=rng.uniform(0.3e-3, 1e-3),
+            drift_bpm_per_min=0.2 * rng.uniform(-1, 1),
+        )  # fmt: skip
+        for i, b in enumerate(bpms)
+    ]
+
+
+def _analysed(tmp_path, trains, seed, impairments=None, **options):
+    impairments = synthetic.Impairments.phone() if impairments is None else impairments
+    rec = synthetic.make_recording(trains, impairments=impairments, seed=seed)
+    path = rec.write(tmp_path / f"r{seed}.wav")
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a phone's clipping and band limits
-        ds = analyze_timing(path)
+        warnings.simplefilter("ignore")  # "too short" for a recording under a minute
+        ds = analyze_timing(path, **options)
+    return ds, [t.times for t in rec.truth]
+
+
+def _tick_by_tick(table, recall=0.99):
+    r, precision, timing, bpm = table.T
+    assert np.all(r >= recall), r
+    assert np.all(precision >= 0.99), precision
+    assert np.all(timing <= 1e-3), timing
+    assert np.all(bpm <= 0.1), bpm
+
+
+@pytest.mark.parametrize("structure", sorted(STRUCTURES))
+def test_a_tick_of_several_impacts_is_one_tick_at_its_loud_impact(tmp_path, structure):
+    """One metronome whose tick is several impacts (bounces after the loud one; for
+    "precursor", a quieter one 10-45 ms before it too, its lead wandering tick to tick):
+    one metronome, every tick once, timed at its loud impact, and its learned tick
+    says what came before and after."""
+    ds, truth = _analysed(tmp_path, _trains(1, 3, structure=structure), 3)
     assert ds.attrs["metronomes"] == 1
-    truth = recording.truth[0].times
-    recall, precision, errors = match(truth[truth > 0.1], ds.tick_time.values)
-    assert recall >= 0.99 and precision >= 0.99
-    assert np.abs(errors).max() < 1e-3
-    assert abs(float(ds.bpm[0]) - 96.4) < 0.2
+    _tick_by_tick(scores(ds, truth), recall=1.0)
+    assert int((ds.tick_metronome == 0).sum()) == truth[0].size
+    words = str(ds.tick_impacts.values[0])
+    assert "0 ms (main)" in words
+    if structure == "precursor":  # heard before most ticks, and learned as part of them
+        assert ds.attrs["impacts"] > 1.5 * truth[0].size
+        assert "−" in words.split(";")[0]
+    assert float(ds.tick_probability.min()) > 0.5 and float(ds.explained[0]) > 0.9
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_one_metronome_is_never_two(tmp_path, seed):
+    """Through a phone made too loud, with bumps, every structure in turn."""
+    structure = sorted(STRUCTURES)[seed % len(STRUCTURES)]
+    trains = _trains(1, 20 + seed, structure=structure, duration=30.0)
+    impairments = synthetic.Impairments.phone(clipping=0.7, bumps=4)
+    ds, _ = _analysed(tmp_path, trains, 20 + seed, impairments)
+    assert ds.attrs["metronomes"] == 1
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_metronomes_of_different_makes_and_tempi_are_each_heard_tick_by_tick(tmp_path, n):
+    bpms = [100.0, 131.0, 172.0][:n]
+    ds, truth = _analysed(tmp_path, _trains(n, 40 + n, structure="uneven", bpms=bpms), 40 + n)
+    assert ds.attrs["metronomes"] == n
+    assert ds.attrs["attribution"] == "the timing model"
+    _tick_by_tick(scores(ds, truth), recall=0.95)
+    assert ds.attrs["no_common_beat"]
+
+
+def test_two_metronomes_of_one_make_4_bpm_apart_are_two(tmp_path):
+    """Told apart by their timing alone: the same sound, drifting through each other."""
+    trains = _trains(2, 7, same_voice=True, bpms=[100.0, 104.0], duration=60.0)
+    ds, truth = _analysed(tmp_path, trains, 7)
+    assert ds.attrs["metronomes"] == 2
+    table = scores(ds, truth)
+    assert np.all(table[:, 3] <= 0.1) and np.all(table[:, 0] >= 0.9)
+
+
+def test_a_setting_near_the_tempo_changes_nothing_and_one_far_off_draws_a_warning(tmp_path):
+    trains = _trains(1, 11, bpms=[150.0])
+    ds, truth = _analysed(tmp_path, trains, 11, bpm=152)
+    _tick_by_tick(scores(ds, truth), recall=1.0)
+    rec = synthetic.make_recording(trains, impairments=synthetic.Impairments.phone(), seed=11)
+    path = rec.write(tmp_path / "far.wav")
+    with pytest.warns(UserWarning, match="not near `bpm` 90"):
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="the recording holds only")
+            analyze_timing(path, bpm=90)
+
+
+def test_a_metronome_count_given_that_differs_from_the_one_heard_is_noted(tmp_path):
+    ds, _ = _analysed(tmp_path, _trains(1, 12), 12, metronomes=2)
+    assert ds.attrs["metronomes"] == 2 and ds.attrs["metronomes_source"] == "given"
+    assert "1 metronome told apart, 2 expected" in ds.attrs["summary"]
+
+
+def test_two_microphones_in_two_files_recorded_together(tmp_path):
+    """Two metronomes of one make, each near its own phone: the files start 0.73 s and
+    0 s into the session; aligned, both metronomes heard, every hearable tick their own."""
+    sound = voices(1, 4)[0]
+    trains = [synthetic.steady_train(b, 40, phase=p, voice=sound, seed=i, jitter_s=0.5e-3)
+              for i, (b, p) in enumerate([(150.0, 0.1), (156.0, 0.6)])]  # fmt: skip
+    near = [synthetic.Microphone((1.0, 0.25), (0.0, 0.001)),
+            synthetic.Microphone((0.25, 1.0), (0.001, 0.0))]  # fmt: skip
+    rec = synthetic.make_recording(trains, microphones=near,
+                                   impairments=synthetic.Impairments.phone(), seed=4)  # fmt: skip
+    late = round(0.73 * rec.sample_rate)
+    a, b = tmp_path / "a.wav", tmp_path / "b.wav"
+    sf.write(str(a), rec.samples[late:, 0], rec.sample_rate)
+    sf.write(str(b), rec.samples[:, 1], rec.sample_rate)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "too short"
+        ds = analyze_timing([a, b])
+    # within the sound's travel between the microphones (1 ms here)
+    assert ds.attrs["offsets"] == pytest.approx([0.0, -0.73], abs=1.5e-3)
+    assert ds.attrs["channels"] == 2 and ds.attrs["metronomes"] == 2
+    truth = [t.times - 0.73 for t in rec.truth]  # at microphone 0, on a.wav's time line
+    # each tick is timed where it is heard first, up to 1 ms before microphone 0 hears it
+    table = scores(ds, truth, tolerance=2e-3)
+    assert np.all(table[:, 0] >= 0.95) and np.all(table[:, 1] >= 0.97)
+    assert np.all(table[:, 3] <= 0.1)
+
+
+def test_files_not_recorded_together_draw_a_warning(tmp_path):
+    a = clicks.metronome_train(150, 30, phase=0.1)
+    b = clicks.metronome_train(97, 30, phase=0.4)
+    pa = clicks.write(tmp_path / "a.wav", clicks.render([a], 30))
+    pb = clicks.write(tmp_path / "b.wav", clicks.render([b], 30, pitches=[2400.0]))
+    with pytest.warns(UserWarning, match="hardly match at any offset"):
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="the recording holds only")
+            analyze_timing([pa, pb])
+
+
+def test_two_metronomes_of_one_tempo_half_a_beat_apart_are_two(tmp_path):
+    """The same click, locked half a beat apart: the tempo's own frequency cancels in the
+    periodicity search, its second harmonic finds them (`periodicity.HARMONICS`)."""
+    a = clicks.metronome_train(184, 30, phase=0.0)
+    b = clicks.metronome_train(184, 30, phase=0.5)
+    x = clicks.render([a, b], 30, pitches=[2000.0, 2000.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = analyze_timing(clicks.write(tmp_path / "locked.wav", x))
+    assert ds.attrs["metronomes"] == 2
+    assert scores(ds, [a, b])[:, :2].min() == 1.0
+
+
+def test_two_metronomes_locked_in_step_heard_from_two_sides_are_two(tmp_path):
+    """`metrosync listen`'s two metronomes, in step within seconds: in timing one tick of
+    two impacts; heard from two sides, two metronomes (`decompose.elsewhere`)."""
+    import metrosync
+    from metrosync.show.recording import RecordedRun
+    from metrosync.show.sound import crossing_times, write_wav
+
+    run = metrosync.simulate(2, 184.0, sigma_bpm=0.75, duration=40.0, record_every=1,
+                             trajectories=True, seed=1)  # fmt: skip
+    write_wav(run, tmp_path / "two.wav")
+    crossings = crossing_times(RecordedRun.from_dataset(run))
+    ds = analyze_timing(tmp_path / "two.wav")
+    assert ds.attrs["metronomes"] == 2
+    assert scores(ds, crossings)[:, :2].min() >= 0.95
+
+
+@pytest.mark.xfail(strict=True, reason="what the timing model cannot do yet: a metronome "
+                   "of three of one tempo, their ticks crossing as they fall into step over "
+                   "90 s, is lost where they cross (its timing is one model for the whole "
+                   "recording, its tick told from theirs by timing and place only)")  # fmt: skip
+def test_three_metronomes_falling_into_step_over_90_s_are_each_followed(listen_run):
+    path, crossings = listen_run
+    ds = analyze_timing(path, metronomes=3)
+    assert ds.sizes.get("metronome", 0) == 3
+    assert scores(ds, crossings)[:, :2].min() >= 0.95

@@ -255,16 +255,8 @@ def analyze_audio(
     pendulums = _pendulum_phases(kept, GRID_DT)
     ds = ds.merge(pendulums)
     ds.attrs.update(pendulums.attrs)
+    ds.attrs.update(recording_attrs(recording, scan))
     ds.attrs.update(
-        path=str(recording.path),
-        paths=list(getattr(recording, "names", ())) or [str(recording.path)],
-        offsets=(np.asarray(getattr(recording, "offsets", [0])) / rate).tolist(),
-        sample_rate=rate,
-        channels=recording.channels,
-        duration=recording.duration,
-        format=f"{recording.format} {recording.subtype}",
-        peak_dbfs=20 * math.log10(scan.peak),
-        clipped_samples=scan.clipped,
         beat_period=period,
         bpm_ensemble=60.0 / period,
         tempo_source=tempo_source,
@@ -306,6 +298,22 @@ def analyze_audio(
         )
     ds.attrs["summary"] = summary_text(ds)
     return ds
+
+
+def recording_attrs(recording, scan) -> dict:
+    """What the dataset says of the recording itself: its file(s), format, level."""
+    rate = recording.sample_rate
+    return dict(
+        path=str(recording.path),
+        paths=list(getattr(recording, "names", ())) or [str(recording.path)],
+        offsets=(np.asarray(getattr(recording, "offsets", [0])) / rate).tolist(),
+        sample_rate=rate,
+        channels=recording.channels,
+        duration=recording.duration,
+        format=f"{recording.format} {recording.subtype}",
+        peak_dbfs=20 * math.log10(scan.peak),
+        clipped_samples=scan.clipped,
+    )
 
 
 def _settled(ticks, trains: list[Train]) -> list[Train] | None:

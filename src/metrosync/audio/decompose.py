@@ -21,13 +21,13 @@ the owner of each onset (−1: clutter).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import AnalysisError
 from .periodicity import BPM_RANGE, candidate_tempi
-from .structure import Followed, follow, normal_density
+from .structure import Followed, explained_by, follow, normal_density
 
 #: Share of its beats a metronome's main impact must be heard in.
 MIN_HEARD = 0.5
@@ -39,6 +39,9 @@ MAX_METRONOMES = 8
 REDUNDANT = 0.5
 #: Passes of refollowing every metronome with the others' onsets set aside.
 PASSES = 2
+#: Difference of level between microphones, dB, beyond which two impacts come from two
+#: places: more than a room's colouring moves one source's (a few dB).
+PLACE_DB = 3.0
 
 
 @dataclass(frozen=True)
@@ -60,12 +63,15 @@ class Heard:
         return self.followed.beat[self.followed.main]
 
 
-def decompose(times, strengths=None, bpm_range=BPM_RANGE) -> tuple[list[Heard], np.ndarray]:
+def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
+              ) -> tuple[list[Heard], np.ndarray]:  # fmt: skip
     """Metronomes that explain the sorted onset ``times`` (s), with their ``strengths``
     (dB, optional: they tell a strike from a bounce as regular as it), and each onset's
-    owner."""
+    owner. ``channel_levels`` (K, C), dB, each onset's level at each microphone
+    (optional): the impacts of one tick come from one place (`elsewhere`)."""
     t = np.asarray(times, dtype=float)
     level = None if strengths is None else np.asarray(strengths, dtype=float)
+    place = _placement(channel_levels)
     owner = np.full(t.size, -1)
     metronomes: list[Heard] = []
     starts: list[float] = []  # the tempo each was first followed from, which worked
@@ -75,22 +81,70 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE) -> tuple[list[Heard], 
         if kept is None:
             break
         start, heard = kept
-        owner[heard.pool[heard.followed.impact >= 0]] = len(metronomes)
+        # an impact heard from another place is another metronome's tick, left for the
+        # search to find as one
+        mine = (heard.followed.impact >= 0) & ~elsewhere(heard, place)
+        owner[heard.pool[mine]] = len(metronomes)
         metronomes.append(heard)
         starts.append(start)
-    mains = None
+    # each refollowed on all but the others' ticks as the pursuit found them: on every
+    # onset, two metronomes of one tempo would both lock on the one found first
+    mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
         metronomes, owner = _refollow(t, level, starts, metronomes, mains)
         kept = _without_redundant(metronomes, t.size)
         starts = [starts[m] for m in kept]
         metronomes = [metronomes[m] for m in kept]
-        mains = np.full(t.size, -1)
-        for m, h in enumerate(metronomes):
-            mains[h.ticks] = m
+        mains = _mains_of(metronomes, t.size)
+    metronomes, owner = one_tick_an_onset(t, metronomes, owner)
     order = np.argsort([m.followed.timing.period for m in metronomes])[::-1]
     relabel = np.full(len(metronomes) + 1, -1)
     relabel[order] = np.arange(order.size)
     return [metronomes[i] for i in order], np.where(owner >= 0, relabel[owner], -1)
+
+
+def one_tick_an_onset(t: np.ndarray, heard: list[Heard], owner: np.ndarray):
+    """(``heard`` with every metronome's fitted model explaining all the onsets
+    (`structure.explained_by`), each onset that times a metronome's beat left to it
+    only where that metronome is the likeliest to have made it (`belonging`), and each
+    onset's owner again): one onset is one impact, and where it is another's, this
+    metronome's tick on that beat was hidden behind it (not heard)."""
+    if not heard:
+        return heard, owner
+    every = np.arange(t.size)
+    heard = [Heard(explained_by(t, h.followed), every) for h in heard]
+    likeliest = np.argmax(belonging(t, heard, owner), axis=0)
+    heard = [
+        Heard(replace(h.followed, main=h.followed.main & (likeliest == m)), every)
+        for m, h in enumerate(heard)
+    ]
+    kept = [h for h in heard if _is_metronome(h.followed)]
+    if len(kept) < len(heard):  # one left with too few ticks of its own is none
+        return one_tick_an_onset(t, kept, owner)
+    explained = np.any([h.followed.impact >= 0 for h in heard], axis=0)
+    return heard, np.where(explained, likeliest, -1)
+
+
+def _mains_of(heard: list[Heard], k: int) -> np.ndarray:
+    """(K,) the metronome whose tick each onset is (−1: none)."""
+    mains = np.full(k, -1)
+    for m, h in enumerate(heard):
+        mains[h.ticks] = m
+    return mains
+
+
+def belonging(times, heard: list[Heard], owner: np.ndarray) -> np.ndarray:
+    """(M, K) the probability that each onset is metronome m's (an impact of its tick),
+    from the model's intensities: λ_m(t) / (Σ_m' λ_m'(t) + λ_c), where the clutter's
+    intensity λ_c is its onsets (``owner`` −1) per second of the recording, spread
+    evenly. The rest of each column is the probability that the onset is clutter."""
+    t = np.asarray(times, dtype=float)
+    if not heard or not t.size:
+        return np.zeros((len(heard), t.size))
+    rate = np.stack([h.followed.intensity(t) for h in heard])
+    span = max(float(t[-1] - t[0]), 1.0)
+    clutter = max(int(np.sum(owner < 0)), 1) / span
+    return rate / (rate.sum(axis=0) + clutter)
 
 
 def _without_redundant(heard: list[Heard], k: int) -> list[int]:
@@ -108,6 +162,47 @@ def _without_redundant(heard: list[Heard], k: int) -> list[int]:
         if others[heard[m].ticks].mean() > REDUNDANT:
             kept.discard(m)
     return sorted(kept)
+
+
+def _placement(channel_levels) -> np.ndarray | None:
+    """(K, C) each onset's level at each microphone less its mean over them, dB: where
+    it came from, whatever its loudness (None with one microphone)."""
+    if channel_levels is None:
+        return None
+    levels = np.asarray(channel_levels, dtype=float)
+    if levels.ndim != 2 or levels.shape[1] < 2:
+        return None
+    return levels - levels.mean(axis=1, keepdims=True)
+
+
+def elsewhere(heard: Heard, place: np.ndarray | None) -> np.ndarray:
+    """(len(pool),) True for the onsets of an impact of ``heard``'s tick heard from
+    another place than its main impact. The impacts of one tick come from one
+    metronome, so their levels at the microphones differ alike; two metronomes of one
+    tempo locked at a fixed offset are, in timing, one tick of two impacts, and only
+    where they are heard from tells them apart. An impact is elsewhere where its mean
+    placement differs from the main impact's by more than `PLACE_DB` and by more than
+    four standard errors of the difference."""
+    out = np.zeros(heard.pool.size, dtype=bool)
+    if place is None:
+        return out
+    f = heard.followed
+    at = place[heard.pool]
+    for kind, structure in enumerate(f.structure):
+        kind_of = (np.mod(f.beat, 2) == kind) & (f.beat >= 0)
+        main = at[kind_of & (f.impact == structure.main)]
+        for j in range(len(structure.impacts)):
+            if j == structure.main:
+                continue
+            mine = kind_of & (f.impact == j)
+            other = at[mine]
+            if other.shape[0] < 4 or main.shape[0] < 4:
+                continue
+            gap = np.abs(other.mean(axis=0) - main.mean(axis=0))
+            error = np.sqrt(other.var(axis=0) / other.shape[0] + main.var(axis=0) / main.shape[0])
+            if np.any((gap > PLACE_DB) & (gap > 4 * error)):
+                out |= mine
+    return out
 
 
 def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
@@ -132,16 +227,19 @@ def _metronome(t: np.ndarray, bpm: float, level=None) -> Followed | None:
         followed = follow(t, bpm, level)
     except AnalysisError:
         return None
+    return followed if _is_metronome(followed) else None
+
+
+def _is_metronome(followed: Followed) -> bool:
+    """Its main impact heard in `MIN_HEARD` of its beats, over `MIN_BEATS` at least."""
     beats = followed.beat[followed.main]
     if beats.size < 2:
-        return None
+        return False
     span = int(beats.max() - beats.min()) + 1
-    if span < MIN_BEATS or beats.size < MIN_HEARD * span:
-        return None
-    return followed
+    return span >= MIN_BEATS and beats.size >= MIN_HEARD * span
 
 
-def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains=None):
+def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains):
     """Each metronome followed again, from the tempo it was first followed from, on every
     onset but the other metronomes' ticks (``mains``: (K,) the metronome whose tick each
     onset is, −1 for none), keeping its last model where that fails; an onset two
@@ -149,7 +247,6 @@ def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], ma
     (`_density`)."""
     heard: list[Heard] = []
     density = np.zeros((len(starts), t.size))
-    mains = np.full(t.size, -1) if mains is None else mains
     for m, bpm in enumerate(starts):
         pool = np.flatnonzero((mains < 0) | (mains == m))
         followed = _metronome(t[pool], bpm, _part(level, pool))

@@ -30,6 +30,7 @@ import numpy as np
 from scipy.stats import t as student_t
 
 from ..errors import AnalysisError
+from .periodicity import SEGMENT
 from .timing import DOF, Timing, fit_timing
 
 #: Share of the beats an impact must be heard in to time the tick.
@@ -44,14 +45,13 @@ ROUNDS = 4
 #: Length of the first stretch the timing is fitted on, s; each next one doubles it, so
 #: that a tempo known to the periodicity search's resolution never loses count of beats.
 FIRST_STRETCH = 10.0
-#: ... and at least this many beats, so that each kind of beat has enough ticks to fit.
-FIRST_BEATS = 24
+#: ... and at least this many beats, eight of each kind (enough for a kind's main impact
+#: among clutter); no more, since a slow metronome's spring can change its tempo by a
+#: BPM a minute, which a first timing without drift cannot follow for long.
+FIRST_BEATS = 16
 #: Bin and window of the offsets' density where the main impact is sought, s: finer
 #: than the gap between two impacts, wider than an escapement's jitter.
 BIN, WINDOW = 0.5e-3, 3e-3
-#: How far from a candidate's beat (a share) and in how many trials the first timing
-#: is sought: a few times the periodicity search's resolution.
-PERIOD_SEARCH, PERIOD_TRIALS = 5e-3, 41
 #: Fewest onsets per impact fitted: with fewer, a mixture splits one impact's jitter
 #: into narrow impacts of its own, each fitting a handful of onsets.
 ONSETS_PER_IMPACT = 5
@@ -61,6 +61,10 @@ ONSETS_PER_IMPACT = 5
 DRIFT_TICKS = 12
 #: Narrowest spread of an impact, s: the onset detector's own timing noise.
 MIN_SPREAD = 0.2e-3
+#: Widest, s: a quieter impact ahead of the strike wanders by several milliseconds tick
+#: to tick (a Neewer's by 11-42 ms, a spread of about 8), but keeps to its tick; the
+#: onsets of a metronome whose beat slides past this one's spread far wider.
+MAX_SPREAD = 15e-3
 
 
 @dataclass(frozen=True)
@@ -111,6 +115,22 @@ class Followed:
         """Indices of the onsets that time the ticks."""
         return np.flatnonzero(self.main)
 
+    def intensity(self, times) -> np.ndarray:
+        """(K,) how many of this metronome's onsets the model expects per second at each
+        of ``times`` (1/s): Σ_j p_j N(t − τ_k − o_j; 0, s_j²) over the impacts j of the
+        nearest beat's kind, 0 beyond `REACH` of a beat."""
+        t = np.asarray(times, dtype=float)
+        beat, offset = _nearest_beats(t, self.timing)
+        near = np.abs(offset) <= REACH * self.timing.period
+        out = np.zeros(t.size)
+        for kind, structure in enumerate(self.structure):
+            mine = near & (np.mod(beat, 2) == kind)
+            for impact in structure.impacts:
+                out[mine] += impact.presence * normal_density(
+                    offset[mine], impact.offset, impact.spread
+                )
+        return out
+
 
 def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Structure, np.ndarray]:
     """The impacts that explain ``offsets`` (s, onsets about their beats, within ±reach)
@@ -123,6 +143,7 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     """
     d = np.asarray(offsets, dtype=float)
     b = np.asarray(beats)
+    v = None if strengths is None else np.asarray(strengths, dtype=float)
     span = int(b.max() - b.min()) // 2 + 1 if b.size else 0  # beats of this kind
     centre, width = _main_bump(d, b, span)
     best = None
@@ -135,15 +156,23 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     if best is None:
         raise AnalysisError(f"too few onsets ({d.size}) to learn a tick's impacts")
     _, means, spreads, shares, resp = best
+    # a component wider than an impact wanders is no impact: the onsets of another
+    # metronome whose beat slides past this one's (clutter, left for it to be found)
+    wide = spreads > MAX_SPREAD
+    if wide.all():
+        wide[np.argmin(spreads)] = False
+    if wide.any():
+        resp = np.column_stack([resp[:, :-1][:, ~wide],
+                                resp[:, -1] + resp[:, :-1][:, wide].sum(axis=1)])  # fmt: skip
+        means, spreads, shares = means[~wide], spreads[~wide], shares[~wide]
     presence = shares * d.size / max(span, 1)
     order = np.argsort(means)
     means, spreads, presence = means[order], spreads[order], presence[order]
     resp = resp[:, np.append(order, means.size)]
     levels = (
         np.full(means.size, np.nan)
-        if strengths is None
-        else (resp[:, :-1] * np.asarray(strengths, dtype=float)[:, None]).sum(axis=0)
-        / np.maximum(resp[:, :-1].sum(axis=0), 1e-12)
+        if v is None
+        else (resp[:, :-1] * v[:, None]).sum(axis=0) / np.maximum(resp[:, :-1].sum(axis=0), 1e-12)
     )
     main = _main(means, spreads, presence, max(span, 1), levels, centre)
     impacts = tuple(
@@ -304,18 +333,52 @@ def _explain(t: np.ndarray, timing: Timing, level=None):
     return np.where(near, beat, -1), impact, main, tuple(structures)
 
 
-def _start(t: np.ndarray, period: float) -> Timing:
-    """A first timing near ``period``: of trial beats within ±`PERIOD_SEARCH` of it, the
-    one at which the onsets of the first stretch, folded at the swing (two beats), put
-    an onset within ±`WINDOW` of one phase in the most swings; that phase is beat 0's.
+def explained_by(times, followed: Followed) -> Followed:
+    """``followed``'s timing and learned ticks, unchanged, explaining the onsets
+    ``times`` instead of those it was fitted on: each onset's beat, impact and whether
+    it times its beat, as `follow` decides them."""
+    t = np.asarray(times, dtype=float)
+    beat, offset = _nearest_beats(t, followed.timing)
+    reach = REACH * followed.timing.period
+    near = np.abs(offset) <= reach
+    impact = np.full(t.size, -1)
+    main = np.zeros(t.size, dtype=bool)
+    for kind, structure in enumerate(followed.structure):
+        mine = np.flatnonzero(near & (np.mod(beat, 2) == kind))
+        d = offset[mine]
+        likelihood = np.column_stack(
+            [i.presence * normal_density(d, i.offset, i.spread) for i in structure.impacts]
+            + [np.full(d.size, max(structure.clutter, 1e-3) / (2.0 * reach))]
+        )
+        label = np.argmax(likelihood, axis=1)
+        label[label == len(structure.impacts)] = -1
+        chosen = mine[_mains(d, beat[mine], structure, reach)]
+        main[chosen] = True
+        label[np.isin(mine, chosen)] = structure.main
+        impact[mine] = label
+    return Followed(followed.timing, followed.structure, np.where(near, beat, -1), impact, main)
 
-    A candidate tempo is known to about a tenth of a per cent (`periodicity`); over the
-    first stretch that error alone would smear the main impact's offsets over more
-    than its jitter, where the structure could not find it.
+
+def _start(t: np.ndarray, period: float) -> Timing:
+    """A first timing near ``period``: of trial beats within the periodicity search's
+    resolution of it, the one at which the onsets of the first stretch, folded at the
+    swing (two beats), put an onset within ±`WINDOW` of one phase in the most swings;
+    that phase is beat 0's.
+
+    A candidate's frequency is known to about one independent frequency of the search,
+    1/L for a stretch L of the recording folded at once (`periodicity.SEGMENT` at most),
+    so its beat to T·T/L: 2 % for a slow metronome in 40 s. Over the first stretch S that
+    error alone would smear the main impact's offsets over far more than its jitter;
+    the trials step by 2·`WINDOW`/S of the beat, so that the nearest misses by `WINDOW`
+    at most over the stretch.
     """
     stretch = t[t <= t[0] + max(FIRST_STRETCH, FIRST_BEATS * period)]
+    folded_at_once = min(max(float(t[-1] - t[0]), period), SEGMENT)
+    search = period / folded_at_once
+    step = 2.0 * WINDOW / max(float(stretch[-1] - stretch[0]), period)
+    trials = 2 * math.ceil(search / step) + 1
     best = (-1, 0.0, period)
-    for trial in period * (1 + np.linspace(-PERIOD_SEARCH, PERIOD_SEARCH, PERIOD_TRIALS)):
+    for trial in period * (1 + np.linspace(-search, search, trials)):
         swing = 2.0 * trial
         fold = np.mod(stretch - stretch[0], swing)
         edges = np.arange(0.0, swing + BIN, BIN)

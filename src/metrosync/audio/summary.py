@@ -55,12 +55,18 @@ def summary_text(ds) -> str:
                 )
             )
             lines.append(f"    {str(ds.beat_verdict.values[m])}")
+            if "tick_impacts" in ds:
+                lines.append(f"    its sound: {str(ds.tick_impacts.values[m])}")
     if a.get("attribution_sureness"):
         lines.insert(
             5 if a.get("metronomes_hidden") else 4,
             f"  attribution: {a['attribution_sureness']} (confidence "
-            f"{a['attribution_confidence']:.2f}: share of ticks in a train x share of beats "
-            f"heard x how far apart the sounds are)",
+            f"{a['attribution_confidence']:.2f}: "
+            + a.get(
+                "attribution_meaning",
+                "share of ticks in a train x share of beats heard x how far apart the sounds are",
+            )
+            + ")",
         )
     phase = ds.phase_difference.values
     label = ds.tick_metronome.values
