@@ -139,7 +139,9 @@ def smaller(command: str) -> list[str]:
         out += ["--bpm", "166:178:2"] if grid_file and "--bpm" not in out else []
         out += ["--n", "16,32"] if grid_file and "--n" not in out else []
         # a grid file that grows each point to a target error grows it two batches at most
-        out += ["--max-runs", "4"] if grid_file and "--max-runs" not in out else []
+        adaptive = any(w.endswith(".toml") and Path(w).is_file()
+                       and "target_error" in Path(w).read_text() for w in out)  # fmt: skip
+        out += ["--max-runs", "4"] if adaptive and "--max-runs" not in out else []
         out += ["--no-progress"]
     return [sys.executable, "-m", "metrosync", *out[1:]]
 
