@@ -157,12 +157,16 @@ def timed_analysis(folder: Path) -> None:
     """Ten minutes of four metronomes through a phone, analysed in a fresh process: wall
     time, CPU time (user + system of the child) and peak memory."""
     subprocess.run([sys.executable, __file__, "--make-corpus", str(folder)], check=True)
-    wall, cpu, peak, stdout = measured_command(["analyze", str(folder / "corpus4_7.wav")])
-    found = [line.strip() for line in stdout.splitlines() if "metronome" in line][:6]
-    print(f"10 min, 4 real-sounding metronomes through a phone: metrosync analyze "
-          f"{wall:.1f} s wall, {cpu:.1f} s CPU (fresh process), peak memory "
-          f"{peak:.0f} MiB")  # fmt: skip
-    print("  " + "\n  ".join(found))
+    # the stages and the timing model in turn, on the same file in the same run
+    for analysis in ("stages", "timing"):
+        wall, cpu, peak, stdout = measured_command(
+            ["analyze", str(folder / "corpus4_7.wav"), "--analysis", analysis]
+        )
+        found = [line.strip() for line in stdout.splitlines() if "metronome" in line][:6]
+        print(f"10 min, 4 real-sounding metronomes through a phone: metrosync analyze "
+              f"--analysis {analysis}: {wall:.1f} s wall, {cpu:.1f} s CPU (fresh process), "
+              f"peak memory {peak:.0f} MiB")  # fmt: skip
+        print("  " + "\n  ".join(found))
 
 
 def seeds_option(default: range = range(6)) -> list[int]:
