@@ -29,9 +29,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _interrupted(argv: list[str] | None, what: str) -> int:
-    """Say, in the command's one line, that Ctrl-C ended it and ``what`` was kept."""
+    """Say, in the command's one line, that Ctrl-C ended it and ``what`` was kept; then
+    exit 130 (`_end_interrupted`: an interrupt that escaped an import's C code would
+    otherwise kill the interpreter by SIGINT at exit, after the line)."""
     command = " ".join((sys.argv[1:] if argv is None else argv)[:1])
     print(f"metrosync {command}: interrupted: {what}", file=sys.stderr)
+    if argv is None:  # the command itself, not a caller in this process
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        _end_interrupted()
     return 130
 
 
