@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
-import soundfile as sf
+from phones import two_phone_files
 
 from metrosync import synthetic
 from metrosync.audio.timing_analysis import analyze_timing
@@ -125,24 +125,13 @@ def test_a_metronome_count_given_that_differs_from_the_one_heard_is_noted(tmp_pa
 def test_two_microphones_in_two_files_recorded_together(tmp_path):
     """Two metronomes of one make, each near its own phone: the files start 0.73 s and
     0 s into the session; aligned, both metronomes heard, every hearable tick their own."""
-    sound = voices(1, 4)[0]
-    trains = [synthetic.steady_train(b, 40, phase=p, voice=sound, seed=i, jitter_s=0.5e-3)
-              for i, (b, p) in enumerate([(150.0, 0.1), (156.0, 0.6)])]  # fmt: skip
-    near = [synthetic.Microphone((1.0, 0.25), (0.0, 0.001)),
-            synthetic.Microphone((0.25, 1.0), (0.001, 0.0))]  # fmt: skip
-    rec = synthetic.make_recording(trains, microphones=near,
-                                   impairments=synthetic.Impairments.phone(), seed=4)  # fmt: skip
-    late = round(0.73 * rec.sample_rate)
-    a, b = tmp_path / "a.wav", tmp_path / "b.wav"
-    sf.write(str(a), rec.samples[late:, 0], rec.sample_rate)
-    sf.write(str(b), rec.samples[:, 1], rec.sample_rate)
+    files, truth = two_phone_files(tmp_path, (150.0, 156.0))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # "too short"
-        ds = analyze_timing([a, b])
+        ds = analyze_timing(files)
     # within the sound's travel between the microphones (1 ms here)
     assert ds.attrs["offsets"] == pytest.approx([0.0, -0.73], abs=1.5e-3)
     assert ds.attrs["channels"] == 2 and ds.attrs["metronomes"] == 2
-    truth = [t.times - 0.73 for t in rec.truth]  # at microphone 0, on a.wav's time line
     # each tick is timed where it is heard first, up to 1 ms before microphone 0 hears it
     table = scores(ds, truth, tolerance=2e-3)
     assert np.all(table[:, 0] >= 0.95) and np.all(table[:, 1] >= 0.97)

@@ -119,14 +119,10 @@ def analyze_timing(
         # the beats no onset was detected at, sought where each metronome's timing puts
         # them, and every onset explained again with them
         found, whose = seek(recording, scan, impacts, heard)
-        merged = _subset(
-            _joined(impacts, found),
-            np.argsort(np.concatenate([impacts.time, found.time]), kind="stable"),
-        )
-        owner = np.concatenate([owner, whose])[
-            np.argsort(np.concatenate([impacts.time, found.time]), kind="stable")
-        ]
-        impacts = merged
+        joined = _joined(impacts, found)
+        in_time = np.argsort(joined.time, kind="stable")
+        impacts = _subset(joined, in_time)
+        owner = np.concatenate([owner, whose])[in_time]
         heard, owner = one_tick_an_onset(impacts.time, heard, owner)
     # The ticks: each metronome's main impacts; a tick's other impacts are not ticks, nor
     # is clutter (a bump, a voice). With no metronome found, every onset is a tick.
