@@ -15,6 +15,7 @@ if (ROOT / "src" / "metrosync").is_dir():  # the checkout's sources, installed o
     sys.path.insert(0, str(ROOT / "src"))
 
 import metrosync  # noqa: E402
+from metrosync.integrators.warm_up import compile_kernels  # noqa: E402
 
 project = "metrosync"
 author = "the metrosync authors"
@@ -143,14 +144,8 @@ def _tidy_field_docstrings(app, what, name, obj, options, lines):
 # once; they are kept on disk). Compiling them here, before the gallery runs, keeps that
 # out of the examples' own times, which the gallery prints under each of them.
 def _compile_kernels(app, config):
-    if not run_gallery:
-        return
-    for integrator in ("verlet", "located"):
-        for n, runs in ((3, 16), (12, 2)):  # both memory layouts: runs or metronomes innermost
-            metrosync.simulate(n, 192.0, runs=runs, duration=0.2, integrator=integrator,
-                               progress=False)  # fmt: skip
-        metrosync.simulate(2, 192.0, duration=0.2, integrator=integrator, trajectories=True,
-                           record_every=1, progress=False)  # fmt: skip
+    if run_gallery:
+        compile_kernels()
 
 
 def setup(app):

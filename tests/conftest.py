@@ -7,6 +7,9 @@ the work done once per run rather than once per worker:
 - `build_once` (a fixture): a session fixture's expensive result (a rendered corpus, a video, a
   tiny reproduction) is built by the first worker that needs it, into a folder shared
   by the run's workers, under a file lock; the others wait for it and read it back.
+- `pytest_configure`: before the workers start, the kernels are compiled once, one
+  scheme per core (`metrosync.integrators.warm_up`), so that no two workers compile
+  the same kernel side by side; with the cache warm this takes a few seconds.
 - `pytest_xdist_make_scheduler`: the tests of a module that defines a module-scoped
   fixture are one group, run by one worker, which builds that fixture once
   (``--dist loadgroup``; the other tests are dealt out one by one).
@@ -20,6 +23,8 @@ import pickle
 import re
 import shutil
 import signal
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
@@ -96,6 +101,23 @@ def _module_group(path: str) -> str | None:
     if len(names) == 1:
         return names.pop()
     return path if names or _MODULE_FIXTURE.search(text) else None
+
+
+def pytest_configure(config):
+    """On the xdist controller of a run on several workers: the kernels compiled first
+    (see the module's docstring), each scheme in a process of its own."""
+    workers = getattr(config.option, "numprocesses", None)
+    if os.environ.get("PYTEST_XDIST_WORKER") or not workers or config.option.collectonly:
+        return
+    from metrosync.integrators.warm_up import SCHEMES
+
+    compiling = [
+        subprocess.Popen([sys.executable, "-m", "metrosync.integrators.warm_up", scheme],
+                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+        for scheme in SCHEMES
+    ]  # fmt: skip
+    for process in compiling:
+        process.wait()  # a failure shows again, with its traceback, in the tests themselves
 
 
 @pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: absent without the plugin

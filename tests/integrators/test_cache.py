@@ -140,3 +140,14 @@ def test_a_cold_cache_is_announced_once_and_left_out_of_the_throughput(tmp_path)
     # Compiling took seconds, the simulation milliseconds: counted in, the cold rate would
     # be hundreds of times the warm one's inverse.
     assert float(cold_rate) > float(warm_rate) / 20, (cold_rate, warm_rate)
+
+
+def test_the_warm_up_compiles_both_layouts_of_each_scheme_it_is_given(capsys):
+    from metrosync.integrators import warm_up
+
+    assert warm_up.main(["verlet", "located"]) == 0  # a cold cache compiles, a warm one loads
+    for kernel in (verlet.advance_runs, verlet.advance_metronomes, located.advance_runs,
+                   located.advance_metronomes):  # fmt: skip
+        assert _cache.is_cached(kernel), _cache.kernel_name(kernel)
+    assert warm_up.main(["leapfrog"]) == 2
+    assert "unknown scheme 'leapfrog': choose from verlet, located" in capsys.readouterr().err
