@@ -178,10 +178,10 @@ def test_two_metronomes_locked_in_step_heard_from_two_sides_are_two(tmp_path):
     assert scores(ds, crossings)[:, :2].min() >= 0.95
 
 
-@pytest.mark.xfail(strict=True, reason="what the timing model cannot do yet: a metronome "
-                   "of three of one tempo, their ticks crossing as they fall into step over "
-                   "90 s, is lost where they cross (its timing is one model for the whole "
-                   "recording, its tick told from theirs by timing and place only)")  # fmt: skip
+@pytest.mark.xfail(strict=True, reason="what the timing model cannot do yet: three of one "
+                   "sound falling into step over 90 s are all found and followed (their wander "
+                   "smoothed), but two of them swap identities where their ticks cross, "
+                   "told apart by timing alone")  # fmt: skip
 def test_three_metronomes_falling_into_step_over_90_s_are_each_followed(listen_run):
     path, crossings = listen_run
     ds = analyze_timing(path, metronomes=3)

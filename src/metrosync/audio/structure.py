@@ -276,7 +276,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
 
     The timing is first fitted on the first `FIRST_STRETCH` seconds, then on longer
     stretches, each as far as the last fit predicts well (`_reach_of`) and numbered by
-    that prediction; on each, the impacts of
+    that prediction (its wander included: `wander`); on each, the impacts of
     the tick and of the tock (even and odd beats: struck by different pallets, they
     sound and fall differently) are learned and the timing refitted to the main ones
     (`ROUNDS` times).
@@ -290,8 +290,9 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
         for _ in range(ROUNDS):
             explained = _explain(t[inside], timing, None if level is None else level[inside])
             mains = inside[explained[2]]
-            timing = fit_timing(t[mains], explained[0][explained[2]],
-                                drift=drift and mains.size >= DRIFT_TICKS)  # fmt: skip
+            beats = explained[0][explained[2]]
+            enough = drift and mains.size >= DRIFT_TICKS
+            timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         if end >= t[-1]:
             break
         end = max(_reach_of(timing, end), t[0] + 1.25 * (end - t[0]))
@@ -305,8 +306,10 @@ def _reach_of(timing: Timing, end: float) -> float:
     main impact's offsets would smear past the bump that finds it."""
     sp, st, _, sd = timing.errors
     k_end = (end - timing.phase) / timing.period
+    last = k_end if timing.wander is None else float(timing.wander.beats[-1])
     for k in np.arange(k_end, 2 * k_end + 1, 1.0):
-        spread = math.sqrt(sp**2 + (k * st) ** 2 + (0.5 * k * k * sd) ** 2)
+        wander = 0.0 if timing.wander is None else timing.wander.spread_after(k - last)
+        spread = math.sqrt(sp**2 + (k * st) ** 2 + (0.5 * k * k * sd) ** 2 + wander**2)
         if spread > WINDOW / 3:
             return float(timing.predict(k))
     return float(timing.predict(2 * k_end))

@@ -33,12 +33,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import AnalysisError
+from .wander import Wander, smooth_wander
 
 #: Degrees of freedom of the Student-t likelihood of a tick's timing error: few, so that
 #: a tick several jitters off (a hidden tick timed on another's sound) weighs little.
 DOF = 4.0
 #: Passes of iteratively reweighted least squares (the weights settle in a few).
 PASSES = 8
+#: Smoothings of the wander, each followed by a refit of the model to the ticks less it.
+WANDER_PASSES = 3
 #: Fewest ticks that determine the four parameters with a jitter to spare.
 MIN_TICKS = 6
 
@@ -58,6 +61,8 @@ class Timing:
         metronome's than not), so that a few mistimed ticks do not inflate it.
     errors : (4,) standard errors of (φ, T, λ, Ṫ).
     ticks : the number of ticks the fit used (weight > 0).
+    wander : the beat's smooth wander about the model (`wander.Wander`), or None: what
+        coupled metronomes pulling each other's phase add to it; `predict` includes it.
     """
 
     phase: float
@@ -67,6 +72,7 @@ class Timing:
     jitter: float
     errors: tuple[float, float, float, float]
     ticks: int
+    wander: Wander | None = None
 
     @property
     def bpm(self) -> float:
@@ -88,7 +94,8 @@ class Timing:
         k = np.asarray(beats, dtype=float)
         odd = np.mod(k, 2.0)
         limp = 0.5 * self.limp * self.period * odd
-        return self.phase + k * self.period + limp + 0.5 * self.drift * k**2
+        model = self.phase + k * self.period + limp + 0.5 * self.drift * k**2
+        return model if self.wander is None else model + self.wander.at(k)
 
     def residuals(self, times, beats) -> np.ndarray:
         """Heard minus predicted time of each tick, s."""
@@ -102,13 +109,16 @@ def _design(beats: np.ndarray, drift: bool) -> np.ndarray:
     return np.column_stack(columns)
 
 
-def fit_timing(times, beats, weights=None, *, drift: bool = True) -> Timing:
+def fit_timing(times, beats, weights=None, *, drift: bool = True, wander: bool = False) -> Timing:
     """The `Timing` that best explains ``times`` at beat numbers ``beats``.
 
     times : (K,) tick times, s.
     beats : (K,) integer beat numbers (gaps for missed beats; any offset).
     weights : (K,) probabilities that each tick is this metronome's (default 1).
     drift : fit Ṫ; without it Ṫ = 0 (a short recording cannot tell drift from jitter).
+    wander : also smooth the beat's wander about the model (`wander.smooth_wander`),
+        kept where the residuals ask for it; the model is then refitted to the ticks
+        less their wander, and the jitter is the ticks' spread about both.
 
     Raises `AnalysisError` with fewer than `MIN_TICKS` ticks of positive weight, or
     beat numbers that leave the limp or the drift undetermined (all even, say).
@@ -129,6 +139,38 @@ def fit_timing(times, beats, weights=None, *, drift: bool = True) -> Timing:
     if np.any(norm == 0) or np.linalg.matrix_rank(x / norm) < x.shape[1]:
         raise AnalysisError("the beat numbers leave the limp or the drift undetermined")
     robust = np.ones_like(t)
+    coef, r, scale = _reweighted(x, norm, t, w, robust)
+    wandering = None
+    if wander:
+        order = np.argsort(k, kind="stable")
+        for _ in range(WANDER_PASSES):
+            about_model = (t - x @ coef)[order]  # the wander is what the model leaves
+            wandering = smooth_wander(k[order], about_model, (w * robust)[order], _jitter(r, w))
+            if wandering is None:
+                break
+            g = wandering.at(k)
+            coef, r, scale = _reweighted(x, norm, t - g, w, robust)
+    err = np.sqrt(np.maximum(np.diag(_covariance(x / norm, w, r, scale)), 0.0)) / norm
+    if not drift:
+        coef, err = np.append(coef, 0.0), np.append(err, 0.0)
+    phase, period, half_limp, half_drift = coef
+    jitter = _jitter(r, w)
+    return Timing(
+        phase=float(phase),
+        period=float(period),
+        limp=float(2.0 * half_limp / period),
+        drift=float(2.0 * half_drift),
+        jitter=jitter,
+        errors=(float(err[0]), float(err[1]), float(2.0 * err[2] / period), float(2.0 * err[3])),
+        ticks=int(t.size),
+        wander=wandering,
+    )
+
+
+def _reweighted(x, norm, t, w, robust):
+    """Iteratively reweighted least squares of ``t`` on ``x`` (columns scaled by
+    ``norm``) under the Student-t likelihood: (coefficients, residuals, scale), the
+    robust weights updated in ``robust`` in place."""
     scale = 0.0
     for _ in range(PASSES):
         sw = np.sqrt(w * robust)
@@ -138,22 +180,15 @@ def fit_timing(times, beats, weights=None, *, drift: bool = True) -> Timing:
         scale = _t_scale(r, w, robust)
         if scale == 0:
             break
-        robust = (DOF + 1.0) / (DOF + (r / scale) ** 2)
-    err = np.sqrt(np.maximum(np.diag(_covariance(x / norm, w, r, scale)), 0.0)) / norm
-    if not drift:
-        coef, err = np.append(coef, 0.0), np.append(err, 0.0)
-    phase, period, half_limp, half_drift = coef
+        robust[:] = (DOF + 1.0) / (DOF + (r / scale) ** 2)
+    return coef, r, scale
+
+
+def _jitter(r: np.ndarray, w: np.ndarray) -> float:
+    """1.4826 times the median absolute residual of the ticks more likely this
+    metronome's than not (of all, if none is), s."""
     mine = w >= 0.5
-    jitter = 1.4826 * float(np.median(np.abs(r[mine] if mine.any() else r)))
-    return Timing(
-        phase=float(phase),
-        period=float(period),
-        limp=float(2.0 * half_limp / period),
-        drift=float(2.0 * half_drift),
-        jitter=jitter,
-        errors=(float(err[0]), float(err[1]), float(2.0 * err[2] / period), float(2.0 * err[3])),
-        ticks=int(t.size),
-    )
+    return 1.4826 * float(np.median(np.abs(r[mine] if mine.any() else r)))
 
 
 def _t_scale(r: np.ndarray, w: np.ndarray, robust: np.ndarray) -> float:
