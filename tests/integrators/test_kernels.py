@@ -222,12 +222,12 @@ def test_a_corrupt_compile_cache_is_rebuilt_not_used(tmp_path):
     # This run's compiled kernels, where they are cached already, start the cache (the
     # first run loads them instead of compiling them once more); else it compiles them.
     ours = _cache.kernel_cache_dir()
-    if _cache.is_cached(verlet.advance_runs):
+    if ours.is_dir():
         shutil.copytree(ours, tmp_path / "cache" / ours.relative_to(nb.config.CACHE_DIR))
     first = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert first.returncode == 0, first.stderr
     files = [p for p in Path(tmp_path / "cache").rglob("*") if p.is_file()]
-    assert any(p.name.startswith("verlet.advance_runs-") for p in files), "no cached kernel"
+    assert any(p.name.startswith("verlet.advance_") for p in files), "no cached kernel"
     for path in files:
         path.write_bytes(b"\x00garbage" * 7)
     again = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
