@@ -33,7 +33,11 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         print(f"unknown scheme {unknown[0]!r}: choose from {', '.join(SCHEMES)}", file=sys.stderr)
         return 2
-    compile_kernels(schemes or SCHEMES)
+    try:
+        compile_kernels(schemes or SCHEMES)
+    except KeyboardInterrupt:  # what is compiled is on disk; the rest compiles on use
+        print("interrupted: the kernels not yet compiled compile when first used", file=sys.stderr)
+        return 130
     return 0
 
 
