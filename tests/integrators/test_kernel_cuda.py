@@ -18,7 +18,28 @@ import sys
 # syncthreads(), holding the GIL for a whole switch interval (5 ms) per poll: a short
 # interval makes the same check about eight times faster.
 sys.setswitchinterval(5e-5)
+import threading
+import traceback
 import numpy as np
+from numba import types
+from numba.cuda.simulator import kernelapi
+from numba.np import numpy_support
+
+# The simulator keys a static shared array by the line that asks for it and creates it on
+# first use with no lock, so two threads that ask at once can each get an array of their
+# own (a race of the simulator, not of the kernel: CI met it once at this switch
+# interval). The same lookup under a lock:
+_first_use = threading.Lock()
+
+def shared_array(self, shape, dtype):
+    caller = tuple(traceback.extract_stack(sys._getframe(1), limit=1)[0])[:2]
+    with _first_use:
+        if caller not in self._allocations:
+            dtype = numpy_support.as_dtype(dtype) if isinstance(dtype, types.Type) else dtype
+            self._allocations[caller] = np.empty(shape, dtype)
+        return self._allocations[caller]
+
+kernelapi.FakeCUDAShared.array = shared_array
 from metrosync import build_ensemble, get_preset
 from metrosync.capabilities import FEATURES as TABLE, UnsupportedFeature, runs
 from metrosync.integrators import kernel_cuda, twin
