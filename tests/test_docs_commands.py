@@ -107,7 +107,14 @@ def runnable(command: str) -> bool:
     return command.startswith(("metrosync ", "python docs/")) and elsewhere(command) is None
 
 
-EXAMPLES = [(page, c) for page in PAGES for c in dict.fromkeys(commands(page)) if runnable(c)]
+#: Each runnable command once, in the folder of the first page that shows it: every page's
+#: folder starts with the same inputs, so a line that two pages show (the README repeats
+#: a few of the site's) runs the same there.
+FIRST_SHOWN: dict[str, Path] = {}
+for _page in PAGES:
+    for _command in filter(runnable, commands(_page)):
+        FIRST_SHOWN.setdefault(_command, _page)
+EXAMPLES = [(page, command) for command, page in FIRST_SHOWN.items()]
 
 
 def smaller(command: str) -> list[str]:
@@ -189,7 +196,10 @@ def test_every_example_is_run_here_or_by_a_named_test():
 
 
 @pytest.mark.parametrize(
-    ("page", "command"), EXAMPLES, ids=[f"{p.name}: {c[:60]}" for p, c in EXAMPLES]
+    ("page", "command"),
+    # A page's examples run on one xdist worker, in the page's order (`--dist loadgroup`).
+    [pytest.param(p, c, marks=pytest.mark.xdist_group(f"docs-{p.stem}")) for p, c in EXAMPLES],
+    ids=[f"{p.name}: {c[:60]}" for p, c in EXAMPLES],
 )
 def test_the_example_runs_at_reduced_size(page, command, folders):
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "MPLBACKEND": "Agg"}
