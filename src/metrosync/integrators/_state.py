@@ -18,6 +18,10 @@ from ..status import STATUS_DIVERGED, STATUS_OK
 from ._abi import Recording, State
 
 
+#: Which of `StepState`'s two tuples holds each field.
+_PART_OF = {**dict.fromkeys(Recording._fields, "recording"), **dict.fromkeys(State._fields, "state")}
+
+
 @dataclass
 class StepState:
     """State (B runs × N metronomes) and record buffers, advanced in place: the
@@ -54,10 +58,11 @@ class StepState:
     def __getattr__(self, name: str):
         # Called only for names the dataclass itself lacks; vars() rather than
         # attributes, so that an instance without fields yet (copy, pickle) does not recurse.
-        for part in (vars(self).get("state"), vars(self).get("recording")):
-            if part is not None and name in part._fields:
-                return getattr(part, name)
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        # The NumPy twin reads fields this way some forty times a step: one dict lookup.
+        part = vars(self).get(_PART_OF.get(name, ""))
+        if part is None:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        return getattr(part, name)
 
     @classmethod
     def start(
