@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from metrosync.audio import structure
 from metrosync.audio.periodicity import candidate_tempi
 from metrosync.audio.structure import follow, learn_structure
 from metrosync.audio.timing import Timing
@@ -91,3 +92,38 @@ def test_onsets_of_a_beat_that_slides_past_are_no_impact_of_the_tick():
     assert all(i.spread <= MAX_SPREAD for i in structure.impacts)
     assert structure.main_impact.offset == pytest.approx(0.0, abs=0.3e-3)
     assert np.mean(label[beats.size :] == -1) > 0.8
+
+
+def plain_em(d, means, spreads, shares, uniform, iterations):
+    """The EM of `structure._mixture` written with NumPy arrays, all iterations run."""
+    count = means.size
+    for _ in range(iterations):
+        dens = np.empty((d.size, count + 1))
+        z = (d[:, None] - means) / spreads
+        dens[:, :count] = shares[:count] * np.exp(-0.5 * z**2) / (spreads * np.sqrt(2 * np.pi))
+        dens[:, count] = shares[count] * uniform
+        total = dens.sum(axis=1)
+        resp = dens / np.maximum(total, 1e-300)[:, None]
+        weight = resp.sum(axis=0)
+        shares = np.maximum(weight / d.size, 1e-9)
+        held = weight[:count] > 1e-9
+        safe = np.where(held, weight[:count], 1.0)
+        means = np.where(held, (resp[:, :count] * d[:, None]).sum(axis=0) / safe, means)
+        var = (resp[:, :count] * (d[:, None] - means) ** 2).sum(axis=0) / safe
+        spreads = np.maximum(np.sqrt(var), structure.MIN_SPREAD)
+    return means, spreads, shares, resp, total
+
+
+@pytest.mark.parametrize("count", [1, 2, 3])
+def test_the_compiled_em_is_the_plain_one(count):
+    # A strike, a precursor 25 ms ahead in 70 % of the beats, and clutter over ±0.15 s.
+    rng = np.random.default_rng(count)
+    d = np.concatenate([rng.normal(0.0, 0.6e-3, 300), rng.normal(-0.025, 3e-3, 210),
+                        rng.uniform(-0.15, 0.15, 60)])  # fmt: skip
+    start = (np.array([0.0, -0.02, 0.01][:count]), np.full(count, 2e-3),
+             np.full(count + 1, 1.0 / (count + 1)))  # fmt: skip
+    expected = plain_em(d, *(a.copy() for a in start), 1 / 0.3, 60)
+    means, spreads, shares = (a.copy() for a in start)
+    resp, total = structure._em(d, means, spreads, shares, 1 / 0.3, 60)
+    for got, want in zip((means, spreads, shares, resp, total), expected, strict=True):
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 from scipy.stats import t as student_t
 
@@ -245,24 +246,67 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
     spreads = np.full(count, max(float(np.std(rest)) / count if rest.size else width, width))
     spreads[0] = width
     shares = np.full(count + 1, 1.0 / (count + 1))
-    uniform = 1.0 / (2.0 * reach)
-    for _ in range(iterations):
-        dens = np.empty((d.size, count + 1))
-        dens[:, :count] = shares[:count] * normal_density(d[:, None], means, spreads)
-        dens[:, count] = shares[count] * uniform
-        total = dens.sum(axis=1, keepdims=True)
-        resp = dens / np.maximum(total, 1e-300)
-        weight = resp.sum(axis=0)
-        shares = np.maximum(weight / d.size, 1e-9)
-        held = weight[:count] > 1e-9
-        safe = np.where(held, weight[:count], 1.0)
-        means = np.where(held, (resp[:, :count] * d[:, None]).sum(axis=0) / safe, means)
-        var = (resp[:, :count] * (d[:, None] - means) ** 2).sum(axis=0) / safe
-        spreads = np.maximum(np.sqrt(var), MIN_SPREAD)
-    loglik = float(np.log(np.maximum(total[:, 0], 1e-300)).sum())
+    resp, total = _em(d, means, spreads, shares, 1.0 / (2.0 * reach), iterations)
+    loglik = float(np.log(np.maximum(total, 1e-300)).sum())
     parameters = 3 * count  # mean, spread, share each (the clutter's share is the rest)
     bic = -2.0 * loglik + parameters * math.log(d.size)
     return bic, means, spreads, shares[:count], resp
+
+
+@nb.njit(cache=True)
+def _em(d, means, spreads, shares, uniform, iterations):
+    """`_mixture`'s EM iterations, in place on ``means``, ``spreads`` and ``shares``
+    (the last the uniform clutter's): (responsibilities (K, count+1), each onset's
+    total density). Stops early once an iteration moves no parameter by more than
+    `_SETTLED` (then every later one would repeat it)."""
+    k, count = d.size, means.size
+    resp = np.empty((k, count + 1))
+    total = np.empty(k)
+    scale = 1.0 / math.sqrt(2.0 * math.pi)
+    for _ in range(iterations):
+        for i in range(k):
+            sum_i = 0.0
+            for j in range(count):
+                z = (d[i] - means[j]) / spreads[j]
+                resp[i, j] = shares[j] * math.exp(-0.5 * z * z) * scale / spreads[j]
+                sum_i += resp[i, j]
+            resp[i, count] = shares[count] * uniform
+            sum_i += resp[i, count]
+            total[i] = sum_i
+            inv = 1.0 / max(sum_i, 1e-300)
+            for j in range(count + 1):
+                resp[i, j] *= inv
+        moved = 0.0
+        for j in range(count + 1):
+            weight = 0.0
+            for i in range(k):
+                weight += resp[i, j]
+            share = max(weight / k, 1e-9)
+            moved = max(moved, abs(share - shares[j]))
+            shares[j] = share
+            if j == count:
+                continue
+            held = weight > 1e-9
+            safe = weight if held else 1.0
+            mean = means[j]
+            if held:
+                mean = 0.0
+                for i in range(k):
+                    mean += resp[i, j] * d[i]
+                mean /= safe
+            var = 0.0
+            for i in range(k):
+                var += resp[i, j] * (d[i] - mean) ** 2
+            spread = max(math.sqrt(var / safe), MIN_SPREAD)
+            moved = max(moved, abs(mean - means[j]), abs(spread - spreads[j]))
+            means[j], spreads[j] = mean, spread
+        if moved < _SETTLED:
+            break
+    return resp, total
+
+
+#: A change of an EM parameter (s, or a share) below which it has settled.
+_SETTLED = 1e-12
 
 
 def normal_density(x, mean, spread):
