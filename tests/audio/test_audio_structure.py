@@ -127,3 +127,16 @@ def test_the_compiled_em_is_the_plain_one(count):
     resp, total = structure._em(d, means, spreads, shares, 1 / 0.3, 60)
     for got, want in zip((means, spreads, shares, resp, total), expected, strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+
+
+def test_beats_are_numbered_right_far_into_a_drifting_recording():
+    # 161 BPM speeding up by 0.05 BPM a minute for ten minutes: by the end the drift's
+    # ½·Ṫ·k² has moved beat k 2.3 beats from (t − φ)/T, and the limp moves odd beats
+    period, drift = 60.0 / 161.25, -7.2e-7
+    timing = Timing(0.3, period, 0.04, drift, 0.5e-3, (0.0,) * 4, 1600)
+    k = np.arange(1612)
+    t = timing.predict(k) + np.random.default_rng(0).normal(0, 0.5e-3, k.size)
+    assert 0.5 * abs(drift) * k[-1] ** 2 > 2 * period
+    beat, offset = structure._nearest_beats(t, timing)
+    np.testing.assert_array_equal(beat, k)
+    assert np.abs(offset).max() < 3e-3
