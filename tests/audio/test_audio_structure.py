@@ -140,3 +140,18 @@ def test_beats_are_numbered_right_far_into_a_drifting_recording():
     beat, offset = structure._nearest_beats(t, timing)
     np.testing.assert_array_equal(beat, k)
     assert np.abs(offset).max() < 3e-3
+
+
+def test_another_metronomes_beat_passing_is_no_impact_but_a_sparse_bounce_is():
+    # 600 beats of one kind: the main impact at most of them, a bounce at a random third
+    # of them all along, and another metronome's ticks crossing one offset in two runs
+    rng = np.random.default_rng(3)
+    beats = np.arange(0, 1200, 2)
+    main = beats[rng.uniform(size=beats.size) < 0.9]
+    bounce = beats[rng.uniform(size=beats.size) < 0.3]
+    passing = np.concatenate([beats[100:130], beats[400:425]])
+    every = np.concatenate([main, bounce, passing])
+    label = np.repeat([0, 1, 2], [main.size, bounce.size, passing.size])
+    assert structure._passing(every, label, 3).tolist() == [False, False, True]
+    # the main impact is not tested, even where it comes in runs
+    assert not structure._passing(passing, np.zeros(passing.size, dtype=int), 1).any()

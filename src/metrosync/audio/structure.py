@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
+from scipy.stats import kstest, uniform
 from scipy.stats import t as student_t
 
 from ..errors import AnalysisError
@@ -65,6 +66,9 @@ ONSETS_PER_IMPACT = 5
 DRIFT_TICKS = 12
 #: Narrowest spread of an impact, s: the onset detector's own timing noise.
 MIN_SPREAD = 0.2e-3
+#: False-alarm probability of the test that takes a component for another metronome's
+#: beat passing (`_passing`): an impact of this tick is taken for one this seldom.
+PASSING_P = 1e-3
 #: Widest, s: a quieter impact ahead of the strike wanders by several milliseconds tick
 #: to tick (a Neewer's by 11-42 ms, a spread of about 8), but keeps to its tick; the
 #: onsets of a metronome whose beat slides past this one's spread far wider.
@@ -161,8 +165,9 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
         raise AnalysisError(f"too few onsets ({d.size}) to learn a tick's impacts")
     _, means, spreads, shares, resp = best
     # a component wider than an impact wanders is no impact: the onsets of another
-    # metronome whose beat slides past this one's (clutter, left for it to be found)
-    wide = spreads > MAX_SPREAD
+    # metronome whose beat slides past this one's (clutter, left for it to be found);
+    # nor is one whose onsets come in a few runs of beats, not all along (`_passing`)
+    wide = (spreads > MAX_SPREAD) | _passing(b, np.argmax(resp, axis=1), means.size)
     if wide.all():
         wide[np.argmin(spreads)] = False
     if wide.any():
@@ -187,6 +192,25 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     label[label == means.size] = -1
     clutter = float(resp[:, -1].mean())
     return Structure(impacts, main, clutter), label
+
+
+def _passing(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
+    """(count,) which components of a tick's mixture are another metronome's beat passing
+    this one's, not an impact: an impact is struck at every beat it is heard at, so the
+    beat numbers of its onsets are spread evenly over the recording's beats; a train
+    sliding past at another tempo crosses a given offset only now and then, in runs.
+    Kolmogorov–Smirnov test of each component's beat numbers against the uniform over
+    the beats, at false-alarm probability `PASSING_P`; the first component (started on
+    the main impact) is not tested."""
+    out = np.zeros(count, dtype=bool)
+    if beats.size == 0:
+        return out
+    lo, width = float(beats.min()), float(beats.max() - beats.min()) + 1.0
+    for j in range(1, count):
+        mine = beats[label == j]
+        if mine.size >= ONSETS_PER_IMPACT:
+            out[j] = kstest(mine, uniform(lo, width).cdf).pvalue < PASSING_P
+    return out
 
 
 def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
