@@ -9,7 +9,8 @@ d = t − τ_k of the onsets near a metronome's beats τ_k are a one-dimensional
 Gaussians N(o_j, s_j²) weighted p_j, plus a uniform component. It is fitted by
 expectation–maximisation, with the number of impacts chosen by the Bayesian
 information criterion (BIC); nothing about how many impacts a tick has, in which order
-or how far apart, is assumed.
+or how far apart, is assumed. A component whose onsets come in runs of beats rather
+than all along is another metronome's beat sliding past, and is clutter (`_passing`).
 
 The tick's time is the time of its most regular impact, the one of smallest spread
 among those heard in at least `MIN_PRESENCE` of the beats: the escapement's impact,
