@@ -155,3 +155,55 @@ def test_another_metronomes_beat_passing_is_no_impact_but_a_sparse_bounce_is():
     assert structure._passing(every, label, 3).tolist() == [False, False, True]
     # the main impact is not tested, even where it comes in runs
     assert not structure._passing(passing, np.zeros(passing.size, dtype=int), 1).any()
+
+
+def _precursor_and_strike():
+    """A tick as a Neewer strikes it: a wandering precursor ~20 ms ahead, the strike."""
+    impacts = (structure.Impact(-0.020, 0.008, 0.9), structure.Impact(0.0, 0.5e-3, 1.0))
+    return structure.Structure(impacts, main=1, clutter=0.01)
+
+
+def test_a_beat_s_onsets_are_paired_with_its_impacts_one_to_one():
+    # both onsets of beat 0 are, each alone, likelier the strike than the precursor (the
+    # strike's density is sharp and tall); an impact is struck once a beat, so the
+    # earlier is the precursor. Beat 2's lone early onset stays the precursor's, and
+    # beat 4's onset far from both is clutter.
+    s = _precursor_and_strike()
+    offset = np.array([-1.2e-3, 0.3e-3, -0.021, 0.3])
+    beat = np.array([0, 0, 2, 4])
+    assert structure._assigned(offset, beat, s, reach=0.45).tolist() == [0, 1, 0, -1]
+    # the pairing does not depend on the onsets' order
+    flip = np.array([1, 0, 2, 3])
+    assert structure._assigned(offset[flip], beat[flip], s, 0.45).tolist() == [1, 0, 0, -1]
+
+
+def test_the_strike_s_timing_is_heavy_tailed_and_each_impact_s_rate_sums_to_its_presence():
+    s = _precursor_and_strike()
+    x = np.linspace(-0.2, 0.2, 400_001)
+    dx = x[1] - x[0]
+    for j, impact in enumerate(s.impacts):
+        assert np.exp(s.log_density(j, x)).sum() * dx == pytest.approx(impact.presence, rel=1e-3)
+    # an escapement's 5-sigma error is far likelier under the strike's Student-t than
+    # under a Gaussian of the same spread
+    z5 = np.exp(s.log_density(1, 5 * 0.5e-3)) * 0.5e-3
+    assert z5 > 100 * np.exp(-12.5) / np.sqrt(2 * np.pi)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_strike_s_rare_large_errors_stay_the_strike_s(seed):
+    # 300 beats of one kind, a bounce at +25 ms after half of them, and the strike's
+    # jitter 0.5 ms but for two escapement errors of +4 sigma: neither is an impact of
+    # its own (a narrow component on the two), nor left to clutter or the bounce
+    rng = np.random.default_rng(seed)
+    beats = np.arange(0, 600, 2)
+    strike = rng.normal(0, 0.5e-3, beats.size)
+    strike[[40, 170]] = [2.0e-3, 2.1e-3]
+    heard = rng.uniform(size=beats.size) < 0.5
+    bounce = 0.025 + rng.normal(0, 1.5e-3, heard.sum())
+    offsets = np.concatenate([strike, bounce])
+    every = np.concatenate([beats, beats[heard]])
+    s, _ = learn_structure(offsets, every, reach=0.2)
+    assert len(s.impacts) == 2
+    assert s.main_impact.offset == pytest.approx(0.0, abs=2e-4)
+    label = structure._assigned(offsets, every, s, reach=0.2)
+    assert np.all(label[: beats.size] == s.main)

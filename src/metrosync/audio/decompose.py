@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import AnalysisError
 from .periodicity import BPM_RANGE, candidate_tempi
-from .structure import Followed, explained_by, follow, normal_density
+from .structure import Followed, explained_by, follow
 
 #: Share of its beats a metronome's main impact must be heard in.
 MIN_HEARD = 0.5
@@ -264,13 +264,13 @@ def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], ma
 
 def _density(t: np.ndarray, followed: Followed) -> np.ndarray:
     """(K,) the density (1/s) of each onset under the impact that explains it, weighted
-    by how often that impact is heard: presence × N(offset; o_j, s_j²); 0 for clutter."""
+    by how often that impact is heard (`Structure.log_density`); 0 for clutter."""
     out = np.zeros(t.size)
     beat = followed.beat
     for kind, structure in enumerate(followed.structure):
-        for j, impact in enumerate(structure.impacts):
+        for j in range(len(structure.impacts)):
             mine = (followed.impact == j) & (np.mod(beat, 2) == kind) & (beat >= 0)
             if mine.any():
                 offset = t[mine] - followed.timing.predict(beat[mine])
-                out[mine] = impact.presence * normal_density(offset, impact.offset, impact.spread)
+                out[mine] = np.exp(structure.log_density(j, offset))
     return out

@@ -100,6 +100,15 @@ class Structure:
     def main_impact(self) -> Impact:
         return self.impacts[self.main]
 
+    def log_density(self, j: int, offset) -> np.ndarray:
+        """log of impact j's rate at ``offset`` (s from the beat): presence × its density
+        (1/s); the main impact's timing is Student-t (`timing.DOF`), as the timing model
+        takes it, the others' Gaussian."""
+        impact = self.impacts[j]
+        z = (np.asarray(offset, dtype=float) - impact.offset) / impact.spread
+        shape = student_t.logpdf(z, DOF) if j == self.main else -0.5 * z * z - _LOG_ROOT_2PI
+        return math.log(max(impact.presence, 1e-300)) + shape - math.log(impact.spread)
+
 
 @dataclass(frozen=True)
 class Followed:
@@ -134,10 +143,8 @@ class Followed:
         out = np.zeros(t.size)
         for kind, structure in enumerate(self.structure):
             mine = near & (np.mod(beat, 2) == kind)
-            for impact in structure.impacts:
-                out[mine] += impact.presence * normal_density(
-                    offset[mine], impact.offset, impact.spread
-                )
+            for j in range(len(structure.impacts)):
+                out[mine] += np.exp(structure.log_density(j, offset[mine]))
         return out
 
 
@@ -160,6 +167,10 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
         if d.size < ONSETS_PER_IMPACT * count:
             break
         fitted = _mixture(d, count, reach, centre, width)
+        if count > 1 and np.min(fitted[3]) * d.size < ONSETS_PER_IMPACT:
+            # an impact fitted to a handful of onsets is the tail of another's jitter
+            # (an escapement's 4-sigma tick), not an impact of its own
+            continue
         if best is None or fitted[0] < best[0]:
             best = fitted
     if best is None:
@@ -333,13 +344,10 @@ def _em(d, means, spreads, shares, uniform, iterations):
     return resp, total
 
 
+_LOG_ROOT_2PI = 0.5 * math.log(2.0 * math.pi)
+
 #: A change of an EM parameter (s, or a share) below which it has settled.
 _SETTLED = 1e-12
-
-
-def normal_density(x, mean, spread):
-    """The density of N(mean, spread²) at ``x`` (1/s for times in s)."""
-    return np.exp(-0.5 * ((x - mean) / spread) ** 2) / (spread * math.sqrt(2 * math.pi))
 
 
 def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed:
@@ -399,10 +407,9 @@ def _explain(t: np.ndarray, timing: Timing, level=None):
     for kind in (0, 1):
         mine = np.flatnonzero(near & (np.mod(beat, 2) == kind))
         strengths = None if level is None else level[mine]
-        structure, label = learn_structure(offset[mine], beat[mine], reach, strengths)
-        chosen = mine[_mains(offset[mine], beat[mine], structure, reach)]
-        main[chosen] = True
-        label[np.isin(mine, chosen)] = structure.main
+        structure, _ = learn_structure(offset[mine], beat[mine], reach, strengths)
+        label = _assigned(offset[mine], beat[mine], structure, reach)
+        main[mine[label == structure.main]] = True
         impact[mine] = label
         structures.append(structure)
     return np.where(near, beat, -1), impact, main, tuple(structures)
@@ -420,16 +427,8 @@ def explained_by(times, followed: Followed) -> Followed:
     main = np.zeros(t.size, dtype=bool)
     for kind, structure in enumerate(followed.structure):
         mine = np.flatnonzero(near & (np.mod(beat, 2) == kind))
-        d = offset[mine]
-        likelihood = np.column_stack(
-            [i.presence * normal_density(d, i.offset, i.spread) for i in structure.impacts]
-            + [np.full(d.size, max(structure.clutter, 1e-3) / (2.0 * reach))]
-        )
-        label = np.argmax(likelihood, axis=1)
-        label[label == len(structure.impacts)] = -1
-        chosen = mine[_mains(d, beat[mine], structure, reach)]
-        main[chosen] = True
-        label[np.isin(mine, chosen)] = structure.main
+        label = _assigned(offset[mine], beat[mine], structure, reach)
+        main[mine[label == structure.main]] = True
         impact[mine] = label
     return Followed(followed.timing, followed.structure, np.where(near, beat, -1), impact, main)
 
@@ -505,22 +504,59 @@ def _nearest_beats(t: np.ndarray, timing: Timing) -> tuple[np.ndarray, np.ndarra
     return best, offset
 
 
-def _mains(offset: np.ndarray, beat: np.ndarray, structure: Structure, reach: float):
-    """Indices of the onsets that time their beats: in each beat, the onset likeliest to
-    be the main impact against every other impact and the clutter, if it is more likely
-    the main impact than anything else. The main impact's timing is taken as Student-t
-    (`timing.DOF`), as the timing model takes it: an escapement's rare large error
-    should not hand a tick to a precursor. A beat holds one main impact at most."""
-    main = structure.main_impact
-    z = (offset - main.offset) / main.spread
-    own = main.presence * student_t.pdf(z, DOF) / main.spread
-    other = np.full(offset.size, max(structure.clutter, 1e-3) / (2.0 * reach))
-    for j, impact in enumerate(structure.impacts):
-        if j != structure.main:
-            other += impact.presence * normal_density(offset, impact.offset, impact.spread)
-    ratio = own / other
-    mine = np.flatnonzero(ratio > 1.0)
-    order = mine[np.lexsort((-ratio[mine], beat[mine]))]
-    first = np.ones(order.size, dtype=bool)
-    first[1:] = beat[order][1:] != beat[order][:-1]
-    return np.sort(order[first])
+def _assigned(offset: np.ndarray, beat: np.ndarray, structure: Structure, reach: float):
+    """(K,) the impact of each onset about its beat (−1: clutter), assigned beat by beat:
+    an impact is struck once a beat at most, so within a beat the onsets and impacts are
+    paired to maximise Σ log(p_j f_j(d_i) / c) over the pairs (f_j the impact's density,
+    c the clutter's), an onset left unpaired being clutter. The main impact's timing is
+    Student-t (`timing.DOF`), as the timing model takes it: an escapement's rare large
+    error should not hand a tick to a precursor, nor the precursor of the same beat."""
+    clutter = math.log(max(structure.clutter, 1e-3) / (2.0 * reach))
+    gain = np.empty((offset.size, len(structure.impacts)))
+    for j in range(len(structure.impacts)):
+        gain[:, j] = structure.log_density(j, offset) - clutter
+    order = np.argsort(beat, kind="stable")
+    label = np.full(offset.size, -1, dtype=np.int64)
+    label[order] = _pair_by_beat(np.ascontiguousarray(gain[order]), beat[order].astype(np.int64))
+    return label
+
+
+@nb.njit(cache=True)
+def _pair_by_beat(gain, beat):
+    """`_assigned`'s pairing: for onsets sorted by ``beat``, their (K, J) gains, the best
+    one-to-one pairing of each beat's onsets with impacts (a dynamic programme over the
+    set of impacts used), −1 for an onset paired with none."""
+    k, impacts = gain.shape
+    masks = 1 << impacts
+    label = np.full(k, -1, dtype=np.int64)
+    start = 0
+    while start < k:
+        stop = start
+        while stop < k and beat[stop] == beat[start]:
+            stop += 1
+        m = stop - start
+        score = np.full(masks, -np.inf)
+        score[0] = 0.0
+        choice = np.full((m, masks), -1, dtype=np.int64)
+        for i in range(m):
+            new = score.copy()  # the onset is clutter
+            for used in range(masks):
+                if score[used] == -np.inf:
+                    continue
+                for j in range(impacts):
+                    bit = 1 << j
+                    g = gain[start + i, j]
+                    if used & bit or g <= 0.0:
+                        continue
+                    if score[used] + g > new[used | bit]:
+                        new[used | bit] = score[used] + g
+                        choice[i, used | bit] = j
+            score = new
+        used = int(np.argmax(score))
+        for i in range(m - 1, -1, -1):
+            j = choice[i, used]
+            if j >= 0:
+                label[start + i] = j
+                used ^= 1 << j
+        start = stop
+    return label
