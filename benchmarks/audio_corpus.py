@@ -59,7 +59,7 @@ HEARD = 0.5
 #: The analyses that can be scored, by name: today's stages, and the timing model that is
 #: to replace them (`metrosync.audio.timing_analysis`).
 ANALYSES = {
-    "stages": ("metrosync.audio", "analyze_audio"),
+    "stages": ("metrosync.audio.dataset", "analyze_audio"),
     "timing": ("metrosync.audio.timing_analysis", "analyze_timing"),
 }
 
