@@ -37,6 +37,9 @@ MIN_BEATS = 16
 MAX_METRONOMES = 8
 #: Share of a metronome's ticks that another explains, beyond which it is no metronome.
 REDUNDANT = 0.5
+#: A metronome followed at twice the tempo found that hears more than this many times
+#: its ticks is the metronome, the one found its half tempo (which hears half of them).
+HALF_TEMPO = 1.5
 #: Passes of refollowing every metronome with the others' onsets set aside.
 PASSES = 2
 #: Difference of level between microphones, dB, beyond which two impacts come from two
@@ -212,9 +215,28 @@ def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
         return None
     for candidate in candidate_tempi(t[free], bpm_range=bpm_range):
         followed = _metronome(t[free], candidate.bpm, _part(level, free))
-        if followed is not None:
-            return candidate.bpm, Heard(followed, free)
+        if followed is None:
+            continue
+        bpm, followed = _at_its_tempo(
+            t[free], candidate.bpm, followed, _part(level, free), bpm_range
+        )
+        return bpm, Heard(followed, free)
     return None
+
+
+def _at_its_tempo(t: np.ndarray, bpm: float, followed: Followed, level, bpm_range=BPM_RANGE):
+    """(the tempo, the metronome): ``followed`` at ``bpm``, or, where it is a metronome
+    at half its tempo, the one at twice ``bpm``. At half its tempo a metronome is a
+    metronome too, on every other beat, its other ticks left over; followed at twice
+    the tempo it hears twice the ticks, where a metronome at its own tempo followed at
+    twice hears no more (`HALF_TEMPO`)."""
+    double = 2.0 * bpm
+    if double > bpm_range[1]:
+        return bpm, followed
+    faster = _metronome(t, double, level)
+    if faster is not None and faster.main.sum() > HALF_TEMPO * followed.main.sum():
+        return double, faster
+    return bpm, followed
 
 
 def _part(level, index):
@@ -250,6 +272,8 @@ def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], ma
     for m, bpm in enumerate(starts):
         pool = np.flatnonzero((mains < 0) | (mains == m))
         followed = _metronome(t[pool], bpm, _part(level, pool))
+        if followed is not None:
+            starts[m], followed = _at_its_tempo(t[pool], bpm, followed, _part(level, pool))
         one = before[m] if followed is None else Heard(followed, pool)
         density[m, one.pool] = _density(t[one.pool], one.followed)
         heard.append(one)

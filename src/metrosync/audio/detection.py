@@ -305,6 +305,17 @@ class Ticks:
     channel_strength: np.ndarray
     rise: np.ndarray
 
+    @staticmethod
+    def none(channels: int) -> Ticks:
+        """No ticks, for a recording of ``channels`` channels."""
+        empty = np.zeros(0)
+        return Ticks(empty, empty, np.zeros((0, channels)), empty)
+
+    def joined(self, other: Ticks) -> Ticks:
+        """These ticks, then ``other``'s, every field alike."""
+        return Ticks(*(np.concatenate([getattr(self, f), getattr(other, f)])
+                       for f in Ticks.__dataclass_fields__))  # fmt: skip
+
 
 def refine(recording: Recording, scan: Scan, hops: np.ndarray, *, chunk: int = 2048) -> Ticks:
     """Time the ticks found at ``hops`` on the waveform (see the module docstring)."""

@@ -11,6 +11,15 @@ threshold is the level the detection curve's maximum over such a window exceeds,
 chance, in a share `FALSE_TICK` of windows, read off the recording's own curve away
 from its onsets; the largest rise in the window above it is the tick.
 
+Where the curve's rise is not enough (a tick in another's ring rises little over what
+rings there already), the beat is sought by the metronome's own sound, as pulsar
+timing times a pulse by a template learned from the data: the metronome's sound is
+the mean of its clean ticks' first `SOUND` seconds (band-passed, aligned by their
+cross-correlation), and the statistic is the largest normalised cross-correlation of
+that sound with the recording over the beat's window. Its chance level is read where
+the confusion lies: the same statistic at windows in the rings of the onsets that are
+not this metronome's ticks; the threshold is passed by chance in `FALSE_TICK` of them.
+
 Contract: `seek(recording, scan, impacts, heard)` returns the `detection.Ticks` found
 (timed by `detection.refine`) and (L,) the metronome of each.
 """
@@ -18,7 +27,7 @@ Contract: `seek(recording, scan, impacts, heard)` returns the `detection.Ticks` 
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, signal
 
 from . import detection as det
 from .decompose import Heard
@@ -29,9 +38,25 @@ WINDOW_JITTERS = 3.0
 MIN_WINDOW = 1e-3
 #: Share of windows with no tick in which the curve's maximum passes the threshold.
 FALSE_TICK = 0.01
-#: Onsets this close (s) are kept out of the chance level, and a window holding one is
-#: left alone: that beat's onset is another's, which hid this one.
+#: Onsets this close (s) are kept out of the curve's chance level, and a window near one
+#: is left to the sound: the onset hides the beat from the curve.
 CLEAR = det.RESOLUTION
+#: Length of a metronome's sound that is matched, s: a strike's first milliseconds,
+#: before its ring, which another's ring covers least.
+SOUND = 0.012
+#: ... and the quiet before its onset that is part of it, s: where the sound of a
+#: clean tick is silence, so that a match slid late (its onset over the tick's loud
+#: start, in another's ring) pays for the energy it puts there.
+QUIET = 1e-3
+#: Most of a metronome's clean ticks (no other onset from `RING` before to `SOUND`
+#: after) averaged into its sound, and fewest to learn it from.
+SOUND_TICKS, MIN_SOUND_TICKS = 48, 8
+#: How long another metronome's tick rings over a beat, s (where the chance level of
+#: the sound's match is read, and what a clean tick is clear of).
+RING = 0.045
+#: Windows in others' rings the sound's chance level is read from: four of them pass
+#: it by chance.
+CHANCE_WINDOWS = round(4 / FALSE_TICK)
 
 
 def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
@@ -42,7 +67,7 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
     clear = int(np.ceil(CLEAR / hop))
     for shift in range(-clear, clear + 1):
         near_onset[np.clip(onset_hops + shift, 0, scan.curve.size - 1)] = True
-    found_hops, whose = [], []
+    found_hops, whose, unfound = [], [], []
     for m, h in enumerate(heard):
         timing = h.followed.timing
         half = max(1, int(np.ceil(max(WINDOW_JITTERS * timing.jitter, MIN_WINDOW) / hop)))
@@ -53,22 +78,152 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
         kinds = np.mod(beats, 2)
         offsets = np.array([s.main_impact.offset for s in h.followed.structure])[kinds]
         centre = np.round((timing.predict(beats) + offsets) / hop).astype(np.int64)
-        for c in centre:
+        for c, kind in zip(centre, kinds, strict=True):
             lo, hi = c - half, c + half + 1
-            if lo < 0 or hi > scan.curve.size or near_onset[lo:hi].any():
+            if lo < 0 or hi > scan.curve.size:
+                continue
+            if near_onset[lo:hi].any():
+                # an onset just before hides the beat from the curve, not from its sound;
+                # one inside the window is another's, which hid this one
+                if not np.any((onset_hops >= lo) & (onset_hops < hi)):
+                    unfound.append((m, int(kind), c * hop, half * hop))
                 continue
             window = scan.curve[lo:hi]
             best = int(np.argmax(window))
             if window[best] > chance:
                 found_hops.append(lo + best)
                 whose.append(m)
+            else:
+                unfound.append((m, int(kind), c * hop, half * hop))
     order = np.argsort(found_hops, kind="stable")  # refine reads the file once, in order
     hops = np.array(found_hops, dtype=np.int64)[order]
     owners = np.array(whose, dtype=np.int64)[order]
-    if not hops.size:
-        none = np.zeros(0)
-        return det.Ticks(none, none, np.zeros((0, recording.channels)), none), owners
-    return det.refine(recording, scan, hops), owners
+    found = (
+        det.Ticks.none(recording.channels) if not hops.size else det.refine(recording, scan, hops)
+    )
+    by_sound, sound_owners = _by_sound(recording, scan, impacts, heard, unfound)
+    if by_sound.time.size:
+        found = found.joined(by_sound)
+        owners = np.concatenate([owners, sound_owners])
+    return found, owners
+
+
+def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
+    """(the ticks found by each metronome's sound at the beats ``unfound`` — (metronome,
+    kind, predicted time s, half-window s) — and their metronomes)."""
+    rate = recording.sample_rate
+    times, whose = [], []
+    rng = np.random.default_rng(0)  # where the chance level is read: fixed, repeatable
+    for m, h in enumerate(heard):
+        mine = [u for u in unfound if u[0] == m]
+        if not mine:
+            continue
+        others = np.setdiff1d(np.arange(impacts.time.size), h.ticks)
+        clean = _clean(impacts.time, h.ticks, others)
+        half = mine[0][3]
+        null = _ring_windows(impacts.time, others, h, half, rng)
+        for kind in (0, 1):
+            beats = [u for u in mine if u[1] == kind]
+            ticks = clean[np.mod(h.followed.beat[np.searchsorted(h.pool, clean)], 2) == kind]
+            sound = _sound(recording, scan, impacts.time[ticks])
+            if not beats or sound is None or null.size < CHANCE_WINDOWS:
+                continue
+            level = np.quantile(_match(recording, scan, sound, null, half)[0], 1 - FALSE_TICK)
+            centres = np.array([u[2] for u in beats])
+            score, at = _match(recording, scan, sound, centres, half)
+            times += list(at[score > level])
+            whose += [m] * int(np.sum(score > level))
+    if not times:
+        return det.Ticks.none(recording.channels), np.zeros(0, dtype=np.int64)
+    order = np.argsort(times)
+    t = np.array(times)[order]
+    hops = np.round(t * rate / scan.hop).astype(np.int64)
+    found = det.refine(recording, scan, hops)  # its strength and levels; its time is the match's
+    return det.Ticks(t, found.strength, found.channel_strength, found.rise), np.array(whose)[order]
+
+
+def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
+    """Of ``ticks``, those no other onset precedes within `RING` nor follows within
+    `SOUND`: the metronome's sound alone."""
+    other = np.sort(t[others])
+    if not other.size:
+        return ticks
+    j = np.searchsorted(other, t[ticks])
+    before = t[ticks] - other[np.maximum(j - 1, 0)]
+    after = other[np.minimum(j, other.size - 1)] - t[ticks]
+    before[j == 0] = np.inf
+    after[j == other.size] = np.inf
+    return ticks[(before > RING) & (after > SOUND)]
+
+
+def _ring_windows(t, others, h: Heard, half: float, rng) -> np.ndarray:
+    """Centres of windows in the rings of the onsets ``others`` (from `CLEAR` to `RING`
+    after one), clear of every onset and of this metronome's beats."""
+    if not others.size:
+        return np.zeros(0)
+    pick = rng.choice(others, size=4 * CHANCE_WINDOWS)
+    centre = t[pick] + rng.uniform(half, RING, pick.size)
+    j = np.searchsorted(t, centre)
+    gap = np.minimum(np.abs(t[np.minimum(j, t.size - 1)] - centre),
+                     np.abs(t[np.maximum(j - 1, 0)] - centre))  # fmt: skip
+    timing = h.followed.timing
+    beat = np.round((centre - timing.phase) / timing.period)
+    off_beat = np.abs(centre - timing.predict(beat)) > RING
+    keep = centre[(gap > half) & off_beat]
+    return keep[:CHANCE_WINDOWS]
+
+
+def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:
+    """A metronome's sound: its clean ticks' `QUIET` before the onset and first `SOUND`
+    after it, band-passed, each aligned to the first by cross-correlation, averaged and
+    normalised (None: too few)."""
+    if ticks_s.size < MIN_SOUND_TICKS:
+        return None
+    pick = ticks_s[np.linspace(0, ticks_s.size - 1, min(SOUND_TICKS, ticks_s.size)).astype(int)]
+    rate = recording.sample_rate
+    n = round((QUIET + SOUND) * rate)
+    quiet = round(QUIET * rate)
+    slack = round(det.RESOLUTION * rate)
+    reference = None
+    total = np.zeros(n)
+    for t in pick:
+        x = _band(recording, scan, round(t * rate) - quiet - slack, n + 2 * slack)
+        if reference is None:
+            reference = x[slack : slack + n]
+            total += reference
+            continue
+        lag = int(np.argmax(np.correlate(x, reference, mode="valid")))
+        total += x[lag : lag + n]
+    total -= total.mean()
+    norm = np.linalg.norm(total)
+    return total / norm if norm > 0 else None
+
+
+def _band(recording, scan, start: int, length: int) -> np.ndarray:
+    """The band-passed channel mix of frames [start, start + length)."""
+    pad = length
+    x = recording.segment(start - pad, start + length + pad).mean(axis=1)
+    return signal.sosfiltfilt(scan.sos, x)[pad : pad + length]
+
+
+def _match(recording, scan, sound: np.ndarray, centres, half: float):
+    """(the largest normalised cross-correlation of ``sound`` with the recording over
+    each window centre ± half (s), and the time (s) where it is)."""
+    rate = recording.sample_rate
+    n, w, quiet = sound.size, round(half * rate), round(QUIET * rate)
+    score, at = np.empty(len(centres)), np.empty(len(centres))
+    for i, c in enumerate(centres):
+        start = round(c * rate) - w - quiet
+        x = _band(recording, scan, start, 2 * w + n)
+        dot = np.correlate(x, sound, mode="valid")
+        s1 = np.concatenate([[0.0], np.cumsum(x)])
+        s2 = np.concatenate([[0.0], np.cumsum(x * x)])
+        sums, squares = s1[n:] - s1[:-n], s2[n:] - s2[:-n]
+        spread = np.sqrt(np.maximum(squares - sums * sums / n, 1e-30))
+        ncc = dot / spread  # the sound has mean 0 and norm 1
+        best = int(np.argmax(ncc))
+        score[i], at[i] = ncc[best], (start + best + quiet) / rate
+    return score, at
 
 
 def _chance_level(curve: np.ndarray, near_onset: np.ndarray, width: int) -> float:

@@ -119,7 +119,7 @@ def analyze_timing(
         # the beats no onset was detected at, sought where each metronome's timing puts
         # them, and every onset explained again with them
         found, whose = seek(recording, scan, impacts, heard)
-        joined = _joined(impacts, found)
+        joined = impacts.joined(found)
         in_time = np.argsort(joined.time, kind="stable")
         impacts = _subset(joined, in_time)
         owner = np.concatenate([owner, whose])[in_time]
@@ -342,9 +342,3 @@ def _impact_words(impacts: int, heard: list[Heard], clutter: int) -> str:
     per = (impacts - clutter) / max(ticks, 1)
     return (f"{plural(ticks, 'tick')} of {plural(len(heard), 'metronome')} "
             f"({per:.1f} impacts a tick), {plural(clutter, 'onset')} of clutter")  # fmt: skip
-
-
-def _joined(a: det.Ticks, b: det.Ticks) -> det.Ticks:
-    """The onsets of ``a`` then those of ``b``, every field alike."""
-    return det.Ticks(*(np.concatenate([getattr(a, f), getattr(b, f)])
-                       for f in det.Ticks.__dataclass_fields__))  # fmt: skip
