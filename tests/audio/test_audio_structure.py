@@ -207,3 +207,14 @@ def test_a_strike_s_rare_large_errors_stay_the_strike_s(seed):
     assert s.main_impact.offset == pytest.approx(0.0, abs=2e-4)
     label = structure._assigned(offsets, every, s, reach=0.2)
     assert np.all(label[: beats.size] == s.main)
+
+
+def test_the_uniformity_test_is_scipy_s_kolmogorov_smirnov():
+    from scipy.stats import kstest
+
+    rng = np.random.default_rng(1)
+    for n in (5, 12, 40, 300):
+        for power in (1.0, 2.0, 3.0):  # uniform, and ever less so
+            u = rng.uniform(size=n) ** power
+            expected = kstest(u, lambda x: np.clip(x, 0.0, 1.0)).pvalue
+            assert structure._uniformity_p(u) == pytest.approx(expected, rel=1e-12, abs=1e-300)

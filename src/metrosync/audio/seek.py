@@ -182,28 +182,24 @@ def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:
     pick = ticks_s[np.linspace(0, ticks_s.size - 1, min(SOUND_TICKS, ticks_s.size)).astype(int)]
     rate = recording.sample_rate
     n = round((QUIET + SOUND) * rate)
-    quiet = round(QUIET * rate)
     slack = round(det.RESOLUTION * rate)
-    reference = None
-    total = np.zeros(n)
-    for t in pick:
-        x = _band(recording, scan, round(t * rate) - quiet - slack, n + 2 * slack)
-        if reference is None:
-            reference = x[slack : slack + n]
-            total += reference
-            continue
-        lag = int(np.argmax(np.correlate(x, reference, mode="valid")))
-        total += x[lag : lag + n]
+    starts = np.round(pick * rate).astype(np.int64) - round(QUIET * rate) - slack
+    x = _bands(recording, scan, starts, n + 2 * slack)
+    reference = x[0, slack : slack + n]
+    total = reference.copy()
+    for row in x[1:]:
+        lag = int(np.argmax(np.correlate(row, reference, mode="valid")))
+        total += row[lag : lag + n]
     total -= total.mean()
     norm = np.linalg.norm(total)
     return total / norm if norm > 0 else None
 
 
-def _band(recording, scan, start: int, length: int) -> np.ndarray:
-    """The band-passed channel mix of frames [start, start + length)."""
-    pad = length
-    x = recording.segment(start - pad, start + length + pad).mean(axis=1)
-    return signal.sosfiltfilt(scan.sos, x)[pad : pad + length]
+def _bands(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
+    """(K, length) the band-passed channel mix of frames [start, start + length) for each
+    of ``starts``, filtered together (each padded by its own length on both sides)."""
+    x = np.stack([recording.segment(a - length, a + 2 * length).mean(axis=1) for a in starts])
+    return signal.sosfiltfilt(scan.sos, x, axis=1)[:, length : 2 * length]
 
 
 def _match(recording, scan, sound: np.ndarray, centres, half: float):
@@ -211,19 +207,19 @@ def _match(recording, scan, sound: np.ndarray, centres, half: float):
     each window centre ± half (s), and the time (s) where it is)."""
     rate = recording.sample_rate
     n, w, quiet = sound.size, round(half * rate), round(QUIET * rate)
-    score, at = np.empty(len(centres)), np.empty(len(centres))
-    for i, c in enumerate(centres):
-        start = round(c * rate) - w - quiet
-        x = _band(recording, scan, start, 2 * w + n)
-        dot = np.correlate(x, sound, mode="valid")
-        s1 = np.concatenate([[0.0], np.cumsum(x)])
-        s2 = np.concatenate([[0.0], np.cumsum(x * x)])
-        sums, squares = s1[n:] - s1[:-n], s2[n:] - s2[:-n]
-        spread = np.sqrt(np.maximum(squares - sums * sums / n, 1e-30))
-        ncc = dot / spread  # the sound has mean 0 and norm 1
-        best = int(np.argmax(ncc))
-        score[i], at[i] = ncc[best], (start + best + quiet) / rate
-    return score, at
+    starts = np.round(np.asarray(centres, dtype=float) * rate).astype(np.int64) - w - quiet
+    if not starts.size:
+        return np.zeros(0), np.zeros(0)
+    x = _bands(recording, scan, starts, 2 * w + n)
+    dot = np.lib.stride_tricks.sliding_window_view(x, n, axis=1) @ sound
+    s1 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x, axis=1)], axis=1)
+    s2 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x * x, axis=1)], axis=1)
+    sums, squares = s1[:, n:] - s1[:, :-n], s2[:, n:] - s2[:, :-n]
+    spread = np.sqrt(np.maximum(squares - sums * sums / n, 1e-30))
+    ncc = dot / spread  # the sound has mean 0 and norm 1
+    best = np.argmax(ncc, axis=1)
+    score = ncc[np.arange(ncc.shape[0]), best]
+    return score, (starts + best + quiet) / rate
 
 
 def _chance_level(curve: np.ndarray, near_onset: np.ndarray, width: int) -> float:
