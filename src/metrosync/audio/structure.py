@@ -378,10 +378,18 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
     end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
     while True:
         inside = np.flatnonzero(t <= end)
+        last = None
         for _ in range(ROUNDS):
             explained = _explain(t[inside], timing, None if level is None else level[inside])
             mains = inside[explained[2]]
             beats = explained[0][explained[2]]
+            if (
+                last is not None
+                and np.array_equal(mains, last[0])
+                and np.array_equal(beats, last[1])
+            ):
+                break  # the same ticks refit the same timing: settled
+            last = (mains, beats)
             enough = drift and mains.size >= DRIFT_TICKS
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         if end >= t[-1]:
