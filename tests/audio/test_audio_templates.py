@@ -247,3 +247,13 @@ def test_a_tick_two_trains_take_as_hidden_sounds_as_each_of_them():
                         [1, 2, 3, 4], np.array([0.535]), np.array([2]))  # fmt: skip
     assert sorted(s for s, _ in around[0]) == [1, 2]
     assert tp.ringing(times, (ticks, whose), np.array([0.535, 0.7])).tolist() == [True, False]
+
+
+def test_where_no_tick_sounds_nothing_rings():
+    # a real video's sound track, whose trains had no sounding tick, ended in an
+    # IndexError here
+    times = np.array([0.1, 0.5, 0.9])
+    none = (np.zeros(0, dtype=np.int64),)
+    assert tp.ringing(times, none, np.array([0.2, 0.6])).tolist() == [False, False]
+    ring = tp.ringing(times, (np.array([0, 1]),), np.array([0.12, 0.5 + tp.AFTER + 0.05]))
+    assert ring.tolist() == [True, False]

@@ -371,6 +371,8 @@ def ringing(times: np.ndarray, sources, at: np.ndarray) -> np.ndarray:
     ``sources`` (`sounding`, in the order of these ``times``) that begins before it:
     in its ring."""
     h = times[sources[0]]
+    if h.size == 0:  # no tick sounds: nothing rings (a video's sound track with no train)
+        return np.zeros(np.shape(at), dtype=bool)
     j = np.searchsorted(h, at, side="left")
     return (j > 0) & (at - h[np.maximum(j - 1, 0)] <= AFTER)
 
