@@ -496,10 +496,21 @@ def _start(t: np.ndarray, period: float) -> Timing:
         near = order[first & (miss[order] <= reach)]
         if near.size < 4:
             break
-        slope, phase = np.polyfit(number[near], stretch[near], 1)
-        trial = slope / 2
+        slope, line = np.polyfit(number[near], stretch[near], 1)
+        # kept only where it holds as many onsets within ±WINDOW as the fold did: a
+        # line through the nearest onsets of a precursor whose lead wanders (or a
+        # codec's pre-echo) runs off the beat
+        if _held(stretch, line, slope) < _held(stretch, phase, 2 * trial):
+            break
+        phase, trial = line, slope / 2
     phase -= trial * math.floor((phase - t[0]) / trial)
     return Timing(float(phase), float(trial), 0.0, 0.0, 0.0, (0.0,) * 4, 0)
+
+
+def _held(t: np.ndarray, phase: float, swing: float) -> int:
+    """How many onsets ``t`` lie within ±`WINDOW` of phase + k·swing."""
+    miss = t - phase - np.round((t - phase) / swing) * swing
+    return int(np.sum(np.abs(miss) <= WINDOW))
 
 
 def _nearest_beats(t: np.ndarray, timing: Timing) -> tuple[np.ndarray, np.ndarray]:
