@@ -94,11 +94,14 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
     # onset, two metronomes of one tempo would both lock on the one found first
     mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
+        before = (list(starts), mains)
         metronomes, owner = _refollow(t, level, starts, metronomes, mains)
         kept = _without_redundant(metronomes, t.size)
         starts = [starts[m] for m in kept]
         metronomes = [metronomes[m] for m in kept]
         mains = _mains_of(metronomes, t.size)
+        if starts == before[0] and np.array_equal(mains, before[1]):
+            break  # the same ticks set aside: another pass would follow the same
     metronomes, owner = one_tick_an_onset(t, metronomes, owner)
     order = np.argsort([m.followed.timing.period for m in metronomes])[::-1]
     relabel = np.full(len(metronomes) + 1, -1)

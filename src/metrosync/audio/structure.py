@@ -378,7 +378,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
     end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
     while True:
         inside = np.flatnonzero(t <= end)
-        last = None
+        last, settled = None, False
         for _ in range(ROUNDS):
             explained = _explain(t[inside], timing, None if level is None else level[inside])
             mains = inside[explained[2]]
@@ -388,14 +388,17 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
                 and np.array_equal(mains, last[0])
                 and np.array_equal(beats, last[1])
             ):
-                break  # the same ticks refit the same timing: settled
+                settled = True  # the same ticks refit the same timing
+                break
             last = (mains, beats)
             enough = drift and mains.size >= DRIFT_TICKS
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         if end >= t[-1]:
             break
         end = max(_reach_of(timing, end), t[0] + 1.25 * (end - t[0]))
-    beat, impact, main, structures = _explain(t, timing, level)
+    if not (settled and inside.size == t.size):  # else the last round's is this one
+        explained = _explain(t, timing, level)
+    beat, impact, main, structures = explained
     return Followed(timing, structures, beat, impact, main)
 
 
