@@ -218,3 +218,27 @@ def test_the_uniformity_test_is_scipy_s_kolmogorov_smirnov():
             u = rng.uniform(size=n) ** power
             expected = kstest(u, lambda x: np.clip(x, 0.0, 1.0)).pvalue
             assert structure._uniformity_p(u) == pytest.approx(expected, rel=1e-12, abs=1e-300)
+
+
+def test_another_metronome_in_a_whole_number_ratio_is_no_impact_but_a_random_one_is():
+    # 40 beats of one kind: a bounce at a random third of them, another metronome
+    # ticking 5 beats to this one's 3 near one offset at every third beat of the kind
+    rng = np.random.default_rng(4)
+    beats = np.arange(0, 80, 2)
+    main = beats
+    bounce = beats[rng.uniform(size=beats.size) < 0.35]
+    neighbour = beats[::3]
+    every = np.concatenate([main, bounce, neighbour])
+    label = np.repeat([0, 1, 2], [main.size, bounce.size, neighbour.size])
+    assert structure._locked(every, label, 3).tolist() == [False, False, True]
+    # odd beats (the tock's) alike, and the main impact is not tested
+    assert structure._locked(every + 1, label, 3).tolist() == [False, False, True]
+    assert not structure._locked(neighbour, np.zeros(neighbour.size, dtype=int), 1).any()
+    # over many random bounces, hardly ever one taken for a neighbour
+    taken = 0
+    for seed in range(200):
+        r = np.random.default_rng(seed)
+        b = beats[r.uniform(size=beats.size) < r.uniform(0.2, 0.9)]
+        taken += structure._locked(np.concatenate([main, b]),
+                                   np.repeat([0, 1], [main.size, b.size]), 2)[1]  # fmt: skip
+    assert taken <= 2

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from scipy.stats import kstwo
+from scipy.stats import chi2, kstwo
 from scipy.stats import t as student_t
 
 from ..errors import AnalysisError
@@ -70,6 +70,10 @@ MIN_SPREAD = 0.2e-3
 #: False-alarm probability of the test that takes a component for another metronome's
 #: beat passing (`_passing`): an impact of this tick is taken for one this seldom.
 PASSING_P = 1e-3
+#: Largest m of the m-to-n ratios of beats in which another metronome is sought among a
+#: tick's impacts (`_locked`): the ratios of two tempi in 30-300 BPM that put the
+#: other's ticks near this one's offsets often enough to be learned as an impact.
+LOCKED_MAX = 6
 #: Widest, s: a quieter impact ahead of the strike wanders by several milliseconds tick
 #: to tick (a Neewer's by 11-42 ms, a spread of about 8), but keeps to its tick; the
 #: onsets of a metronome whose beat slides past this one's spread far wider.
@@ -179,7 +183,8 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     # a component wider than an impact wanders is no impact: the onsets of another
     # metronome whose beat slides past this one's (clutter, left for it to be found);
     # nor is one whose onsets come in a few runs of beats, not all along (`_passing`)
-    wide = (spreads > MAX_SPREAD) | _passing(b, np.argmax(resp, axis=1), means.size)
+    label = np.argmax(resp, axis=1)
+    wide = (spreads > MAX_SPREAD) | _passing(b, label, means.size) | _locked(b, label, means.size)
     if wide.all():
         wide[np.argmin(spreads)] = False
     if wide.any():
@@ -222,6 +227,35 @@ def _passing(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
         mine = beats[label == j]
         if mine.size >= ONSETS_PER_IMPACT:
             out[j] = _uniformity_p(np.clip((mine - lo) / width, 0.0, 1.0)) < PASSING_P
+    return out
+
+
+def _locked(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
+    """(count,) which components of a tick's mixture are another metronome ticking in a
+    ratio of small whole numbers with this one (m beats of this kind to n of its): an
+    impact is struck at each beat of its kind by chance (its presence), whatever the
+    beat's number, but such a neighbour falls near the same offset only every m-th
+    beat, in one residue of the beat's number modulo m. A χ² test of each component's
+    residues modulo m = 2 … `LOCKED_MAX` against the beats available in each, at
+    false-alarm probability `PASSING_P` over the m tried; the first component (started
+    on the main impact) is not tested."""
+    out = np.zeros(count, dtype=bool)
+    if beats.size == 0:
+        return out
+    index = (beats - beats.min()) // 2  # the beat's number among those of its kind
+    available = np.arange(int(index.max()) + 1)
+    tried = LOCKED_MAX - 1
+    for j in range(1, count):
+        mine = index[label == j]
+        if mine.size < ONSETS_PER_IMPACT:
+            continue
+        for m in range(2, LOCKED_MAX + 1):
+            expected = np.bincount(available % m, minlength=m) * mine.size / available.size
+            seen = np.bincount(mine % m, minlength=m)
+            statistic = float(np.sum((seen - expected) ** 2 / np.maximum(expected, 1e-12)))
+            if chi2.sf(statistic, m - 1) < PASSING_P / tried:
+                out[j] = True
+                break
     return out
 
 
