@@ -10,7 +10,11 @@ Gaussians N(o_j, s_j²) weighted p_j, plus a uniform component. It is fitted by
 expectation–maximisation, with the number of impacts chosen by the Bayesian
 information criterion (BIC); nothing about how many impacts a tick has, in which order
 or how far apart, is assumed. A component whose onsets come in runs of beats rather
-than all along is another metronome's beat sliding past, and is clutter (`_passing`).
+than all along is another metronome's beat sliding past, and is clutter (`_passing`);
+so is one whose onsets keep to one residue of the beat's number modulo a small m,
+another metronome ticking in a whole-number ratio with this one (`_locked`). Each
+beat's onsets are then paired one-to-one with the impacts (`_assigned`: an impact is
+struck once a beat at most), the strike's timing taken as Student-t (`timing.DOF`).
 
 The tick's time is the time of its most regular impact, the one of smallest spread
 among those heard in at least `MIN_PRESENCE` of the beats: the escapement's impact,
