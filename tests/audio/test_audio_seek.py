@@ -38,15 +38,14 @@ def test_a_tick_in_another_s_ring_is_timed_by_its_sound(tmp_path):
     quiet, loud = voices(2, 4)
     tick = 0.3 * quiet.waveform(RATE)
     ring = loud.waveform(RATE)
-    folder = tmp_path
     clean_times = 0.2 + 0.3 * np.arange(12)
-    clean = _file(folder, "clean.wav", [(t, tick) for t in clean_times])
+    clean = _file(tmp_path, "clean.wav", [(t, tick) for t in clean_times])
     scan = det.scan(clean)
     sound = seek._sound(clean, scan, clean_times)
     assert sound is not None and np.linalg.norm(sound) == pytest.approx(1.0)
     # the tick 12 ms into the loud one's ring, and a window in the ring alone
     t0 = 1.0123
-    mixed = _file(folder, "mixed.wav", [(1.0, ring), (t0, tick), (2.0, ring)], seed=1)
+    mixed = _file(tmp_path, "mixed.wav", [(1.0, ring), (t0, tick), (2.0, ring)], seed=1)
     score, at = seek._match(mixed, det.scan(mixed), sound, np.array([t0 + 1e-3, 2.0123]), 2e-3)
     assert at[0] == pytest.approx(t0, abs=0.2e-3)
     assert score[0] > 0.5 > score[1]

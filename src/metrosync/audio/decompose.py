@@ -94,13 +94,14 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
     # onset, two metronomes of one tempo would both lock on the one found first
     mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
-        before = (list(starts), mains)
-        metronomes, owner = _refollow(t, level, starts, metronomes, mains)
+        metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains)
         kept = _without_redundant(metronomes, t.size)
-        starts = [starts[m] for m in kept]
+        tempi = [tempi[m] for m in kept]
         metronomes = [metronomes[m] for m in kept]
-        mains = _mains_of(metronomes, t.size)
-        if starts == before[0] and np.array_equal(mains, before[1]):
+        now = _mains_of(metronomes, t.size)
+        settled = tempi == starts and np.array_equal(now, mains)
+        starts, mains = tempi, now
+        if settled:
             break  # the same ticks set aside: another pass would follow the same
     metronomes, owner = one_tick_an_onset(t, metronomes, owner)
     order = np.argsort([m.followed.timing.period for m in metronomes])[::-1]
@@ -265,28 +266,30 @@ def _is_metronome(followed: Followed) -> bool:
 
 
 def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains):
-    """Each metronome followed again, from the tempo it was first followed from, on every
-    onset but the other metronomes' ticks (``mains``: (K,) the metronome whose tick each
-    onset is, −1 for none), keeping its last model where that fails; an onset two
-    metronomes explain goes to the one whose learned tick makes it likelier
-    (`_density`)."""
+    """(the metronomes, each onset's owner, the tempo each was followed from): each
+    metronome followed again, from the tempo it was first followed from (or twice it,
+    `_at_its_tempo`), on every onset but the other metronomes' ticks (``mains``: (K,) the
+    metronome whose tick each onset is, −1 for none), keeping its last model where that
+    fails; an onset two metronomes explain goes to the one whose learned tick makes it
+    likelier (`_density`)."""
     heard: list[Heard] = []
+    tempi = list(starts)
     density = np.zeros((len(starts), t.size))
     for m, bpm in enumerate(starts):
         pool = np.flatnonzero((mains < 0) | (mains == m))
         followed = _metronome(t[pool], bpm, _part(level, pool))
         if followed is not None:
-            starts[m], followed = _at_its_tempo(t[pool], bpm, followed, _part(level, pool))
+            tempi[m], followed = _at_its_tempo(t[pool], bpm, followed, _part(level, pool))
         one = before[m] if followed is None else Heard(followed, pool)
         density[m, one.pool] = _density(t[one.pool], one.followed)
         heard.append(one)
     if not heard:
-        return [], np.full(t.size, -1)
+        return [], np.full(t.size, -1), tempi
     owner = np.where(density.max(axis=0) > 0, np.argmax(density, axis=0), -1)
     for m, one in enumerate(heard):  # a tick is its metronome's, however far off its beat
         ticks = one.ticks
         owner[ticks[owner[ticks] < 0]] = m
-    return heard, owner
+    return heard, owner, tempi
 
 
 def _density(t: np.ndarray, followed: Followed) -> np.ndarray:

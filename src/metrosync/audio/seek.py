@@ -67,6 +67,7 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
     clear = int(np.ceil(CLEAR / hop))
     for shift in range(-clear, clear + 1):
         near_onset[np.clip(onset_hops + shift, 0, scan.curve.size - 1)] = True
+    in_order = np.sort(onset_hops)
     found_hops, whose, unfound = [], [], []
     for m, h in enumerate(heard):
         timing = h.followed.timing
@@ -85,7 +86,8 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
             if near_onset[lo:hi].any():
                 # an onset just before hides the beat from the curve, not from its sound;
                 # one inside the window is another's, which hid this one
-                if not np.any((onset_hops >= lo) & (onset_hops < hi)):
+                first = np.searchsorted(in_order, lo)
+                if first == in_order.size or in_order[first] >= hi:
                     unfound.append((m, int(kind), c * hop, half * hop))
                 continue
             window = scan.curve[lo:hi]
