@@ -73,3 +73,11 @@ def test_a_tick_whose_impacts_come_from_one_place_is_one_metronome():
     times, levels, _ = _locked_pair(0.0)
     heard, _ = decompose(times, channel_levels=levels)
     assert len(heard) == 1 and len(heard[0].followed.structure[0].impacts) == 2
+
+
+def test_a_tempo_window_holds_when_a_metronome_is_followed_again():
+    # asked for 42.5-57.5 BPM, a 100 BPM metronome is heard at half its tempo; followed
+    # again, it must not be taken at twice that, outside the window
+    _, onsets = mixture([100.0], seed=2)
+    heard, _ = decompose(onsets, bpm_range=(42.5, 57.5))
+    assert heard and all(42.5 <= h.followed.timing.bpm <= 57.5 for h in heard)

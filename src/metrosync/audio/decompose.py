@@ -94,7 +94,7 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
     # onset, two metronomes of one tempo would both lock on the one found first
     mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
-        metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains)
+        metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains, bpm_range)
         kept = _without_redundant(metronomes, t.size)
         tempi = [tempi[m] for m in kept]
         metronomes = [metronomes[m] for m in kept]
@@ -265,13 +265,14 @@ def _is_metronome(followed: Followed) -> bool:
     return span >= MIN_BEATS and beats.size >= MIN_HEARD * span
 
 
-def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains):
+def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains,
+              bpm_range=BPM_RANGE):  # fmt: skip
     """(the metronomes, each onset's owner, the tempo each was followed from): each
-    metronome followed again, from the tempo it was first followed from (or twice it,
-    `_at_its_tempo`), on every onset but the other metronomes' ticks (``mains``: (K,) the
-    metronome whose tick each onset is, −1 for none), keeping its last model where that
-    fails; an onset two metronomes explain goes to the one whose learned tick makes it
-    likelier (`_density`)."""
+    metronome followed again, from the tempo it was first followed from (or twice it
+    within ``bpm_range``, `_at_its_tempo`), on every onset but the other metronomes'
+    ticks (``mains``: (K,) the metronome whose tick each onset is, −1 for none), keeping
+    its last model where that fails; an onset two metronomes explain goes to the one
+    whose learned tick makes it likelier (`_density`)."""
     heard: list[Heard] = []
     tempi = list(starts)
     density = np.zeros((len(starts), t.size))
@@ -279,7 +280,9 @@ def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], ma
         pool = np.flatnonzero((mains < 0) | (mains == m))
         followed = _metronome(t[pool], bpm, _part(level, pool))
         if followed is not None:
-            tempi[m], followed = _at_its_tempo(t[pool], bpm, followed, _part(level, pool))
+            tempi[m], followed = _at_its_tempo(
+                t[pool], bpm, followed, _part(level, pool), bpm_range
+            )
         one = before[m] if followed is None else Heard(followed, pool)
         density[m, one.pool] = _density(t[one.pool], one.followed)
         heard.append(one)
