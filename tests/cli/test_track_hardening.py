@@ -143,7 +143,16 @@ def test_long_work_is_warned_of_from_the_measured_rate(two_rods, capsys, monkeyp
                      r"`max_side` \(--resolution\) \(now 640\)", warned[0]), warned[0]  # fmt: skip
 
 
-def test_the_line_before_the_work_states_the_header_only(two_rods, capsys):
+def test_the_line_before_the_work_states_the_header_only(two_rods, capsys, monkeypatch):
+    # the rate is measured only after CALIBRATION_SECONDS of tracking: on a fast machine
+    # these 240 small frames are all tracked sooner, and the line is rightly not given
+    measure = angles.RodGauge.measure
+
+    def slow(self, *args):
+        time.sleep(0.003)
+        return measure(self, *args)
+
+    monkeypatch.setattr(angles.RodGauge, "measure", slow)
     code, _, err = run(capsys, two_rods, "--no-sound")
     assert code == 0, err
     first, second = err.strip().splitlines()[:2]
