@@ -81,3 +81,14 @@ def test_a_tempo_window_holds_when_a_metronome_is_followed_again():
     _, onsets = mixture([100.0], seed=2)
     heard, _ = decompose(onsets, bpm_range=(42.5, 57.5))
     assert heard and all(42.5 <= h.followed.timing.bpm <= 57.5 for h in heard)
+
+
+def test_a_metronome_followed_at_a_quarter_of_its_tempo_is_taken_at_its_tempo():
+    from metrosync.audio.decompose import _at_its_tempo, _metronome
+
+    loud, onsets = metronome(160.0, 40.0, seed=6)
+    quarter = _metronome(onsets, 40.0)
+    assert quarter is not None  # every fourth beat is a metronome too
+    bpm, followed = _at_its_tempo(onsets, 40.0, quarter, None)
+    assert bpm == 160.0 and followed.timing.bpm == pytest.approx(160.0, abs=0.1)
+    assert np.allclose(np.sort(onsets[followed.ticks]), loud)

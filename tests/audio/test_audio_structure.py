@@ -242,3 +242,16 @@ def test_another_metronome_in_a_whole_number_ratio_is_no_impact_but_a_random_one
         taken += structure._locked(np.concatenate([main, b]),
                                    np.repeat([0, 1], [main.size, b.size]), 2)[1]  # fmt: skip
     assert taken <= 2
+
+
+def test_a_kind_hidden_for_the_first_seconds_is_heard_after_them():
+    # other metronomes' ticks can hide one kind's (here the tocks) for seconds on end:
+    # the first stretch grows until the tock is heard in half its beats
+    loud, onsets = metronome(83.5, 40.0, precursor=(0.011, 0.042, 0.5), seed=3)
+    k = np.arange(loud.size)
+    hidden = (loud < 12.0) & (k % 2 == 1) & (k > 1)
+    near = np.abs(onsets[:, None] - loud[hidden][None, :]) < 0.06  # the whole tick
+    onsets = onsets[~near.any(axis=1)]
+    found = follow(onsets, 83.5)
+    assert found.timing.bpm == pytest.approx(83.5, abs=0.1)
+    assert np.allclose(np.sort(onsets[found.ticks]), loud[~hidden])

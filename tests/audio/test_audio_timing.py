@@ -93,3 +93,17 @@ def test_beats_are_numbered_through_gaps_and_drift():
     truth, t = ticks(k, period=0.3, drift=-1e-6, limp=0.03, seed=7)  # 200 → 203 BPM
     heard = np.delete(np.arange(1500), [5, 6, 100, 700, 701, 702])
     assert np.array_equal(number_beats(t[heard], 0.3), heard)
+
+
+def test_the_doubled_timing_puts_its_even_beats_on_the_beats_it_came_from():
+    k = np.arange(0, 120)
+    # a timing at half a metronome's tempo spans tick and tock in each beat: no limp
+    _, t = ticks(k, limp=0.0, drift=3e-5, jitter=0.3e-3, seed=4)
+    t = t + np.cumsum(np.cumsum(np.random.default_rng(5).normal(0, 2e-5, k.size)))  # a wander
+    slow = fit_timing(t, k, wander=True)
+    assert slow.wander is not None
+    fast = slow.doubled()
+    assert fast.bpm == pytest.approx(2 * slow.bpm)
+    assert np.allclose(fast.predict(2 * k), slow.predict(k) - slow.limp * slow.period / 2 * (k % 2),
+                       atol=1e-9)
+    assert fast.mean_bpm(0, 236) == pytest.approx(2 * slow.mean_bpm(0, 118))

@@ -234,12 +234,13 @@ def _at_its_tempo(t: np.ndarray, bpm: float, followed: Followed, level, bpm_rang
     metronome too, on every other beat, its other ticks left over; followed at twice
     the tempo it hears twice the ticks, where a metronome at its own tempo followed at
     twice hears no more (`HALF_TEMPO`)."""
-    double = 2.0 * bpm
-    if double > bpm_range[1]:
-        return bpm, followed
-    faster = _metronome(t, double, level)
-    if faster is not None and faster.main.sum() > HALF_TEMPO * followed.main.sum():
-        return double, faster
+    while 2.0 * bpm <= bpm_range[1]:
+        # from its timing at half the tempo, not afresh: other metronomes' ticks can
+        # hide one kind's for the first stretch a fresh timing is fitted on
+        faster = _metronome(t, 2.0 * bpm, level, start=followed.timing.doubled())
+        if faster is None or faster.main.sum() <= HALF_TEMPO * followed.main.sum():
+            break
+        bpm, followed = 2.0 * bpm, faster  # and a quarter of its tempo is half of half
     return bpm, followed
 
 
@@ -247,10 +248,11 @@ def _part(level, index):
     return None if level is None else level[index]
 
 
-def _metronome(t: np.ndarray, bpm: float, level=None) -> Followed | None:
-    """The metronome followed from ``bpm`` among onsets ``t``, if it is one."""
+def _metronome(t: np.ndarray, bpm: float, level=None, start=None) -> Followed | None:
+    """The metronome followed from ``bpm`` (or the timing ``start``) among onsets ``t``,
+    if it is one."""
     try:
-        followed = follow(t, bpm, level)
+        followed = follow(t, bpm, level, start=start)
     except AnalysisError:
         return None
     return followed if _is_metronome(followed) else None

@@ -399,9 +399,11 @@ _LOG_ROOT_2PI = 0.5 * math.log(2.0 * math.pi)
 _SETTLED = 1e-12
 
 
-def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed:
+def follow(times, bpm: float, strengths=None, *, drift: bool = True,
+           start: Timing | None = None) -> Followed:  # fmt: skip
     """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``
-    (their ``strengths``, dB, tell a strike from a bounce as regular as it).
+    (their ``strengths``, dB, tell a strike from a bounce as regular as it); from the
+    timing ``start`` where one is known over the whole recording (then ``bpm`` is its).
 
     The timing is first fitted on the first `FIRST_STRETCH` seconds, then on longer
     stretches, each as far as the last fit predicts well (`_reach_of`) and numbered by
@@ -412,13 +414,26 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
     """
     t = np.asarray(times, dtype=float)
     level = None if strengths is None else np.asarray(strengths, dtype=float)
-    timing = _start(t, 60.0 / float(bpm))
-    end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
+    if start is None:
+        timing = _start(t, 60.0 / float(bpm))
+        end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
+    else:
+        timing, end = start, t[-1]
+    first = True
     while True:
         inside = np.flatnonzero(t <= end)
         last, settled = None, False
         for _ in range(ROUNDS):
-            explained = _explain(t[inside], timing, None if level is None else level[inside])
+            try:
+                explained = _explain(t[inside], timing, None if level is None else level[inside])
+            except AnalysisError:
+                if not first or last is not None or end >= t[-1]:
+                    raise
+                # other metronomes' ticks can hide a kind's for seconds on end: the
+                # first stretch is doubled until its ticks are heard in half its beats
+                end = t[0] + 2.0 * (end - t[0])
+                inside = np.flatnonzero(t <= end)
+                continue
             mains = inside[explained[2]]
             beats = explained[0][explained[2]]
             if (
@@ -431,6 +446,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True) -> Followed
             last = (mains, beats)
             enough = drift and mains.size >= DRIFT_TICKS
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
+        first = False
         if end >= t[-1]:
             break
         end = max(_reach_of(timing, end), t[0] + 1.25 * (end - t[0]))

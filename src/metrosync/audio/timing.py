@@ -97,6 +97,19 @@ class Timing:
         model = self.phase + k * self.period + limp + 0.5 * self.drift * k**2
         return model if self.wander is None else model + self.wander.at(k)
 
+    def doubled(self) -> Timing:
+        """The timing at twice the tempo whose even beat 2k is this one's beat k (the
+        limp at twice the tempo unknown, taken as none): where a metronome was followed
+        at half its tempo, its other beats fall between."""
+        wander = self.wander
+        if wander is not None:
+            wander = Wander(2 * wander.beats, wander.offset, wander.rate / 2, wander.q / 2**1.5)
+        half = self.period / 2
+        # the drift per beat of half the length is a quarter: ½(Ṫ/4)(2k)² = ½Ṫk²
+        return Timing(self.phase, half, 0.0, self.drift / 4, self.jitter,
+                      (self.errors[0], self.errors[1] / 2, 0.0, self.errors[3] / 4),
+                      self.ticks, wander)  # fmt: skip
+
     def residuals(self, times, beats) -> np.ndarray:
         """Heard minus predicted time of each tick, s."""
         return np.asarray(times, dtype=float) - self.predict(beats)
