@@ -7,6 +7,7 @@ from metrosync.audio import structure
 from metrosync.audio.periodicity import candidate_tempi
 from metrosync.audio.structure import follow, learn_structure
 from metrosync.audio.timing import Timing
+from metrosync.errors import AnalysisError
 
 
 def metronome(bpm, duration, *, limp=0.039, jitter=0.5e-3, precursor=(0.011, 0.042, 0.88),
@@ -255,3 +256,25 @@ def test_a_kind_hidden_for_the_first_seconds_is_heard_after_them():
     found = follow(onsets, 83.5)
     assert found.timing.bpm == pytest.approx(83.5, abs=0.1)
     assert np.allclose(np.sort(onsets[found.ticks]), loud[~hidden])
+
+
+def _hidden_for_a_while(seed=2):
+    """A 185 BPM metronome whose ticks another's hide from 30 s to 36 s, while the pull
+    of the others shortens its beat by 0.2 %; and clutter."""
+    rng = np.random.default_rng(seed)
+    period = 60 / 185
+    t = 0.2 + np.arange(int(60 / period)) * period
+    after = t > 30
+    t[after] -= np.cumsum(np.full(after.sum(), 0.002 * period))
+    t = t + rng.normal(0, 0.2e-3, t.size)
+    heard = t[(t < 30) | (t > 36)]
+    return heard, np.sort(np.concatenate([heard, rng.uniform(0, 60, 40)]))
+
+
+def test_ticks_lost_behind_another_s_are_found_again_where_they_come_out():
+    ticks, onsets = _hidden_for_a_while()
+    found = follow(onsets, 185.0, refind=True)
+    assert np.allclose(np.sort(onsets[found.ticks]), ticks)
+    # carried past the gap, the timing misses the ticks after it by 12 ms and more
+    with pytest.raises(AnalysisError, match="half the beats"):
+        follow(onsets, 185.0)

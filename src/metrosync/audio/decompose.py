@@ -27,6 +27,8 @@ import numpy as np
 
 from ..errors import AnalysisError
 from .periodicity import BPM_RANGE, candidate_tempi
+from .sounds import Sounds, learn_sounds
+from .tempo import HINT_RANGE
 from .structure import Followed, explained_by, follow
 
 #: Share of its beats a metronome's main impact must be heard in.
@@ -66,12 +68,14 @@ class Heard:
         return self.followed.beat[self.followed.main]
 
 
-def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
-              ) -> tuple[list[Heard], np.ndarray]:  # fmt: skip
+def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None,
+              features=None) -> tuple[list[Heard], np.ndarray]:  # fmt: skip
     """Metronomes that explain the sorted onset ``times`` (s), with their ``strengths``
     (dB, optional: they tell a strike from a bounce as regular as it), and each onset's
     owner. ``channel_levels`` (K, C), dB, each onset's level at each microphone
-    (optional): the impacts of one tick come from one place (`elsewhere`)."""
+    (optional): the impacts of one tick come from one place (`elsewhere`).
+    ``features`` (K, D), each onset's sound (`voices.Features.matrix`, optional): an
+    onset that sounds like another metronome is not followed as this one's (`sounds`)."""
     t = np.asarray(times, dtype=float)
     level = None if strengths is None else np.asarray(strengths, dtype=float)
     place = _placement(channel_levels)
@@ -94,7 +98,11 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None
     # onset, two metronomes of one tempo would both lock on the one found first
     mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
-        metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains, bpm_range)
+        sounds = None if features is None else learn_sounds(
+            features, [h.ticks for h in metronomes], [np.mod(h.beats, 2) for h in metronomes], t
+        )
+        metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains, bpm_range,
+                                             sounds)  # fmt: skip
         kept = _without_redundant(metronomes, t.size)
         tempi = [tempi[m] for m in kept]
         metronomes = [metronomes[m] for m in kept]
@@ -248,11 +256,12 @@ def _part(level, index):
     return None if level is None else level[index]
 
 
-def _metronome(t: np.ndarray, bpm: float, level=None, start=None) -> Followed | None:
+def _metronome(t: np.ndarray, bpm: float, level=None, start=None, refind=False
+               ) -> Followed | None:  # fmt: skip
     """The metronome followed from ``bpm`` (or the timing ``start``) among onsets ``t``,
-    if it is one."""
+    if it is one (``refind`` as `follow` takes it)."""
     try:
-        followed = follow(t, bpm, level, start=start)
+        followed = follow(t, bpm, level, start=start, refind=refind)
     except AnalysisError:
         return None
     return followed if _is_metronome(followed) else None
@@ -268,19 +277,27 @@ def _is_metronome(followed: Followed) -> bool:
 
 
 def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains,
-              bpm_range=BPM_RANGE):  # fmt: skip
+              bpm_range=BPM_RANGE, sounds: Sounds | None = None):  # fmt: skip
     """(the metronomes, each onset's owner, the tempo each was followed from): each
     metronome followed again, from the tempo it was first followed from (or twice it
     within ``bpm_range``, `_at_its_tempo`), on every onset but the other metronomes'
     ticks (``mains``: (K,) the metronome whose tick each onset is, −1 for none), keeping
     its last model where that fails; an onset two metronomes explain goes to the one
-    whose learned tick makes it likelier (`_density`)."""
+    whose learned tick makes it likelier (`_density`). With their ``sounds`` learned,
+    an onset that sounds like another metronome is not this one's, and one that sounds
+    like this one is, whoever's tick the pursuit made it."""
     heard: list[Heard] = []
     tempi = list(starts)
     density = np.zeros((len(starts), t.size))
     for m, bpm in enumerate(starts):
-        pool = np.flatnonzero((mains < 0) | (mains == m))
-        followed = _metronome(t[pool], bpm, _part(level, pool))
+        free = (mains < 0) | (mains == m)
+        refind = False
+        if sounds is not None:
+            twins = _twins(t, before, sounds, m)
+            free = (free | np.isin(mains, twins) | sounds.mine(m)) & ~sounds.others(m)
+            refind = bool(twins) or sounds.told_apart(m, [h.ticks for h in before])
+        pool = np.flatnonzero(free)
+        followed = _metronome(t[pool], bpm, _part(level, pool), refind=refind)
         if followed is not None:
             tempi[m], followed = _at_its_tempo(
                 t[pool], bpm, followed, _part(level, pool), bpm_range
@@ -295,6 +312,24 @@ def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], ma
         ticks = one.ticks
         owner[ticks[owner[ticks] < 0]] = m
     return heard, owner, tempi
+
+
+def _twins(t: np.ndarray, heard: list[Heard], sounds: Sounds, m: int) -> list[int]:
+    """The metronomes that may be m itself, lost for a while and found again as
+    another: of its sound (not told apart from it, `Sounds.others`), near its tempo
+    (`HINT_RANGE`), heard only before its first tick or after its last."""
+    mine = heard[m].ticks
+    out = []
+    for j, other in enumerate(heard):
+        if j == m or not other.ticks.size or not mine.size:
+            continue
+        alike = (np.mean(sounds.others(m)[other.ticks]) < 0.5
+                 and np.mean(sounds.others(j)[mine]) < 0.5)  # fmt: skip
+        near = abs(other.followed.timing.bpm / heard[m].followed.timing.bpm - 1) <= HINT_RANGE
+        apart = t[other.ticks].min() > t[mine].max() or t[other.ticks].max() < t[mine].min()
+        if alike and near and apart:
+            out.append(j)
+    return out
 
 
 def _density(t: np.ndarray, followed: Followed) -> np.ndarray:

@@ -400,10 +400,13 @@ _SETTLED = 1e-12
 
 
 def follow(times, bpm: float, strengths=None, *, drift: bool = True,
-           start: Timing | None = None) -> Followed:  # fmt: skip
+           start: Timing | None = None, refind: bool = False) -> Followed:  # fmt: skip
     """The metronome at about ``bpm`` whose ticks best explain the onsets ``times``
     (their ``strengths``, dB, tell a strike from a bounce as regular as it); from the
     timing ``start`` where one is known over the whole recording (then ``bpm`` is its).
+    ``refind``: where the ticks are lost for a while, they are found again after
+    (`_found_again`), for onsets that hold no other metronome's ticks (told apart by
+    their sound): among others', what comes out of the gap may be another's train.
 
     The timing is first fitted on the first `FIRST_STRETCH` seconds, then on longer
     stretches, each as far as the last fit predicts well (`_reach_of`) and numbered by
@@ -447,6 +450,10 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
             enough = drift and mains.size >= DRIFT_TICKS
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         first = False
+        again = _found_again(t, level, timing, mains, beats, end) if refind else None
+        if again is not None:  # refitted with the ticks after the gap; the stretch again
+            timing, end = again
+            continue
         if end >= t[-1]:
             break
         end = max(_reach_of(timing, end), t[0] + 1.25 * (end - t[0]))
@@ -456,17 +463,60 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
     return Followed(timing, structures, beat, impact, main)
 
 
+def _found_again(t, level, timing: Timing, mains, beats, end: float):
+    """(the timing refitted, the stretch's new end) where the ticks were lost before
+    ``end``, or None. Another metronome's ticks can hide this one's for seconds (two
+    falling into step sound as one), and the timing, carried past them, then misses
+    the ticks where they come out: with `FIRST_BEATS` beats' time of onsets after the
+    last tick, a timing is started afresh on them (`_start`) and its beats numbered by
+    the old timing's prediction, where that is sure to the beat (its spread under a
+    quarter of one)."""
+    if mains.size == 0:
+        return None
+    period = float(timing.period_at(beats.max()))
+    t_last = float(t[mains].max())
+    if end - t_last < FIRST_BEATS * period:
+        return None
+    after = np.flatnonzero(t > t_last + REACH * period)
+    if after.size < FIRST_BEATS // 2:
+        return None
+    local = _start(t[after], period)
+    stretch = after[t[after] <= t[after[0]] + max(FIRST_STRETCH, FIRST_BEATS * period)]
+    try:
+        explained = _explain(t[stretch], local, None if level is None else level[stretch])
+    except AnalysisError:
+        return None  # nothing regular after the gap
+    k0 = int(_nearest_beats(np.array([local.phase]), timing)[0][0])
+    if _spread_at(timing, k0) > period / 4:
+        return None  # the gap is too long to count its beats
+    more = stretch[explained[2]]
+    numbers = explained[0][explained[2]] + k0
+    later = numbers > beats.max()
+    if not later.any():
+        return None
+    joined = np.concatenate([mains, more[later]])
+    refit = fit_timing(t[joined], np.concatenate([beats, numbers[later]]),
+                       drift=joined.size >= DRIFT_TICKS, wander=True)  # fmt: skip
+    return refit, max(end, float(t[more].max()))
+
+
+def _spread_at(timing: Timing, k: float) -> float:
+    """The standard deviation of the timing's prediction of beat ``k``, s: its
+    parameters' errors and the wander's random walk past its last tick."""
+    sp, st, _, sd = timing.errors
+    wander = 0.0
+    if timing.wander is not None:
+        wander = timing.wander.spread_after(k - float(timing.wander.beats[-1]))
+    return math.sqrt(sp**2 + (k * st) ** 2 + (0.5 * k * k * sd) ** 2 + wander**2)
+
+
 def _reach_of(timing: Timing, end: float) -> float:
     """How far past ``end`` the timing predicts a beat within a third of `WINDOW`, by its
     parameters' errors (at most twice as far from the start as ``end``): beyond, the
     main impact's offsets would smear past the bump that finds it."""
-    sp, st, _, sd = timing.errors
     k_end = (end - timing.phase) / timing.period
-    last = k_end if timing.wander is None else float(timing.wander.beats[-1])
     for k in np.arange(k_end, 2 * k_end + 1, 1.0):
-        wander = 0.0 if timing.wander is None else timing.wander.spread_after(k - last)
-        spread = math.sqrt(sp**2 + (k * st) ** 2 + (0.5 * k * k * sd) ** 2 + wander**2)
-        if spread > WINDOW / 3:
+        if _spread_at(timing, k) > WINDOW / 3:
             return float(timing.predict(k))
     return float(timing.predict(2 * k_end))
 

@@ -60,6 +60,7 @@ from .separation import sureness
 from .structure import Structure
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
+from .voices import impact_features
 
 
 def analyze_timing(
@@ -114,7 +115,8 @@ def analyze_timing(
     impacts = _subset(impacts, np.argsort(impacts.time, kind="stable"))
     if impacts.time.size < MIN_TICKS:
         beat_period(impacts.time)  # raises the error that says what to try
-    heard, owner = _metronomes(impacts, bpm)
+    sound = impact_features(recording, impacts.time).matrix()
+    heard, owner = _metronomes(impacts, bpm, sound)
     if heard:
         # the beats no onset was detected at, sought where each metronome's timing puts
         # them, and every onset explained again with them
@@ -240,13 +242,15 @@ def _open(path, band):
     return record_together(path, band=band)
 
 
-def _metronomes(impacts: det.Ticks, bpm: float | None) -> tuple[list[Heard], np.ndarray]:
+def _metronomes(impacts: det.Ticks, bpm: float | None, sound=None
+                ) -> tuple[list[Heard], np.ndarray]:  # fmt: skip
     """The metronomes that explain the impacts (`decompose`), loudest first, and each
     impact's owner (−1: clutter). Given ``bpm``, where none heard is near it, they are
     sought within `HINT_RANGE` of it (a setting the user knows rules out a harmonic
     or a slower tempo the ticks also fit)."""
     heard, owner = decompose(
-        impacts.time, impacts.strength, channel_levels=impacts.channel_strength
+        impacts.time, impacts.strength, channel_levels=impacts.channel_strength,
+        features=sound,
     )
     if bpm is not None and not any(abs(60.0 / _own_period(h) / bpm - 1) <= HINT_RANGE
                                    for h in heard):  # fmt: skip
@@ -257,6 +261,7 @@ def _metronomes(impacts: det.Ticks, bpm: float | None) -> tuple[list[Heard], np.
             impacts.strength,
             bpm_range=window,
             channel_levels=impacts.channel_strength,
+            features=sound,
         )
         # taken where it explains the onsets as well: a third of a tempo heard, say, fits
         # every third tick as well as the tempo does, and leaves the rest unexplained
