@@ -29,15 +29,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .voices import SPREAD_FLOOR
+from .voices import FEATURE_LEAD, FEATURE_LENGTH, SPREAD_FLOOR
 
 #: Log-likelihood ratio (natural log) above which an onset is another's by its sound.
 APART = math.log(1000.0)
 #: Ticks a kind's sound is learned from at least.
 MIN_TICKS = 8
-#: No other onset this near a tick (s) for its sound to be learned from it: the
-#: features read 6 ms after an onset less as long before it.
-CLEAR = 15e-3
+#: No other onset this near a tick (s) for its sound to be learned from it, or judged:
+#: the features read the sound from just before the onset to 6 ms after it, less as
+#: long before (another's onset in those windows makes it two sounds at once).
+CLEAR = FEATURE_LEAD + FEATURE_LENGTH
 
 
 @dataclass(frozen=True)
