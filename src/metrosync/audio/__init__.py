@@ -13,6 +13,14 @@ train made of another's missed beats, given back to it), `recovery`
 (several microphones aligned), `metronome` (one metronome's tempo, jitter and beat),
 `order` (the acoustic order parameter and clusters), `attribution` (the phase of one
 metronome in another's beat), `plots`.
+
+The timing model that is to replace the stages (`timing_analysis.analyze_timing`,
+``metrosync analyze --analysis timing``; docs/sound.md) is made of `timing` (a
+metronome's timing model), `wander` (its beat's smooth wander), `periodicity`
+(candidate tempi by epoch folding), `structure` (a tick's impacts learned from the
+recording, and a metronome followed), `decompose` (the onsets explained as metronomes
+and clutter), `sounds` (each metronome's sound, and whose an onset is by it) and
+`seek` (beats no onset was detected at, sought where the timing puts them).
 `analyze_audio` is imported on first use (it needs scipy and xarray), so that the
 reader's checks stay quick to import.
 """
