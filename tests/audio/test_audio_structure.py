@@ -258,6 +258,17 @@ def test_a_kind_hidden_for_the_first_seconds_is_heard_after_them():
     assert np.allclose(np.sort(onsets[found.ticks]), loud[~hidden])
 
 
+def test_a_kind_hidden_for_50_s_is_heard_after_it_however_many_doublings_it_takes():
+    # the first stretch doubled four times: each doubling is no round of the fit
+    loud, onsets = metronome(83.5, 600.0, precursor=(0.011, 0.042, 0.5), seed=3)
+    k = np.arange(loud.size)
+    hidden = (loud < 50.0) & (k % 2 == 1) & (k > 1)
+    near = np.abs(onsets[:, None] - loud[hidden][None, :]) < 0.06
+    onsets = onsets[~near.any(axis=1)]
+    found = follow(onsets, 83.5)
+    assert np.allclose(np.sort(onsets[found.ticks]), loud[~hidden])
+
+
 def _hidden_for_a_while(seed=2):
     """A 185 BPM metronome whose ticks another's hide from 30 s to 36 s, while the pull
     of the others shortens its beat by 0.2 %; and clutter."""

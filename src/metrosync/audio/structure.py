@@ -422,11 +422,11 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
         end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
     else:
         timing, end = start, t[-1]
-    first = True
+    first, lost_at = True, -math.inf
     while True:
         inside = np.flatnonzero(t <= end)
-        last, settled = None, False
-        for _ in range(ROUNDS):
+        last, settled, rounds = None, False, 0
+        while rounds < ROUNDS:
             try:
                 explained = _explain(t[inside], timing, None if level is None else level[inside])
             except AnalysisError:
@@ -437,6 +437,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
                 end = t[0] + 2.0 * (end - t[0])
                 inside = np.flatnonzero(t <= end)
                 continue
+            rounds += 1
             mains = inside[explained[2]]
             beats = explained[0][explained[2]]
             if (
@@ -450,7 +451,10 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
             enough = drift and mains.size >= DRIFT_TICKS
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         first = False
-        again = _found_again(t, level, timing, mains, beats, end) if refind else None
+        again = None
+        if refind and mains.size and t[mains].max() > lost_at:  # each gap sought once
+            lost_at = float(t[mains].max())
+            again = _found_again(t, level, timing, mains, beats, end)
         if again is not None:  # refitted with the ticks after the gap; the stretch again
             timing, end = again
             continue
