@@ -452,10 +452,10 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
             timing = fit_timing(t[mains], beats, drift=enough, wander=drift)
         first = False
         again = None
-        if refind and mains.size and t[mains].max() > lost_at:  # each gap sought once
-            lost_at = float(t[mains].max())
+        if refind and mains.size and t[mains].max() > lost_at:  # each gap crossed once
             again = _found_again(t, level, timing, mains, beats, end)
         if again is not None:  # refitted with the ticks after the gap; the stretch again
+            lost_at = float(t[mains].max())
             timing, end = again
             continue
         if end >= t[-1]:
