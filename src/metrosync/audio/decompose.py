@@ -28,8 +28,8 @@ import numpy as np
 from ..errors import AnalysisError
 from .periodicity import BPM_RANGE, candidate_tempi
 from .sounds import Sounds, learn_sounds
-from .tempo import HINT_RANGE
 from .structure import Followed, explained_by, follow
+from .tempo import HINT_RANGE
 
 #: Share of its beats a metronome's main impact must be heard in.
 MIN_HEARD = 0.5
@@ -98,9 +98,10 @@ def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None,
     # onset, two metronomes of one tempo would both lock on the one found first
     mains = _mains_of(metronomes, t.size)
     for _ in range(PASSES):
-        sounds = None if features is None else learn_sounds(
-            features, [h.ticks for h in metronomes], [np.mod(h.beats, 2) for h in metronomes], t
-        )
+        sounds = None
+        if features is not None:
+            ticks, kinds = [h.ticks for h in metronomes], [np.mod(h.beats, 2) for h in metronomes]
+            sounds = learn_sounds(features, ticks, kinds, t)
         metronomes, owner, tempi = _refollow(t, level, starts, metronomes, mains, bpm_range,
                                              sounds)  # fmt: skip
         kept = _without_redundant(metronomes, t.size)

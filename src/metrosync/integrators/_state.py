@@ -17,9 +17,11 @@ from ..observables.mechanics import platform_momentum
 from ..status import STATUS_DIVERGED, STATUS_OK
 from ._abi import Recording, State
 
-
 #: Which of `StepState`'s two tuples holds each field.
-_PART_OF = {**dict.fromkeys(Recording._fields, "recording"), **dict.fromkeys(State._fields, "state")}
+_PART_OF = {
+    **dict.fromkeys(Recording._fields, "recording"),
+    **dict.fromkeys(State._fields, "state"),
+}
 
 
 @dataclass
