@@ -35,19 +35,24 @@ def r_from_crossings(ds, crossings, *, merge):
     return o.r
 
 
-@pytest.fixture(scope="module", params=["clean", "noise+reverb 10 dB"])
-def analysed(request, listen_run, tmp_path_factory):
+def recording(condition, listen_run, tmp_path_factory):
+    """The listen WAV, clean or with reverberation and noise at 10 dB SNR."""
     path, crossings = listen_run
-    if request.param != "clean":
+    if condition != "clean":
         x, rate = sf.read(str(path))
         rng = np.random.default_rng(15)
         x = clicks.add_noise(clicks.add_reverb(x, rng, rate), 10.0, crossings, rng, rate)
         path = clicks.write(tmp_path_factory.mktemp("noisy") / "noisy.wav", x, rate)
-    return analyze_audio(path, metronomes=3), crossings
+    return path
 
 
-def test_clicks_found_within_a_millisecond(analysed):
-    ds, crossings = analysed
+@pytest.fixture(scope="module", params=["clean", "noise+reverb 10 dB"])
+def analysed(request, listen_run, tmp_path_factory):
+    path = recording(request.param, listen_run, tmp_path_factory)
+    return analyze_audio(path, metronomes=3), listen_run[1]
+
+
+def assert_clicks_found_within_a_millisecond(ds, crossings):
     found = ds.tick_time.values
     times, alone = score.resolvable(crossings, ds.attrs["resolution"])
     recall, _, errors = score.match(times[alone], found)
@@ -55,6 +60,10 @@ def test_clicks_found_within_a_millisecond(analysed):
     assert recall >= 0.99 and precision >= 0.99
     assert np.abs(errors).max() <= 1e-3
     assert ds.attrs["beat_period"] == pytest.approx(beat_period(np.sort(times)), rel=1e-3)
+
+
+def test_clicks_found_within_a_millisecond(analysed):
+    assert_clicks_found_within_a_millisecond(*analysed)
 
 
 def test_acoustic_order_parameter_within_005_of_the_crossings(analysed):
@@ -70,25 +79,13 @@ def timed(request, listen_run, tmp_path_factory):
     """The same recordings read by the timing model (`analyze_timing`)."""
     from metrosync.audio.timing_analysis import analyze_timing
 
-    path, crossings = listen_run
-    if request.param != "clean":
-        x, rate = sf.read(str(path))
-        rng = np.random.default_rng(15)
-        x = clicks.add_noise(clicks.add_reverb(x, rng, rate), 10.0, crossings, rng, rate)
-        path = clicks.write(tmp_path_factory.mktemp("noisy") / "noisy.wav", x, rate)
-    return analyze_timing(path, metronomes=3), crossings
+    path = recording(request.param, listen_run, tmp_path_factory)
+    return analyze_timing(path, metronomes=3), listen_run[1]
 
 
 def test_the_timing_model_finds_the_clicks_of_three_falling_into_step(timed):
     # each metronome's own sound keeps it through the crossings (benchmarks/audio_listen.py)
-    ds, crossings = timed
-    found = ds.tick_time.values
-    times, alone = score.resolvable(crossings, ds.attrs["resolution"])
-    recall, _, errors = score.match(times[alone], found)
-    _, precision, _ = score.match(times, found)
-    assert recall >= 0.99 and precision >= 0.99
-    assert np.abs(errors).max() <= 1e-3
-    assert ds.attrs["beat_period"] == pytest.approx(beat_period(np.sort(times)), rel=1e-3)
+    assert_clicks_found_within_a_millisecond(*timed)
 
 
 def test_the_timing_model_s_order_parameter_is_the_crossings_own(timed):
