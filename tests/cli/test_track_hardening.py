@@ -123,9 +123,10 @@ def test_the_time_left_is_measured_on_the_frames_tracked(two_rods, capsys, monke
     assert 0.5 * took <= float(found[2]) <= 2.0 * took, (line, took)
 
 
-def test_long_work_is_warned_of_from_the_measured_rate(two_rods, capsys, monkeypatch):
-    import metrosync.budget
-
+@pytest.fixture
+def slow_rods(monkeypatch):
+    """Each rod measured 3 ms slower, so that the rate is measured (after
+    CALIBRATION_SECONDS of tracking) on any machine, and a few seconds are "long"."""
     measure = angles.RodGauge.measure
 
     def slow(self, *args):
@@ -133,6 +134,11 @@ def test_long_work_is_warned_of_from_the_measured_rate(two_rods, capsys, monkeyp
         return measure(self, *args)
 
     monkeypatch.setattr(angles.RodGauge, "measure", slow)
+
+
+def test_long_work_is_warned_of_from_the_measured_rate(two_rods, capsys, monkeypatch, slow_rods):
+    import metrosync.budget
+
     monkeypatch.setattr(metrosync.budget, "WARN_SECONDS", 0.5)  # a few minutes, scaled down
     code, _, err = run(capsys, two_rods, "--no-sound")
     assert code == 0, err
@@ -143,16 +149,9 @@ def test_long_work_is_warned_of_from_the_measured_rate(two_rods, capsys, monkeyp
                      r"`max_side` \(--resolution\) \(now 640\)", warned[0]), warned[0]  # fmt: skip
 
 
-def test_the_line_before_the_work_states_the_header_only(two_rods, capsys, monkeypatch):
+def test_the_line_before_the_work_states_the_header_only(two_rods, capsys, slow_rods):
     # the rate is measured only after CALIBRATION_SECONDS of tracking: on a fast machine
     # these 240 small frames are all tracked sooner, and the line is rightly not given
-    measure = angles.RodGauge.measure
-
-    def slow(self, *args):
-        time.sleep(0.003)
-        return measure(self, *args)
-
-    monkeypatch.setattr(angles.RodGauge, "measure", slow)
     code, _, err = run(capsys, two_rods, "--no-sound")
     assert code == 0, err
     first, second = err.strip().splitlines()[:2]

@@ -48,21 +48,19 @@ class Sounds:
     loglik : (M, K) ℓ_m of each onset's features (NaN for a metronome not learned).
     learned : (M,) whether each metronome's sound was learned.
     clear : (K,) whether each onset is clear of others (`CLEAR`).
+    margin : (M, K) ℓ_m less the largest ℓ of the other learned metronomes (NaN where
+        m or no other was learned): positive where the onset sounds likelier m's.
     """
 
     loglik: np.ndarray
     learned: np.ndarray
     clear: np.ndarray
+    margin: np.ndarray
 
     def others(self, m: int) -> np.ndarray:
         """(K,) clear onsets another learned metronome's sound explains `APART` better
         (a crowded onset's sound is two at once: nothing is said of it)."""
-        if not self.learned[m] or self.loglik.shape[0] < 2:
-            return np.zeros(self.loglik.shape[1], dtype=bool)
-        rest = np.delete(self.loglik, m, axis=0)[np.delete(self.learned, m)]
-        if rest.size == 0:
-            return np.zeros(self.loglik.shape[1], dtype=bool)
-        return self.clear & (rest.max(axis=0) - self.loglik[m] > APART)
+        return self.clear & (self.margin[m] < -APART)
 
     def told_apart(self, m: int, ticks: list[np.ndarray]) -> bool:
         """Whether every other metronome's ticks (``ticks[j]``, indices of onsets) sound,
@@ -74,11 +72,9 @@ class Sounds:
                    if j != m and own.size)  # fmt: skip
 
     def mine(self, m: int) -> np.ndarray:
-        """(K,) onsets whose sound is m's, `APART` better than every other learned one."""
-        if not self.learned[m] or np.sum(self.learned) < 2:
-            return np.zeros(self.loglik.shape[1], dtype=bool)
-        rest = np.delete(self.loglik, m, axis=0)[np.delete(self.learned, m)]
-        return self.clear & (self.loglik[m] - rest.max(axis=0) > APART)
+        """(K,) clear onsets whose sound is m's, `APART` better than every other learned
+        one."""
+        return self.clear & (self.margin[m] > APART)
 
 
 def learn_sounds(x: np.ndarray, ticks: list[np.ndarray], kinds: list[np.ndarray],
@@ -110,7 +106,16 @@ def learn_sounds(x: np.ndarray, ticks: list[np.ndarray], kinds: list[np.ndarray]
         elif len(parts) == 1:  # one kind heard clearly enough: its sound stands for both
             loglik[m] = parts[0]
             learned[m] = True
-    return Sounds(loglik, learned, clear)
+    return Sounds(loglik, learned, clear, _margins(loglik, learned))
+
+
+def _margins(loglik: np.ndarray, learned: np.ndarray) -> np.ndarray:
+    """(M, K) each learned metronome's ℓ less the largest of the other learned ones'."""
+    margin = np.full(loglik.shape, np.nan)
+    index = np.flatnonzero(learned)
+    for m in index if index.size > 1 else ():
+        margin[m] = loglik[m] - loglik[index[index != m]].max(axis=0)
+    return margin
 
 
 def _clear(t: np.ndarray) -> np.ndarray:

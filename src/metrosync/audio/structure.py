@@ -453,7 +453,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
         first = False
         again = None
         if refind and mains.size and t[mains].max() > lost_at:  # each gap crossed once
-            again = _found_again(t, level, timing, mains, beats, end)
+            again = _found_again(t, level, timing, mains, beats, end, drift)
         if again is not None:  # refitted with the ticks after the gap; the stretch again
             lost_at = float(t[mains].max())
             timing, end = again
@@ -467,16 +467,14 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
     return Followed(timing, structures, beat, impact, main)
 
 
-def _found_again(t, level, timing: Timing, mains, beats, end: float):
+def _found_again(t, level, timing: Timing, mains, beats, end: float, drift: bool):
     """(the timing refitted, the stretch's new end) where the ticks were lost before
     ``end``, or None. Another metronome's ticks can hide this one's for seconds (two
     falling into step sound as one), and the timing, carried past them, then misses
     the ticks where they come out: with `FIRST_BEATS` beats' time of onsets after the
     last tick, a timing is started afresh on them (`_start`) and its beats numbered by
     the old timing's prediction, where that is sure to the beat (its spread under a
-    quarter of one)."""
-    if mains.size == 0:
-        return None
+    quarter of one); refitted as `follow` fits (``drift``)."""
     period = float(timing.period_at(beats.max()))
     t_last = float(t[mains].max())
     if end - t_last < FIRST_BEATS * period:
@@ -500,7 +498,7 @@ def _found_again(t, level, timing: Timing, mains, beats, end: float):
         return None
     joined = np.concatenate([mains, more[later]])
     refit = fit_timing(t[joined], np.concatenate([beats, numbers[later]]),
-                       drift=joined.size >= DRIFT_TICKS, wander=True)  # fmt: skip
+                       drift=drift and joined.size >= DRIFT_TICKS, wander=drift)  # fmt: skip
     return refit, max(end, float(t[more].max()))
 
 
