@@ -21,6 +21,8 @@
     python benchmarks/audio.py            # all
     python benchmarks/audio.py --accuracy # only the second
     python benchmarks/audio.py --corpus   # only the third
+    python benchmarks/audio.py --corpus --baseline da6763e  # the ten minutes timed with
+        # revision da6763e's analysis too, in turn with this tree's (A B A B)
     python benchmarks/audio.py --seeds 12-23  # the corpus's recordings of seeds 12-23
                                               # (one to four metronomes), not timed
     python benchmarks/audio.py --seeds 0-239 --failures  # and a line for each wrong
@@ -29,6 +31,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import statistics
 import subprocess
 import sys
@@ -129,8 +132,10 @@ def corpus_recording(n, seed, folder, duration=40.0, bpms=None, drift=0.1):
     return rec.write(folder / f"corpus{n}_{seed}.wav"), [t.times for t in rec.truth]
 
 
-def measured_command(args: list[str]) -> tuple[float, float, float, str]:
-    """``metrosync ARGS`` in a fresh process: (wall s, CPU s, peak memory MiB, stdout).
+def measured_command(args: list[str], root: Path | None = None
+                     ) -> tuple[float, float, float, str]:  # fmt: skip
+    """``metrosync ARGS`` in a fresh process: (wall s, CPU s, peak memory MiB, stdout);
+    from the source of the worktree ``root`` where given (`_baseline`).
 
     The peak is the process's own high-water mark (VmHWM), read inside it at the end.
     Not `getrusage`'s ru_maxrss: Linux carries the peak of the process that spawned it
@@ -144,8 +149,10 @@ def measured_command(args: list[str]) -> tuple[float, float, float, str]:
     )
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
+    from _baseline import environment
+
     done = subprocess.run([sys.executable, "-c", probe, *args], check=True,
-                          capture_output=True, text=True)  # fmt: skip
+                          capture_output=True, text=True, env=environment(root))  # fmt: skip
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -153,20 +160,26 @@ def measured_command(args: list[str]) -> tuple[float, float, float, str]:
     return wall, cpu, peak, done.stdout
 
 
-def timed_analysis(folder: Path) -> None:
+def timed_analysis(folder: Path, baseline: str | None = None) -> None:
     """Ten minutes of four metronomes through a phone, analysed in a fresh process: wall
-    time, CPU time (user + system of the child) and peak memory."""
+    time, CPU time (user + system of the child) and peak memory; with ``baseline`` (a
+    revision), that revision's analysis of the same file too, the two in turn, twice."""
     subprocess.run([sys.executable, __file__, "--make-corpus", str(folder)], check=True)
-    # the stages and the timing model in turn, on the same file in the same run
-    for analysis in ("stages", "timing"):
-        wall, cpu, peak, stdout = measured_command(
-            ["analyze", str(folder / "corpus4_7.wav"), "--analysis", analysis]
-        )
-        found = [line.strip() for line in stdout.splitlines() if "metronome" in line][:6]
-        print(f"10 min, 4 real-sounding metronomes through a phone: metrosync analyze "
-              f"--analysis {analysis}: {wall:.1f} s wall, {cpu:.1f} s CPU (fresh process), "
-              f"peak memory {peak:.0f} MiB")  # fmt: skip
-        print("  " + "\n  ".join(found))
+    command = ["analyze", str(folder / "corpus4_7.wav")]
+    with contextlib.ExitStack() as stack:
+        trees = [("this tree", None)]
+        if baseline is not None:
+            from _baseline import checkout
+
+            trees = [(f"revision {baseline}", stack.enter_context(checkout(baseline))),
+                     *trees] * 2  # fmt: skip
+        for name, root in trees:
+            wall, cpu, peak, stdout = measured_command(command, root=root)
+            found = [line.strip() for line in stdout.splitlines() if "metronome" in line][:6]
+            print(f"10 min, 4 real-sounding metronomes through a phone, metrosync analyze "
+                  f"({name}): {wall:.1f} s wall, {cpu:.1f} s CPU (fresh process), peak "
+                  f"memory {peak:.0f} MiB")  # fmt: skip
+            print("  " + "\n  ".join(found))
 
 
 def seeds_option(default: range = range(6)) -> list[int]:
@@ -184,13 +197,24 @@ def seeds_option(default: range = range(6)) -> list[int]:
         sys.exit(f"--seeds {text!r}: give a range A-B or a list A,B,C of whole numbers")
 
 
-def realistic(folder: Path, seeds: list[int], timed: bool = True) -> None:
+def baseline_option() -> str | None:
+    """The revision after ``--baseline``, or None."""
+    if "--baseline" not in sys.argv:
+        return None
+    at = sys.argv.index("--baseline") + 1
+    if at >= len(sys.argv) or sys.argv[at].startswith("-"):
+        sys.exit("--baseline needs a revision, e.g. --baseline da6763e")
+    return sys.argv[at]
+
+
+def realistic(folder: Path, seeds: list[int], timed: bool = True,
+              baseline: str | None = None) -> None:  # fmt: skip
     import warnings
 
     from metrosync.synthetic.score import hearable, scores
 
     if timed:
-        timed_analysis(folder)
+        timed_analysis(folder, baseline)
     right, rows, heard = [], [], []
     for n in (1, 2, 3, 4):
         for seed in seeds:
@@ -234,7 +258,8 @@ def print_failures(n: int, seed: int, found: int, table) -> None:
             print(f"n={n} seed={seed} metronome {k}: recall {recall:.3f} precision {precision:.3f}")
 
 
-OPTIONS = ("--accuracy", "--corpus", "--seeds", "--failures", "--make", "--make-corpus")
+OPTIONS = ("--accuracy", "--corpus", "--baseline", "--seeds", "--failures", "--make",
+           "--make-corpus")
 
 
 def main() -> None:
@@ -256,7 +281,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         if "--corpus" in sys.argv or "--seeds" in sys.argv:
-            realistic(folder, seeds_option(), timed="--seeds" not in sys.argv)
+            realistic(folder, seeds_option(), timed="--seeds" not in sys.argv,
+                      baseline=baseline_option())
             return
         if "--accuracy" in sys.argv:
             accuracy(folder)

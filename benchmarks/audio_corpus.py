@@ -19,11 +19,14 @@ The figures (targets of the sound model):
     python benchmarks/audio_corpus.py --split dev                 # tune on this
     python benchmarks/audio_corpus.py --split heldout --jobs 2    # report this
     python benchmarks/audio_corpus.py --split dev --limit 10 --json dev.json
-    python benchmarks/audio_corpus.py --split dev --analysis timing   # the timing model
+    python benchmarks/audio_corpus.py --split heldout --baseline da6763e  # beside an
+        # older revision's analysis (da6763e: the stages the timing model replaced)
 
 --limit K keeps the first K mixed recordings and the first K single ones of each tick
 structure. --json FILE writes every recording's result and the summary;
 --from-json FILE prints the table of such a file again, analysing nothing.
+--baseline REV scores revision REV's analysis first, by REV's own copy of this script
+(from a temporary git worktree, with the same options), then this tree's.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ import datetime  # noqa: E402
 import json  # noqa: E402
 import multiprocessing  # noqa: E402
 import platform  # noqa: E402
+import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -56,21 +60,9 @@ from metrosync.synthetic.structures import STRUCTURES  # noqa: E402
 HEARD = 0.5
 
 
-#: The analyses that can be scored, by name: today's stages, and the timing model that is
-#: to replace them (`metrosync.audio.timing_analysis`).
-ANALYSES = {
-    "stages": ("metrosync.audio.dataset", "analyze_audio"),
-    "timing": ("metrosync.audio.timing_analysis", "analyze_timing"),
-}
-
-
-def run_one(task: tuple[Entry, str]) -> dict:
+def run_one(entry: Entry) -> dict:
     """Make, analyse and score one recording: a dict of plain values (JSON)."""
-    import importlib
-
-    entry, analysis = task
-    module, name = ANALYSES[analysis]
-    analyze_audio = getattr(importlib.import_module(module), name)
+    from metrosync.audio import analyze_audio
 
     t0 = time.perf_counter()
     plan = entry.plan()
@@ -229,9 +221,9 @@ def main(argv: list[str] | None = None) -> int:
         description="Score the sound analysis on the benchmark corpus's recordings."
     )
     parser.add_argument("--split", choices=sorted(SPLITS))
-    parser.add_argument("--analysis", choices=sorted(ANALYSES), default="stages",
-                        help="which analysis to score: today's stages (analyze_audio) or "
-                        "the timing model (analyze_timing)")  # fmt: skip
+    parser.add_argument("--baseline", metavar="REV", default=None,
+                        help="score revision REV's analysis first (its own copy of this "
+                        "script, same options), then this tree's")  # fmt: skip
     parser.add_argument(
         "--limit",
         type=int,
@@ -261,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--limit must be a whole number >= 1, got {args.limit}")
     if args.jobs < 1:
         parser.error(f"--jobs must be a whole number >= 1, got {args.jobs}")
+    if args.baseline is not None:
+        _score_baseline(args.baseline, argv if argv is not None else sys.argv[1:])
     todo = chosen(args.split, args.limit)
     order = {e.name: i for i, e in enumerate(todo)}
     print(f"corpus version {VERSION}, split {args.split}: {len(todo)} recordings, "
@@ -269,7 +263,7 @@ def main(argv: list[str] | None = None) -> int:
     results = []
     context = multiprocessing.get_context("spawn")
     with context.Pool(args.jobs) as pool:
-        for r in pool.imap_unordered(run_one, [(e, args.analysis) for e in todo]):
+        for r in pool.imap_unordered(run_one, todo):
             results.append(r)
             elapsed = time.perf_counter() - started
             left = elapsed / len(results) * (len(todo) - len(results))
@@ -291,7 +285,7 @@ def main(argv: list[str] | None = None) -> int:
         document = {
             "corpus_version": VERSION,
             "split": args.split,
-            "analysis": args.analysis,
+            "revision": _revision(),
             "limit": args.limit,
             "command": " ".join(["python", "benchmarks/audio_corpus.py", *sys.argv[1:]]),
             "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
@@ -304,6 +298,36 @@ def main(argv: list[str] | None = None) -> int:
         args.json.write_text(json.dumps(document, indent=1) + "\n", encoding="utf-8")
         print(f"results: {args.json}")
     return 0
+
+
+def _score_baseline(rev: str, argv: list[str]) -> None:
+    """Revision ``rev``'s own copy of this script, with these options but --baseline and
+    --json, on its own source."""
+    from _baseline import checkout, environment
+
+    rest, skip = [], 0
+    for a in argv:
+        if skip:
+            skip -= 1
+        elif a in ("--baseline", "--json"):
+            skip = 1
+        elif not a.startswith(("--baseline=", "--json=")):
+            rest.append(a)
+    with checkout(rev) as root:
+        print(f"--- revision {rev} ---", flush=True)
+        subprocess.run([sys.executable, str(root / "benchmarks" / "audio_corpus.py"), *rest],
+                       env=environment(root), check=True)  # fmt: skip
+    print("--- this tree ---", flush=True)
+
+
+def _revision() -> str:
+    """This tree's commit (with "+changes" where the work tree differs from it)."""
+    here = str(Path(__file__).resolve().parent)
+    head = subprocess.run(["git", "-C", here, "rev-parse", "--short", "HEAD"],
+                          capture_output=True, text=True).stdout.strip()  # fmt: skip
+    dirty = subprocess.run(["git", "-C", here, "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True).stdout.strip()  # fmt: skip
+    return head + ("+changes" if dirty else "")
 
 
 if __name__ == "__main__":

@@ -1,16 +1,16 @@
-"""Both sound analyses on `metrosync listen`'s click track of metronomes falling into step.
+"""The sound analysis on `metrosync listen`'s click track of metronomes falling into step.
 
 Three simulated metronomes at 192 BPM (σ = 0.75 BPM, seed 4, 90 s: the suite's round
 trip, `tests/audio/test_audio_roundtrip.py`) fall into step; their clicks, a pitch of
 their own each, are written as `metrosync listen` writes them, and again with room
-reverberation and noise at 10 dB SNR. Each analysis (the stages, `analyze_audio`, and
-the timing model, `analyze_timing`), told there are three metronomes, is scored as the
-round trip scores it: recall over the clicks no other falls within the detector's
-resolution of, precision over all, a click matched within 1 ms.
+reverberation and noise at 10 dB SNR. The analysis (`analyze_audio`), told there are
+three metronomes, is scored as the round trip scores it: recall over the clicks no
+other falls within the detector's resolution of, precision over all, a click matched
+within 1 ms.
 
     python benchmarks/audio_listen.py
 
-Prints one line per recording and analysis: recall, precision, the largest timing
+Prints one line per recording: recall, precision, the largest timing
 error, the metronomes found and the seconds the analysis took.
 """
 
@@ -27,7 +27,6 @@ import soundfile as sf
 
 import metrosync
 from metrosync.audio import analyze_audio
-from metrosync.audio.timing_analysis import analyze_timing
 from metrosync.show.recording import RecordedRun
 from metrosync.show.sound import crossing_times, write_wav
 from metrosync.synthetic import clicks, score
@@ -51,20 +50,19 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         made, crossings = recordings(Path(tmp))
         for name, path in made:
-            for analysis, analyse in (("stages", analyze_audio), ("timing", analyze_timing)):
-                t0 = time.perf_counter()
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    ds = analyse(path, metronomes=3)
-                seconds = time.perf_counter() - t0
-                found = ds.tick_time.values
-                times, alone = score.resolvable(crossings, ds.attrs["resolution"])
-                recall, _, errors = score.match(times[alone], found)
-                _, precision, _ = score.match(times, found)
-                worst = 1e3 * float(np.abs(errors).max()) if errors.size else float("nan")
-                print(f"{name:20s} {analysis:7s} recall {recall:.4f}  precision {precision:.4f}  "
-                      f"timing max {worst:.3f} ms  metronomes {ds.attrs['metronomes']}  "
-                      f"{seconds:.1f} s")  # fmt: skip
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ds = analyze_audio(path, metronomes=3)
+            seconds = time.perf_counter() - t0
+            found = ds.tick_time.values
+            times, alone = score.resolvable(crossings, ds.attrs["resolution"])
+            recall, _, errors = score.match(times[alone], found)
+            _, precision, _ = score.match(times, found)
+            worst = 1e3 * float(np.abs(errors).max()) if errors.size else float("nan")
+            print(f"{name:20s} recall {recall:.4f}  precision {precision:.4f}  "
+                  f"timing max {worst:.3f} ms  metronomes {ds.attrs['metronomes']}  "
+                  f"{seconds:.1f} s")  # fmt: skip
     return 0
 
 

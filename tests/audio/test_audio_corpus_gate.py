@@ -13,7 +13,7 @@ import warnings
 import numpy as np
 import pytest
 
-from metrosync.audio.timing_analysis import analyze_timing
+from metrosync.audio.analysis import analyze_audio
 from metrosync.synthetic.corpus import entries
 from metrosync.synthetic.score import scores
 
@@ -41,7 +41,7 @@ def test_the_timing_model_holds_its_ground_on_the_corpus(tmp_path, split):
         path = rec.write(tmp_path / f"{entry.kind}{entry.index}.wav")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "too short" for a 40 s recording
-            ds = analyze_timing(path)
+            ds = analyze_audio(path)
         found = int(ds.attrs["metronomes"])
         right += found == entry.metronomes
         singles_as_two += entry.metronomes == 1 and found > 1

@@ -86,11 +86,15 @@ def test_a_common_beat_needs_tempi_closer_than_a_beat_per_window():
 
 def test_metronomes_at_distant_tempi_get_no_common_beat_and_no_r(tmp_path):
     """Two metronomes at 184 and 208 BPM: R and the ticks per beat are not invented."""
-    from test_audio_separation import recording
+    from test_audio_analysis import _analysed, _trains
 
     from metrosync.audio.summary import summary_text
+    from metrosync.synthetic import Impairments
 
-    ds, _ = recording(tmp_path, 2, 3, bpms=[184.0, 208.0], phone=False)
+    def recording(seed, bpms):
+        return _analysed(tmp_path, _trains(2, seed, bpms=bpms), seed, Impairments())
+
+    ds, _ = recording(3, [184.0, 208.0])
     assert sorted(np.round(ds.bpm.values)) == [184, 208]
     assert "12 % apart" in ds.attrs["no_common_beat"]
     assert np.isnan(ds.r_acoustic.values).all() and np.isnan(ds.clusters.values).all()
@@ -98,7 +102,7 @@ def test_metronomes_at_distant_tempi_get_no_common_beat_and_no_r(tmp_path):
     assert "no common beat" in text.splitlines()[1] and "BPM" not in text.splitlines()[1]
     assert "R and distinct ticks per beat: not computed: the metronomes keep tempi" in text
     assert "sound alike and keep the same tempo" not in text
-    near, _ = recording(tmp_path, 2, 4, bpms=[184.0, 186.0], phone=False)
+    near, _ = recording(4, [184.0, 186.0])
     assert near.attrs["no_common_beat"] == ""
     assert np.isfinite(near.r_acoustic.values).any()
     assert "beat " in summary_text(near).splitlines()[1]

@@ -13,8 +13,8 @@ import soundfile as sf
 from metrosync import synthetic
 from metrosync.audio import detection as det
 from metrosync.audio import seek
+from metrosync.audio.analysis import analyze_audio
 from metrosync.audio.reader import open_recording
-from metrosync.audio.timing_analysis import analyze_timing
 from metrosync.synthetic import voices
 from metrosync.synthetic.score import scores
 
@@ -91,11 +91,11 @@ def test_a_quiet_metronome_in_loud_ones_rings_is_heard_by_its_sound(tmp_path, mo
         path, truth = _quiet_among_loud(tmp_path, seed)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            ds = analyze_timing(path)
+            ds = analyze_audio(path)
             with monkeypatch.context() as m:
                 m.setattr(seek, "_by_sound", lambda recording, *_: (
                     det.Ticks.none(recording.channels), np.zeros(0, dtype=np.int64)))  # fmt: skip
-                without = analyze_timing(path)
+                without = analyze_audio(path)
         recall, precision, timing, bpm = scores(ds, truth)[0]
         whole += recall >= 0.99 and precision >= 0.98 and timing <= 1e-3 and bpm <= 0.1
         heard += recall

@@ -311,10 +311,31 @@ class Ticks:
         empty = np.zeros(0)
         return Ticks(empty, empty, np.zeros((0, channels)), empty)
 
+    def taken(self, which: np.ndarray) -> Ticks:
+        """The ticks ``which`` (indices or a mask) selects, every field alike."""
+        return Ticks(*(getattr(self, f)[which] for f in Ticks.__dataclass_fields__))
+
     def joined(self, other: Ticks) -> Ticks:
         """These ticks, then ``other``'s, every field alike."""
         return Ticks(*(np.concatenate([getattr(self, f), getattr(other, f)])
                        for f in Ticks.__dataclass_fields__))  # fmt: skip
+
+
+def heard_apart(times: np.ndarray, refractory: float) -> np.ndarray:
+    """(K,) of sorted onset ``times`` (s), those not within ``refractory`` (s) after the
+    last one kept: two rises of the curve that `refine` times within it (a coder's
+    pre-echo and the attack it precedes, both timed at the attack) are one impact."""
+    keep = np.ones(times.size, dtype=bool)
+    close = np.flatnonzero(np.diff(times) < refractory) + 1
+    if not close.size:
+        return keep
+    last = times[0]
+    for i in range(1, times.size):
+        if times[i] - last < refractory:
+            keep[i] = False
+        else:
+            last = times[i]
+    return keep
 
 
 def refine(recording: Recording, scan: Scan, hops: np.ndarray, *, chunk: int = 2048) -> Ticks:

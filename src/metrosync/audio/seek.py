@@ -73,11 +73,21 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
         timing = h.followed.timing
         half = max(1, int(np.ceil(max(WINDOW_JITTERS * timing.jitter, MIN_WINDOW) / hop)))
         chance = _chance_level(scan.curve, near_onset, 2 * half + 1)
+        main_offset = np.array([s.main_impact.offset for s in h.followed.structure])
+        off = _off_their_beat(impacts.time, h, main_offset, MIN_WINDOW)
+        for beat in h.beats[off]:
+            # the onset heard on the beat may not be the strike but a sound whose rise
+            # hid it (a knock's crack, a coder's pre-echo): the strike is sought by its
+            # sound too, and the timing model takes the likelier of the two
+            kind = int(beat % 2)
+            at = float(timing.predict(np.array([beat]))[0]) + main_offset[kind]
+            onset = float(impacts.time[h.ticks[h.beats == beat][0]])
+            unfound.append((m, kind, at, half * hop, onset))
         beats = np.setdiff1d(np.arange(h.beats.min(), h.beats.max() + 1), h.beats)
         if not beats.size or not np.isfinite(chance):
             continue
         kinds = np.mod(beats, 2)
-        offsets = np.array([s.main_impact.offset for s in h.followed.structure])[kinds]
+        offsets = main_offset[kinds]
         centre = np.round((timing.predict(beats) + offsets) / hop).astype(np.int64)
         for c, kind in zip(centre, kinds, strict=True):
             lo, hi = c - half, c + half + 1
@@ -88,7 +98,7 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
                 # one inside the window is another's, which hid this one
                 first = np.searchsorted(in_order, lo)
                 if first == in_order.size or in_order[first] >= hi:
-                    unfound.append((m, int(kind), c * hop, half * hop))
+                    unfound.append((m, int(kind), c * hop, half * hop, np.nan))
                 continue
             window = scan.curve[lo:hi]
             best = int(np.argmax(window))
@@ -96,7 +106,7 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
                 found_hops.append(lo + best)
                 whose.append(m)
             else:
-                unfound.append((m, int(kind), c * hop, half * hop))
+                unfound.append((m, int(kind), c * hop, half * hop, np.nan))
     order = np.argsort(found_hops, kind="stable")  # refine reads the file once, in order
     hops = np.array(found_hops, dtype=np.int64)[order]
     owners = np.array(whose, dtype=np.int64)[order]
@@ -104,6 +114,8 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
         det.Ticks.none(recording.channels) if not hops.size else det.refine(recording, scan, hops)
     )
     by_sound, sound_owners = _by_sound(recording, scan, impacts, heard, unfound)
+    new = _apart_from(by_sound.time, impacts.time, MIN_WINDOW)  # not an onset found again
+    by_sound, sound_owners = by_sound.taken(new), sound_owners[new]
     if by_sound.time.size:
         found = found.joined(by_sound)
         owners = np.concatenate([owners, sound_owners])
@@ -112,7 +124,9 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
 
 def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
     """(the ticks found by each metronome's sound at the beats ``unfound`` — (metronome,
-    kind, predicted time s, half-window s) — and their metronomes)."""
+    kind, predicted time s, half-window s, the onset heard there s or NaN) — and their
+    metronomes). Where a beat's onset was heard, the sound's best match in the window is
+    a tick only where it matches better than at the onset (within a hop)."""
     rate = recording.sample_rate
     times, whose = [], []
     rng = np.random.default_rng(0)  # where the chance level is read: fixed, repeatable
@@ -133,8 +147,15 @@ def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
             level = np.quantile(_match(recording, scan, sound, null, half)[0], 1 - FALSE_TICK)
             centres = np.array([u[2] for u in beats])
             score, at = _match(recording, scan, sound, centres, half)
-            times += list(at[score > level])
-            whose += [m] * int(np.sum(score > level))
+            found = score > level
+            onsets = np.array([u[4] for u in beats])
+            heard_there = np.isfinite(onsets)
+            if heard_there.any():
+                # where the onset heard matches the sound as well, it is the strike
+                own, _ = _match(recording, scan, sound, onsets[heard_there], scan.hop / rate)
+                found[heard_there] &= score[heard_there] > own
+            times += list(at[found])
+            whose += [m] * int(np.sum(found))
     if not times:
         return det.Ticks.none(recording.channels), np.zeros(0, dtype=np.int64)
     order = np.argsort(times)
@@ -142,6 +163,25 @@ def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
     hops = np.round(t * rate / scan.hop).astype(np.int64)
     found = det.refine(recording, scan, hops)  # its strength and levels; its time is the match's
     return det.Ticks(t, found.strength, found.channel_strength, found.rise), np.array(whose)[order]
+
+
+def _apart_from(t: np.ndarray, onsets: np.ndarray, gap: float) -> np.ndarray:
+    """(len(t),) whether each time is further than ``gap`` (s) from every onset."""
+    if not onsets.size or not t.size:
+        return np.ones(t.size, dtype=bool)
+    order = np.sort(onsets)
+    j = np.clip(np.searchsorted(order, t), 1, order.size - 1)
+    nearest = np.minimum(np.abs(order[j] - t), np.abs(order[j - 1] - t))
+    return (nearest > gap) if order.size > 1 else (np.abs(order[0] - t) > gap)
+
+
+def _off_their_beat(t: np.ndarray, h: Heard, main_offset: np.ndarray, half: float
+                    ) -> np.ndarray:  # fmt: skip
+    """(ticks,) whether each of the metronome's ticks is timed further than ``half`` (s)
+    from where its timing puts its strike."""
+    beats = h.beats
+    predicted = h.followed.timing.predict(beats) + main_offset[np.mod(beats, 2)]
+    return np.abs(t[h.ticks] - predicted) > half
 
 
 def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
@@ -159,20 +199,31 @@ def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
 
 
 def _ring_windows(t, others, h: Heard, half: float, rng) -> np.ndarray:
-    """Centres of windows in the rings of the onsets ``others`` (from `CLEAR` to `RING`
-    after one), clear of every onset and of this metronome's beats."""
-    if not others.size:
-        return np.zeros(0)
-    pick = rng.choice(others, size=4 * CHANCE_WINDOWS)
-    centre = t[pick] + rng.uniform(half, RING, pick.size)
-    j = np.searchsorted(t, centre)
-    gap = np.minimum(np.abs(t[np.minimum(j, t.size - 1)] - centre),
-                     np.abs(t[np.maximum(j - 1, 0)] - centre))  # fmt: skip
+    """Centres of windows in the rings of the onsets ``others`` (from `half` to `RING`
+    after one), clear of every onset and of this metronome's beats; where those are too
+    few, in the rings of its own ticks too (from `CLEAR` past the window to `RING`)."""
     timing = h.followed.timing
-    beat = np.round((centre - timing.phase) / timing.period)
-    off_beat = np.abs(centre - timing.predict(beat)) > RING
-    keep = centre[(gap > half) & off_beat]
+    keep = np.zeros(0)
+    if others.size:
+        pick = rng.choice(others, size=4 * CHANCE_WINDOWS)
+        centre = t[pick] + rng.uniform(half, RING, pick.size)
+        beat = np.round((centre - timing.phase) / timing.period)
+        off_beat = np.abs(centre - timing.predict(beat)) > RING
+        keep = centre[(_gap_to_onsets(t, centre) > half) & off_beat]
+    if keep.size < CHANCE_WINDOWS and h.ticks.size:
+        # too few others (one metronome, a few bumps): its own ticks' rings too, where
+        # its sound rings on as another's would
+        pick = rng.choice(h.ticks, size=4 * CHANCE_WINDOWS)
+        own = t[pick] + rng.uniform(half + CLEAR, RING, pick.size)
+        keep = np.concatenate([keep, own[_gap_to_onsets(t, own) > half]])
     return keep[:CHANCE_WINDOWS]
+
+
+def _gap_to_onsets(t: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """The time from each of ``centre`` to the nearest of the sorted onsets ``t``, s."""
+    j = np.searchsorted(t, centre)
+    return np.minimum(np.abs(t[np.minimum(j, t.size - 1)] - centre),
+                      np.abs(t[np.maximum(j - 1, 0)] - centre))  # fmt: skip
 
 
 def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:

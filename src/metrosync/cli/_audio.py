@@ -28,7 +28,7 @@ AUDIO_OPTIONS = {
     "bpm": "--bpm", "metronomes": "--metronomes", "band": "--band",
     "sensitivity": "--sensitivity", "refractory": "--refractory",
     "order_window": "--order-window", "cluster_gap": "--cluster-gap",
-    "together": "--together", "analysis": "--analysis",
+    "together": "--together",
 }  # fmt: skip
 
 
@@ -102,11 +102,6 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--cluster-gap", type=float, default=CLUSTER_GAP, metavar="F",
                    help="ticks closer than this fraction of a beat sound as one")  # fmt: skip
-    g.add_argument("--analysis", choices=("stages", "timing"), default="stages",
-                   help="how the ticks are told apart: 'stages' (the default) or 'timing', "
-                   "the timing model that is to replace them (each metronome's tick "
-                   "learned from the recording, a quieter impact before the loud one "
-                   "included; docs/sound.md)")  # fmt: skip
     g.add_argument("--together", action="store_true",
                    help="the recordings were made at the same time by several microphones "
                    "(one file each): align them and tell the metronomes apart by their "
@@ -158,12 +153,10 @@ def run_audio(args) -> int:
                       f"logs).", UserWarning, stacklevel=2)  # fmt: skip
     check_output(args.out, "--out", suffixes=NETCDF)
     check_output(args.plot, "--plot", suffixes=FIGURE)
-    from ..audio import analyze_audio
+    from ..audio.analysis import analyze_audio
     from ..audio.plots import plot_audio
-    from ..audio.timing_analysis import analyze_timing
 
-    timing = getattr(args, "analysis", "stages") == "timing"
-    ds = (analyze_timing if timing else analyze_audio)(
+    ds = analyze_audio(
         list(args.logs) if together else args.logs[0],
         bpm=args.bpm,
         metronomes=args.metronomes,

@@ -1,14 +1,21 @@
-"""A recording analysed by the timing model: the analysis that is to replace the stages.
+"""`analyze_audio`: a recording of metronomes → ticks, tempo, beat and synchrony, by
+the timing model (docs/sound.md, "The timing model").
 
-`analyze_timing(path, ...)` takes `analyze_audio`'s options and returns a dataset with
-its variables, made another way: the impacts (`detection`, as `analyze_audio` finds
-them) are explained as metronomes and clutter by `decompose` (candidate tempi by epoch
-folding, each metronome a timing model with its tick learned from the recording, an
-impact heard from elsewhere another metronome's); the beats no onset was detected at
-are sought where each metronome's timing puts them (`seek`); each onset then goes to
-the metronome likeliest to have made it. Then it measures as `analyze_audio` does
-(`metronome`, `observables.crossings`, `attribution`, `order`). Besides
-`analyze_audio`'s variables:
+``analyze_audio(path, *, bpm=None, metronomes=None, ...)`` reads the file (or files
+recorded together, `together`) in blocks (`reader`) and finds every impact
+(`detection`). The impacts are explained as metronomes and clutter by `decompose`:
+candidate tempi by epoch folding (`periodicity`), each metronome a timing model
+(`timing`, `wander`) whose tick and tock are learned from the recording, every impact
+before and after the loudest (`structure`), with its sound (`sounds`); an impact heard
+from elsewhere is another metronome's. The beats no onset was detected at are sought
+where each metronome's timing puts them (`seek`), and each onset goes to the metronome
+likeliest to have made it. Then it measures: each metronome's tempo, jitter and beat
+(`metronome`); its phases, r and frequency as the light gate's
+(`observables.crossings`); the phase of each in metronome 0's beat (`attribution`);
+and the acoustic order parameter and clusters of the ensemble, which need no
+identities (`order`).
+
+It returns the `dataset` module's variables, and:
 
     tick_probability                      (tick)        the probability that the tick
                                                          is its metronome's
@@ -16,12 +23,12 @@ the metronome likeliest to have made it. Then it measures as `analyze_audio` doe
                                                          mean probability of its ticks,
                                                          its learned tick in words
 
-Its ticks are the metronomes' ticks; onsets no metronome explains (a bump, a voice)
-are clutter, counted in ``attrs["tick_structure"]``, not ticks; where no metronome is
-found, every onset is a tick of none (−1).
-
-`metrosync analyze --analysis timing` uses it; `benchmarks/audio_corpus.py --analysis
-timing` scores it beside the stages.
+with the summary (``attrs["summary"]``), how the metronomes were told apart (by their
+sound, or by their tempo and phase alone) and how sure (``attribution``,
+``attribution_confidence``), the settings, and the tempo found. Its ticks are the
+metronomes' ticks; onsets no metronome explains (a bump, a voice) are clutter,
+counted in ``attrs["tick_structure"]``, not ticks; where no metronome is found, every
+onset is a tick of none (−1).
 """
 
 from __future__ import annotations
@@ -42,12 +49,11 @@ from .attribution import phase_difference
 from .dataset import (
     GRID_DT,
     REFRACTORY,
-    _beats,
-    _check_bpm,
-    _check_options,
-    _dataset,
-    _pendulum_phases,
-    _subset,
+    assemble,
+    beat_gaps,
+    check_bpm,
+    check_options,
+    pendulum_phases,
     recording_attrs,
 )
 from .decompose import Heard, belonging, decompose, one_tick_an_onset
@@ -56,14 +62,14 @@ from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess, 
 from .periodicity import BPM_RANGE
 from .reader import open_recording
 from .seek import seek
-from .separation import sureness
+from .sounds import learn_sounds
 from .structure import Structure
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
 from .voices import impact_features
 
 
-def analyze_timing(
+def analyze_audio(
     path: str | Path | list[str | Path],
     *,
     bpm: float | None = None,
@@ -75,8 +81,7 @@ def analyze_timing(
     cluster_gap: float = CLUSTER_GAP,
     progress: bool = False,
 ) -> xr.Dataset:
-    """Analyse a sound recording of one or more metronomes by the timing model (module
-    docstring): what `analyze_audio` does, with the same options and dataset.
+    """Analyse a sound recording of one or more metronomes (module docstring).
 
     Parameters
     ----------
@@ -101,7 +106,7 @@ def analyze_timing(
     -------
     xarray.Dataset, described in the module docstring.
     """
-    _check_options(bpm, metronomes, sensitivity, refractory, order_window, cluster_gap)
+    check_options(bpm, metronomes, sensitivity, refractory, order_window, cluster_gap)
     recording = _open(path, band)
     rate = recording.sample_rate
     from ..progress import progress_bar
@@ -112,18 +117,20 @@ def analyze_timing(
     refractory = REFRACTORY if refractory is None else refractory
     hops = det.pick_ticks(scan, max(1, round(refractory / (scan.hop / rate))))
     impacts = det.refine(recording, scan, hops)
-    impacts = _subset(impacts, np.argsort(impacts.time, kind="stable"))
+    impacts = impacts.taken(np.argsort(impacts.time, kind="stable"))
+    impacts = impacts.taken(det.heard_apart(impacts.time, refractory))
     if impacts.time.size < MIN_TICKS:
         beat_period(impacts.time)  # raises the error that says what to try
     sound = impact_features(recording, impacts.time).matrix()
     heard, owner = _metronomes(impacts, bpm, sound)
+    by = _told_apart_by(heard, sound, impacts.time)
     if heard:
         # the beats no onset was detected at, sought where each metronome's timing puts
         # them, and every onset explained again with them
         found, whose = seek(recording, scan, impacts, heard)
         joined = impacts.joined(found)
         in_time = np.argsort(joined.time, kind="stable")
-        impacts = _subset(joined, in_time)
+        impacts = joined.taken(in_time)
         owner = np.concatenate([owner, whose])[in_time]
         heard, owner = one_tick_an_onset(impacts.time, heard, owner)
     # The ticks: each metronome's main impacts; a tick's other impacts are not ticks, nor
@@ -131,7 +138,7 @@ def analyze_timing(
     is_tick = np.full(owner.size, not heard)
     for h in heard:
         is_tick[h.ticks] = True
-    ticks = _subset(impacts, is_tick)
+    ticks = impacts.taken(is_tick)
     where = np.cumsum(is_tick) - 1
     probability = belonging(impacts.time, heard, owner)
     k = ticks.time.size
@@ -149,7 +156,7 @@ def analyze_timing(
         heard_bpm = 60.0 / period
         tempo_source = "given (bpm)" if bpm is not None else "found from the ticks"
     if bpm is not None:
-        _check_bpm(bpm, heard_bpm)
+        check_bpm(bpm, heard_bpm)
     span = ticks.time[-1] - ticks.time[0]
     per_beat = k * period / max(span + period, period)
     acoustic = acoustic_order(ticks.time, period, window=order_window, cluster_gap=cluster_gap)
@@ -160,7 +167,7 @@ def analyze_timing(
         acoustic = replace(acoustic, r=nan, ticks_per_beat=nan, clusters=nan)
         per_beat = math.nan
         tempo_source = "the median of the metronomes' own tempi; no common beat"
-    n, source, note = _count(heard, metronomes, acoustic, apart)
+    n, source, note = _count(heard, metronomes, acoustic, apart, by)
     floor, excess = floor_and_excess(acoustic.r, n)
     acoustic = replace(acoustic, floor=floor, excess=excess)
     is_tock = np.full(k, -1, dtype=np.int8)
@@ -173,7 +180,7 @@ def analyze_timing(
         stats.append(s)
         is_tock[own] = s.is_tock
         gaps = np.full(own.size, np.nan)
-        gaps[:-1] = _beats(ticks.time[own], s.beat_number)
+        gaps[:-1] = beat_gaps(ticks.time[own], s.beat_number)
         interval[own] = gaps
         kept.append(ph.kept_from_half_periods(ticks.time[own], s.beat_number,
                                               parity=1 if s.is_tock[0] else 0))  # fmt: skip
@@ -189,7 +196,7 @@ def analyze_timing(
             UserWarning,
             stacklevel=2,
         )
-    ds = _dataset(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase)
+    ds = assemble(recording, scan, ticks, acoustic, stats, label, is_tock, interval, phase)
     ds["tick_probability"] = (
         "tick",
         tick_probability,
@@ -197,7 +204,7 @@ def analyze_timing(
     )
     if heard:
         ds = ds.assign(_model_fit(heard, tick_probability, label))
-    pendulums = _pendulum_phases(kept, GRID_DT)
+    pendulums = pendulum_phases(kept, GRID_DT)
     ds = ds.merge(pendulums)
     ds.attrs.update(pendulums.attrs)
     confidence = float(np.nanmin(ds["explained"].values)) if heard else 0.0
@@ -218,7 +225,7 @@ def analyze_timing(
         order_window=acoustic.window,
         order_step=acoustic.step,
         cluster_gap=cluster_gap,
-        attribution="the timing model" if len(heard) > 1 else "none",
+        attribution=by,
         attribution_confidence=confidence,
         attribution_sureness=sureness(confidence) if len(heard) > 1 else "",
         attribution_meaning="the least mean probability, over the metronomes, that a "
@@ -274,12 +281,33 @@ def _metronomes(impacts: det.Ticks, bpm: float | None, sound=None
     return [heard[i] for i in order], np.where(owner >= 0, relabel[owner], -1)
 
 
+def _told_apart_by(heard: list[Heard], sound: np.ndarray, times: np.ndarray) -> str:
+    """How the metronomes differ: "sound" where each one's learned sound (`sounds`) sets
+    its ticks apart from every other's, "tempo" (their timing: tempo and phase) where
+    none does, "sound and tempo" in between; "none" for fewer than two."""
+    if len(heard) < 2:
+        return "none"
+    sounds = learn_sounds(sound, [h.ticks for h in heard], [np.mod(h.beats, 2) for h in heard],
+                          times)  # fmt: skip
+    apart = [sounds.told_apart(m, [h.ticks for h in heard]) for m in range(len(heard))]
+    return "sound" if all(apart) else "sound and tempo" if any(apart) else "tempo"
+
+
+def sureness(confidence: float) -> str:
+    """Words for an attribution confidence (the least of the metronomes' `explained`)."""
+    if confidence >= 0.9:
+        return "sure"
+    if confidence >= 0.7:
+        return "fairly sure"
+    return "unsure: check the plot"
+
+
 def _own_period(h: Heard) -> float:
     """A metronome's mean beat over the beats it was heard in, s (drift included)."""
     return 60.0 / h.followed.timing.mean_bpm(int(h.beats.min()), int(h.beats.max()))
 
 
-def _count(heard: list[Heard], given, acoustic, apart) -> tuple[int, str, str]:
+def _count(heard: list[Heard], given, acoustic, apart, by: str) -> tuple[int, str, str]:
     """(how many metronomes, how that was found, a note where the count is in doubt)."""
     # Synchronized metronomes tick as one; the windows where they were least together
     # count them best.
@@ -294,7 +322,7 @@ def _count(heard: list[Heard], given, acoustic, apart) -> tuple[int, str, str]:
         return int(given), "given", note
     if not heard:
         return busiest, "most ticks per beat in a window (95th percentile), rounded", ""
-    source = "one tick train" if len(heard) == 1 else "told apart by the timing model"
+    source = "one tick train" if len(heard) == 1 else f"told apart by {by}"
     note = ""
     if busiest > len(heard) and not apart:
         note = (f"up to {busiest} ticks per beat are heard but only "
