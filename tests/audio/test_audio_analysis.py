@@ -7,6 +7,7 @@ from its own seeds; none is a corpus recording, and none pins one."""
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -158,7 +159,7 @@ def test_files_not_recorded_together_draw_a_warning(tmp_path):
 
 def test_two_metronomes_of_one_tempo_half_a_beat_apart_are_two(tmp_path):
     """The same click, locked half a beat apart: the tempo's own frequency cancels in the
-    periodicity search, its second harmonic finds them (`periodicity.HARMONICS`)."""
+    periodicity search, its second harmonic finds them (`MODEL.harmonics`)."""
     a = clicks.metronome_train(184, 30, phase=0.0)
     b = clicks.metronome_train(184, 30, phase=0.5)
     x = clicks.render([a, b], 30, pitches=[2000.0, 2000.0])
@@ -239,3 +240,22 @@ def test_a_tick_just_behind_a_knock_is_timed_at_its_own_impact(tmp_path, lead):
         heard[knocked] = False
         assert (error[heard] <= 1e-3).all()
     assert right >= 46
+
+
+def test_the_model_s_parameters_are_few_named_documented_and_recorded(tmp_path):
+    """At most fifteen, each with a unit and a meaning, each in docs/sound.md's table,
+    and every dataset records the ones it used."""
+    import json
+    from pathlib import Path
+
+    from metrosync.audio.settings import MODEL, TimingModel
+
+    described = TimingModel.described()
+    assert len(described) <= 15
+    assert all(meaning for _, _, _, meaning in described)
+    page = (Path(__file__).parents[2] / "docs" / "sound.md").read_text(encoding="utf-8")
+    assert all(f"| `{name}` |" in page for name, *_ in described)
+    train = clicks.metronome_train(150, 20, phase=0.1)
+    ds = analyze_audio(clicks.write(tmp_path / "one.wav", clicks.render([train], 20)))
+    recorded = json.loads(ds.attrs["timing_model"])
+    assert recorded == json.loads(json.dumps(dataclasses.asdict(MODEL)))

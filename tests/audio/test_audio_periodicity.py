@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from metrosync.audio.periodicity import HARMONICS, candidate_tempi, periodogram
+from metrosync.audio.periodicity import candidate_tempi, periodogram
+from metrosync.audio.settings import MODEL
 from metrosync.audio.timing import Timing
 
 
@@ -27,9 +28,10 @@ def test_one_train_among_clutter_is_found_at_its_tempo():
     # not the search, times the train
     assert min(abs(c.bpm - 137.0) for c in found) < 0.2
     # its harmonics and subharmonics, and tempi whose summed harmonics meet its own (p/q
-    # of it, q up to HARMONICS) are candidates too, for the timing model to reject; no
+    # of it, q up to MODEL.harmonics) are candidates too, for the timing model to reject; no
     # tempo unrelated to 137 is
-    ratios = {p / q for q in range(1, HARMONICS + 1) for p in range(1, 2 * HARMONICS + 1)}
+    m = MODEL.harmonics
+    ratios = {p / q for q in range(1, m + 1) for p in range(1, 2 * m + 1)}
     assert all(min(abs(c.bpm / 137.0 - r) for r in ratios) < 0.01 for c in found)
 
 
@@ -50,12 +52,12 @@ def test_a_drifting_tempo_over_ten_minutes_keeps_one_sharp_peak():
 
 def test_clutter_alone_rarely_gives_a_candidate():
     alarms = sum(bool(candidate_tempi(clutter(3.0, 40.0, seed))) for seed in range(100))
-    assert alarms <= 2  # FALSE_ALARM = 1e-3 a recording: 0.1 expected
+    assert alarms <= 2  # MODEL.false_alarm = 1e-3 a recording: 0.1 expected
 
 
 def test_clutter_has_a_mean_power_of_one_per_harmonic():
     _, z = periodogram(clutter(5.0, 200.0, 7), segment=60.0)
-    assert np.mean(z) == pytest.approx(HARMONICS, abs=0.05 * HARMONICS)
+    assert np.mean(z) == pytest.approx(MODEL.harmonics, abs=0.05 * MODEL.harmonics)
 
 
 def test_two_trains_at_one_tempo_half_a_beat_apart_are_a_candidate_at_that_tempo():

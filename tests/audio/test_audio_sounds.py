@@ -1,8 +1,11 @@
 """Each metronome's sound learned from its ticks; whose an onset is by its sound."""
 
+import math
+
 import numpy as np
 
-from metrosync.audio.sounds import APART, CLEAR, learn_sounds
+from metrosync.audio.settings import MODEL
+from metrosync.audio.sounds import CLEAR, learn_sounds
 
 
 def two_makes(separation=6.0, size=200, dims=17, seed=0):
@@ -64,4 +67,4 @@ def test_too_few_clear_ticks_learn_nothing():
     sounds = learn_sounds(x, [ticks[0][:14], ticks[1]], [kinds[0][:14], kinds[1]], t)
     assert not sounds.learned[0] and sounds.learned[1]
     assert not sounds.others(0).any() and not sounds.mine(1).any()
-    assert APART > 6.0  # a ratio of a thousand, as documented
+    assert math.log(MODEL.sound_apart) > 6.0  # a ratio of a thousand, as documented

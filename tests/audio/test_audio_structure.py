@@ -5,6 +5,7 @@ import pytest
 
 from metrosync.audio import structure
 from metrosync.audio.periodicity import candidate_tempi
+from metrosync.audio.settings import MODEL
 from metrosync.audio.structure import follow, learn_structure
 from metrosync.audio.timing import Timing
 from metrosync.errors import AnalysisError
@@ -82,7 +83,7 @@ def test_a_tick_of_one_impact_is_one_impact():
 def test_onsets_of_a_beat_that_slides_past_are_no_impact_of_the_tick():
     """Another metronome 0.4 beat slower over the recording: its onsets cross this one's
     beat at every offset. No impact wanders so far: they are clutter, not an impact."""
-    from metrosync.audio.structure import MAX_SPREAD, learn_structure
+    from metrosync.audio.structure import learn_structure
 
     rng = np.random.default_rng(9)
     beats = np.arange(120)
@@ -90,7 +91,7 @@ def test_onsets_of_a_beat_that_slides_past_are_no_impact_of_the_tick():
     sliding = np.linspace(-0.12, 0.12, beats.size)
     offsets = np.concatenate([main, sliding])
     structure, label = learn_structure(offsets, np.concatenate([beats, beats]), 0.15)
-    assert all(i.spread <= MAX_SPREAD for i in structure.impacts)
+    assert all(i.spread <= MODEL.impact_spread[1] for i in structure.impacts)
     assert structure.main_impact.offset == pytest.approx(0.0, abs=0.3e-3)
     assert np.mean(label[beats.size :] == -1) > 0.8
 
@@ -111,7 +112,7 @@ def plain_em(d, means, spreads, shares, uniform, iterations):
         safe = np.where(held, weight[:count], 1.0)
         means = np.where(held, (resp[:, :count] * d[:, None]).sum(axis=0) / safe, means)
         var = (resp[:, :count] * (d[:, None] - means) ** 2).sum(axis=0) / safe
-        spreads = np.maximum(np.sqrt(var), structure.MIN_SPREAD)
+        spreads = np.maximum(np.sqrt(var), MODEL.impact_spread[0])
     return means, spreads, shares, resp, total
 
 
@@ -125,7 +126,7 @@ def test_the_compiled_em_is_the_plain_one(count):
              np.full(count + 1, 1.0 / (count + 1)))  # fmt: skip
     expected = plain_em(d, *(a.copy() for a in start), 1 / 0.3, 60)
     means, spreads, shares = (a.copy() for a in start)
-    resp, total = structure._em(d, means, spreads, shares, 1 / 0.3, 60)
+    resp, total = structure._em(d, means, spreads, shares, 1 / 0.3, 60, MODEL.impact_spread[0])
     for got, want in zip((means, spreads, shares, resp, total), expected, strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
 

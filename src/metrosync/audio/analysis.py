@@ -25,7 +25,8 @@ It returns the `dataset` module's variables, and:
 
 with the summary (``attrs["summary"]``), how the metronomes were told apart (by their
 sound, or by their tempo and phase alone) and how sure (``attribution``,
-``attribution_confidence``), the settings, and the tempo found. Its ticks are the
+``attribution_confidence``), the settings, the timing model's parameters
+(``timing_model``, JSON of `settings.MODEL`), and the tempo found. Its ticks are the
 metronomes' ticks; onsets no metronome explains (a bump, a voice) are clutter,
 counted in ``attrs["tick_structure"]``, not ticks; where no metronome is found, every
 onset is a tick of none (−1).
@@ -33,9 +34,10 @@ onset is a tick of none (−1).
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -59,9 +61,9 @@ from .dataset import (
 from .decompose import Heard, belonging, decompose, one_tick_an_onset
 from .metronome import beat_statistics
 from .order import CLUSTER_GAP, WINDOW_BEATS, acoustic_order, floor_and_excess, no_common_beat
-from .periodicity import BPM_RANGE
 from .reader import open_recording
 from .seek import seek
+from .settings import MODEL
 from .sounds import learn_sounds
 from .structure import Structure
 from .summary import summary_text
@@ -232,6 +234,7 @@ def analyze_audio(
         "metronome's ticks are its own",
         attribution_note=note,
         no_common_beat=apart,
+        timing_model=json.dumps(asdict(MODEL)),
         metrosync_version=__version__,
     )
     ds.attrs["summary"] = summary_text(ds)
@@ -262,7 +265,7 @@ def _metronomes(impacts: det.Ticks, bpm: float | None, sound=None
     if bpm is not None and not any(abs(60.0 / _own_period(h) / bpm - 1) <= HINT_RANGE
                                    for h in heard):  # fmt: skip
         window = (bpm * (1 - HINT_RANGE), bpm * (1 + HINT_RANGE))
-        window = (max(window[0], BPM_RANGE[0]), min(window[1], BPM_RANGE[1]))
+        window = (max(window[0], MODEL.bpm_range[0]), min(window[1], MODEL.bpm_range[1]))
         hinted, hinted_owner = decompose(
             impacts.time,
             impacts.strength,

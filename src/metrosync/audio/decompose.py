@@ -5,8 +5,8 @@ a timing model with its learned tick (`structure`), plus clutter. M and the metr
 are found by matching pursuit: the periodicity search (`periodicity`) proposes tempi
 among the onsets not yet explained; the metronome at the likeliest tempo is followed
 (`structure.follow`); it is kept if it explains enough of the recording to be a
-metronome (its main impact heard in `MIN_HEARD` of its beats, over at least `MIN_BEATS`
-beats), its onsets are set aside, and the search runs again on the rest, until no
+metronome (its main impact heard in `MODEL.heard_share` of its beats, over at least
+`MODEL.min_beats` beats), its onsets are set aside, and the search runs again on the rest, until no
 tempo is left above the false-alarm threshold. Then each metronome is followed again
 with the others' onsets set aside (the onsets go to whichever metronome explains them
 best), so that the order in which they were found does not decide who holds a tick.
@@ -26,15 +26,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import AnalysisError
-from .periodicity import BPM_RANGE, candidate_tempi
+from .periodicity import candidate_tempi
+from .settings import MODEL
 from .sounds import Sounds, learn_sounds
 from .structure import Followed, explained_by, follow
 from .tempo import HINT_RANGE
 
-#: Share of its beats a metronome's main impact must be heard in.
-MIN_HEARD = 0.5
-#: Fewest beats a metronome must span to be one.
-MIN_BEATS = 16
 #: Most metronomes sought (a bound on the search, not an assumption of the model).
 MAX_METRONOMES = 8
 #: Share of a metronome's ticks that another explains, beyond which it is no metronome.
@@ -44,9 +41,6 @@ REDUNDANT = 0.5
 HALF_TEMPO = 1.5
 #: Passes of refollowing every metronome with the others' onsets set aside.
 PASSES = 2
-#: Difference of level between microphones, dB, beyond which two impacts come from two
-#: places: more than a room's colouring moves one source's (a few dB).
-PLACE_DB = 3.0
 
 
 @dataclass(frozen=True)
@@ -68,7 +62,7 @@ class Heard:
         return self.followed.beat[self.followed.main]
 
 
-def decompose(times, strengths=None, bpm_range=BPM_RANGE, channel_levels=None,
+def decompose(times, strengths=None, bpm_range=MODEL.bpm_range, channel_levels=None,
               features=None) -> tuple[list[Heard], np.ndarray]:  # fmt: skip
     """Metronomes that explain the sorted onset ``times`` (s), with their ``strengths``
     (dB, optional: they tell a strike from a bounce as regular as it), and each onset's
@@ -197,7 +191,7 @@ def elsewhere(heard: Heard, place: np.ndarray | None) -> np.ndarray:
     metronome, so their levels at the microphones differ alike; two metronomes of one
     tempo locked at a fixed offset are, in timing, one tick of two impacts, and only
     where they are heard from tells them apart. An impact is elsewhere where its mean
-    placement differs from the main impact's by more than `PLACE_DB` and by more than
+    placement differs from the main impact's by more than `MODEL.place_db` and by more than
     four standard errors of the difference."""
     out = np.zeros(heard.pool.size, dtype=bool)
     if place is None:
@@ -216,7 +210,7 @@ def elsewhere(heard: Heard, place: np.ndarray | None) -> np.ndarray:
                 continue
             gap = np.abs(other.mean(axis=0) - main.mean(axis=0))
             error = np.sqrt(other.var(axis=0) / other.shape[0] + main.var(axis=0) / main.shape[0])
-            if np.any((gap > PLACE_DB) & (gap > 4 * error)):
+            if np.any((gap > MODEL.place_db) & (gap > 4 * error)):
                 out |= mine
     return out
 
@@ -224,7 +218,7 @@ def elsewhere(heard: Heard, place: np.ndarray | None) -> np.ndarray:
 def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
     """(the tempo it was followed from, the `Heard`) of the first candidate among the
     onsets ``free`` that is a metronome, strongest first; None when none is."""
-    if free.size < MIN_BEATS:
+    if free.size < MODEL.min_beats:
         return None
     for candidate in candidate_tempi(t[free], bpm_range=bpm_range):
         followed = _metronome(t[free], candidate.bpm, _part(level, free))
@@ -237,7 +231,7 @@ def _likeliest(t: np.ndarray, level, free: np.ndarray, bpm_range):
     return None
 
 
-def _at_its_tempo(t: np.ndarray, bpm: float, followed: Followed, level, bpm_range=BPM_RANGE):
+def _at_its_tempo(t: np.ndarray, bpm: float, followed: Followed, level, bpm_range=MODEL.bpm_range):
     """(the tempo, the metronome): ``followed`` at ``bpm``, or, where it is a metronome
     at half its tempo, the one at twice ``bpm``. At half its tempo a metronome is a
     metronome too, on every other beat, its other ticks left over; followed at twice
@@ -269,16 +263,17 @@ def _metronome(t: np.ndarray, bpm: float, level=None, start=None, refind=False
 
 
 def _is_metronome(followed: Followed) -> bool:
-    """Its main impact heard in `MIN_HEARD` of its beats, over `MIN_BEATS` at least."""
+    """Its main impact heard in `MODEL.heard_share` of its beats, over `MODEL.min_beats`
+    at least."""
     beats = followed.beat[followed.main]
     if beats.size < 2:
         return False
     span = int(beats.max() - beats.min()) + 1
-    return span >= MIN_BEATS and beats.size >= MIN_HEARD * span
+    return span >= MODEL.min_beats and beats.size >= MODEL.heard_share * span
 
 
 def _refollow(t: np.ndarray, level, starts: list[float], before: list[Heard], mains,
-              bpm_range=BPM_RANGE, sounds: Sounds | None = None):  # fmt: skip
+              bpm_range=MODEL.bpm_range, sounds: Sounds | None = None):  # fmt: skip
     """(the metronomes, each onset's owner, the tempo each was followed from): each
     metronome followed again, from the tempo it was first followed from (or twice it
     within ``bpm_range``, `_at_its_tempo`), on every onset but the other metronomes'

@@ -9,7 +9,7 @@ share a phase, those of anything else spread over the circle. The Rayleigh stati
 
 measures how much they share (the power of the weighted onset train at frequency f).
 For onsets with no period at f it is exponentially distributed with mean 1. The
-search sums it over the first `HARMONICS` harmonics, Z²_m(f) = Σ_{h≤m} Z(hf) (the Z²_m
+search sums it over the first `MODEL.harmonics` harmonics, Z²_m(f) = Σ_{h≤m} Z(hf) (the Z²_m
 test of pulsar timing, Buccheri et al., A&A 128, 245, 1983): two trains at one beat
 half a beat apart cancel at f and add at 2f, and a train of one tempo still peaks
 highest at its own f. For clutter Z²_m is a Gamma(m, 1) variable, so a peak above its
@@ -36,17 +36,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Tempi searched, ticks a minute (every mechanical metronome's marks lie inside).
-BPM_RANGE = (30.0, 300.0)
+from .settings import MODEL
+
 #: Longest stretch of the recording folded coherently, s.
 SEGMENT = 60.0
-#: Probability that a recording with no period at all gives one candidate.
-FALSE_ALARM = 1e-3
 #: Grid points per independent frequency (1/segment), so that no peak falls between.
 OVERSAMPLE = 5
-#: Harmonics of each trial tempo summed (Z²_m with m = 4): up to four metronomes of one
-#: tempo splayed evenly over the beat cancel each harmonic below their number.
-HARMONICS = 4
 
 
 @dataclass(frozen=True)
@@ -57,10 +52,10 @@ class Candidate:
     z: float
 
 
-def periodogram(times, weights=None, bpm_range=BPM_RANGE, *, segment: float = SEGMENT):
-    """The tempo grid (F,) in BPM and the Rayleigh power Z²_m (F,) on it (`HARMONICS`
+def periodogram(times, weights=None, bpm_range=MODEL.bpm_range, *, segment: float = SEGMENT):
+    """The tempo grid (F,) in BPM and the Rayleigh power Z²_m (F,) on it (`MODEL.harmonics`
     harmonics), summed over segments of at most ``segment`` s and normalised so that
-    pure clutter gives a mean of `HARMONICS` at every tempo."""
+    pure clutter gives a mean of `MODEL.harmonics` at every tempo."""
     t = np.asarray(times, dtype=float)
     w = np.ones_like(t) if weights is None else np.asarray(weights, dtype=float)
     span = float(t[-1] - t[0]) if t.size > 1 else 0.0
@@ -87,7 +82,7 @@ def periodogram(times, weights=None, bpm_range=BPM_RANGE, *, segment: float = SE
             phase = np.exp(2j * np.pi * np.outer(fs, tp - tp[0]))
             power[start : start + 256] = np.abs(phase @ wp) ** 2
             harmonic = phase
-            for _ in range(2, HARMONICS + 1):  # e^{2πi h f t} = (e^{2πi f t})^h
+            for _ in range(2, MODEL.harmonics + 1):  # e^{2πi h f t} = (e^{2πi f t})^h
                 harmonic = harmonic * phase
                 power[start : start + 256] += np.abs(harmonic @ wp) ** 2
         z += power / float(np.sum(wp**2))
@@ -97,16 +92,16 @@ def periodogram(times, weights=None, bpm_range=BPM_RANGE, *, segment: float = SE
 def candidate_tempi(
     times,
     weights=None,
-    bpm_range=BPM_RANGE,
+    bpm_range=MODEL.bpm_range,
     *,
-    false_alarm: float = FALSE_ALARM,
+    false_alarm: float = MODEL.false_alarm,
     segment: float = SEGMENT,
 ) -> list[Candidate]:
     """The periodogram's peaks above the false-alarm threshold, strongest first.
 
     Each peak's tempo is refined by a parabola through its three grid points. With
     ``P`` segments summed the clutter's power is a Gamma(mP, 1/P) variable (m =
-    `HARMONICS`); the threshold is its (1 − α/F) quantile, F the independent
+    `MODEL.harmonics`); the threshold is its (1 − α/F) quantile, F the independent
     frequencies searched.
     """
     from scipy.stats import gamma
@@ -116,7 +111,8 @@ def candidate_tempi(
     span = float(t[-1] - t[0]) if t.size > 1 else 0.0
     pieces = max(1, math.ceil(span / segment))
     independent = max(1.0, bpm.size / OVERSAMPLE)
-    threshold = float(gamma.isf(false_alarm / independent, HARMONICS * pieces, scale=1.0 / pieces))
+    threshold = float(gamma.isf(false_alarm / independent, MODEL.harmonics * pieces,
+                                scale=1.0 / pieces))  # fmt: skip
     inside = np.flatnonzero((z[1:-1] > z[:-2]) & (z[1:-1] >= z[2:]) & (z[1:-1] > threshold)) + 1
     found = []
     for i in inside:

@@ -6,19 +6,19 @@ timing model has followed is known to within its jitter, so there a far smaller 
 is as unlikely to be chance: a quieter tick in another metronome's ring, under the
 detector's threshold, can be heard there (track before detect). The method is a
 constant-false-alarm detector in the window of each unheard beat: the window is the
-main impact's predicted time ± `WINDOW_JITTERS` of the metronome's jitter; the
+main impact's predicted time ± `MODEL.seek_window[0]` of the metronome's jitter; the
 threshold is the level the detection curve's maximum over such a window exceeds, by
-chance, in a share `FALSE_TICK` of windows, read off the recording's own curve away
+chance, in a share `MODEL.seek_false_tick` of windows, read off the recording's own curve away
 from its onsets; the largest rise in the window above it is the tick.
 
 Where the curve's rise is not enough (a tick in another's ring rises little over what
 rings there already), the beat is sought by the metronome's own sound, as pulsar
 timing times a pulse by a template learned from the data: the metronome's sound is
-the mean of its clean ticks' first `SOUND` seconds (band-passed, aligned by their
+the mean of its clean ticks' first `MODEL.sound_length` seconds (band-passed, aligned by their
 cross-correlation), and the statistic is the largest normalised cross-correlation of
 that sound with the recording over the beat's window. Its chance level is read where
 the confusion lies: the same statistic at windows in the rings of the onsets that are
-not this metronome's ticks; the threshold is passed by chance in `FALSE_TICK` of them.
+not this metronome's ticks; the threshold is passed by chance in `MODEL.seek_false_tick` of them.
 
 Contract: `seek(recording, scan, impacts, heard)` returns the `detection.Ticks` found
 (timed by `detection.refine`) and (L,) the metronome of each.
@@ -31,32 +31,21 @@ from scipy import ndimage, signal
 
 from . import detection as det
 from .decompose import Heard
+from .settings import MODEL
 
-#: Half-width of the window of an unheard beat, in the metronome's jitters ...
-WINDOW_JITTERS = 3.0
-#: ... and at least this, s (the detector's timing noise and the timing's own error).
-MIN_WINDOW = 1e-3
-#: Share of windows with no tick in which the curve's maximum passes the threshold.
-FALSE_TICK = 0.01
 #: Onsets this close (s) are kept out of the curve's chance level, and a window near one
 #: is left to the sound: the onset hides the beat from the curve.
 CLEAR = det.RESOLUTION
-#: Length of a metronome's sound that is matched, s: a strike's first milliseconds,
-#: before its ring, which another's ring covers least.
-SOUND = 0.012
 #: ... and the quiet before its onset that is part of it, s: where the sound of a
 #: clean tick is silence, so that a match slid late (its onset over the tick's loud
 #: start, in another's ring) pays for the energy it puts there.
 QUIET = 1e-3
-#: Most of a metronome's clean ticks (no other onset from `RING` before to `SOUND`
-#: after) averaged into its sound, and fewest to learn it from.
+#: Most of a metronome's clean ticks (no other onset from `MODEL.ring` before to
+#: `MODEL.sound_length` after) averaged into its sound, and fewest to learn it from.
 SOUND_TICKS, MIN_SOUND_TICKS = 48, 8
-#: How long another metronome's tick rings over a beat, s (where the chance level of
-#: the sound's match is read, and what a clean tick is clear of).
-RING = 0.045
 #: Windows in others' rings the sound's chance level is read from: four of them pass
 #: it by chance.
-CHANCE_WINDOWS = round(4 / FALSE_TICK)
+CHANCE_WINDOWS = round(4 / MODEL.seek_false_tick)
 
 
 def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
@@ -71,10 +60,11 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
     found_hops, whose, unfound = [], [], []
     for m, h in enumerate(heard):
         timing = h.followed.timing
-        half = max(1, int(np.ceil(max(WINDOW_JITTERS * timing.jitter, MIN_WINDOW) / hop)))
+        jitters, least = MODEL.seek_window
+        half = max(1, int(np.ceil(max(jitters * timing.jitter, least) / hop)))
         chance = _chance_level(scan.curve, near_onset, 2 * half + 1)
         main_offset = np.array([s.main_impact.offset for s in h.followed.structure])
-        off = _off_their_beat(impacts.time, h, main_offset, MIN_WINDOW)
+        off = _off_their_beat(impacts.time, h, main_offset, MODEL.seek_window[1])
         for beat in h.beats[off]:
             # the onset heard on the beat may not be the strike but a sound whose rise
             # hid it (a knock's crack, a coder's pre-echo): the strike is sought by its
@@ -114,7 +104,7 @@ def seek(recording, scan: det.Scan, impacts: det.Ticks, heard: list[Heard]):
         det.Ticks.none(recording.channels) if not hops.size else det.refine(recording, scan, hops)
     )
     by_sound, sound_owners = _by_sound(recording, scan, impacts, heard, unfound)
-    new = _apart_from(by_sound.time, impacts.time, MIN_WINDOW)  # not an onset found again
+    new = _apart_from(by_sound.time, impacts.time, MODEL.seek_window[1])  # not an onset found again
     by_sound, sound_owners = by_sound.taken(new), sound_owners[new]
     if by_sound.time.size:
         found = found.joined(by_sound)
@@ -144,7 +134,8 @@ def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
             sound = _sound(recording, scan, impacts.time[ticks])
             if not beats or sound is None or null.size < CHANCE_WINDOWS:
                 continue
-            level = np.quantile(_match(recording, scan, sound, null, half)[0], 1 - FALSE_TICK)
+            chance = _match(recording, scan, sound, null, half)[0]
+            level = np.quantile(chance, 1 - MODEL.seek_false_tick)
             centres = np.array([u[2] for u in beats])
             score, at = _match(recording, scan, sound, centres, half)
             found = score > level
@@ -185,8 +176,8 @@ def _off_their_beat(t: np.ndarray, h: Heard, main_offset: np.ndarray, half: floa
 
 
 def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
-    """Of ``ticks``, those no other onset precedes within `RING` nor follows within
-    `SOUND`: the metronome's sound alone."""
+    """Of ``ticks``, those no other onset precedes within `MODEL.ring` nor follows within
+    `MODEL.sound_length`: the metronome's sound alone."""
     other = np.sort(t[others])
     if not other.size:
         return ticks
@@ -195,26 +186,26 @@ def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
     after = other[np.minimum(j, other.size - 1)] - t[ticks]
     before[j == 0] = np.inf
     after[j == other.size] = np.inf
-    return ticks[(before > RING) & (after > SOUND)]
+    return ticks[(before > MODEL.ring) & (after > MODEL.sound_length)]
 
 
 def _ring_windows(t, others, h: Heard, half: float, rng) -> np.ndarray:
-    """Centres of windows in the rings of the onsets ``others`` (from `half` to `RING`
+    """Centres of windows in the rings of the onsets ``others`` (from `half` to `MODEL.ring`
     after one), clear of every onset and of this metronome's beats; where those are too
-    few, in the rings of its own ticks too (from `CLEAR` past the window to `RING`)."""
+    few, in the rings of its own ticks too (from `CLEAR` past the window to `MODEL.ring`)."""
     timing = h.followed.timing
     keep = np.zeros(0)
     if others.size:
         pick = rng.choice(others, size=4 * CHANCE_WINDOWS)
-        centre = t[pick] + rng.uniform(half, RING, pick.size)
+        centre = t[pick] + rng.uniform(half, MODEL.ring, pick.size)
         beat = np.round((centre - timing.phase) / timing.period)
-        off_beat = np.abs(centre - timing.predict(beat)) > RING
+        off_beat = np.abs(centre - timing.predict(beat)) > MODEL.ring
         keep = centre[(_gap_to_onsets(t, centre) > half) & off_beat]
     if keep.size < CHANCE_WINDOWS and h.ticks.size:
         # too few others (one metronome, a few bumps): its own ticks' rings too, where
         # its sound rings on as another's would
         pick = rng.choice(h.ticks, size=4 * CHANCE_WINDOWS)
-        own = t[pick] + rng.uniform(half + CLEAR, RING, pick.size)
+        own = t[pick] + rng.uniform(half + CLEAR, MODEL.ring, pick.size)
         keep = np.concatenate([keep, own[_gap_to_onsets(t, own) > half]])
     return keep[:CHANCE_WINDOWS]
 
@@ -227,14 +218,14 @@ def _gap_to_onsets(t: np.ndarray, centre: np.ndarray) -> np.ndarray:
 
 
 def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:
-    """A metronome's sound: its clean ticks' `QUIET` before the onset and first `SOUND`
+    """A metronome's sound: its clean ticks' `QUIET` before the onset and first `MODEL.sound_length`
     after it, band-passed, each aligned to the first by cross-correlation, averaged and
     normalised (None: too few)."""
     if ticks_s.size < MIN_SOUND_TICKS:
         return None
     pick = ticks_s[np.linspace(0, ticks_s.size - 1, min(SOUND_TICKS, ticks_s.size)).astype(int)]
     rate = recording.sample_rate
-    n = round((QUIET + SOUND) * rate)
+    n = round((QUIET + MODEL.sound_length) * rate)
     slack = round(det.RESOLUTION * rate)
     starts = np.round(pick * rate).astype(np.int64) - round(QUIET * rate) - slack
     x = _bands(recording, scan, starts, n + 2 * slack)
@@ -276,11 +267,11 @@ def _match(recording, scan, sound: np.ndarray, centres, half: float):
 
 
 def _chance_level(curve: np.ndarray, near_onset: np.ndarray, width: int) -> float:
-    """The level the curve's maximum over ``width`` hops passes in `FALSE_TICK` of the
+    """The level the curve's maximum over ``width`` hops passes in `MODEL.seek_false_tick` of the
     windows clear of onsets (NaN where there are too few)."""
     maxima = ndimage.maximum_filter1d(curve, size=width, mode="nearest")
     clear = ~ndimage.maximum_filter1d(near_onset.astype(np.uint8), size=width).astype(bool)
     pool = maxima[clear][:: max(1, width)]  # windows side by side, not overlapping
-    if pool.size < 10 / FALSE_TICK:
+    if pool.size < 10 / MODEL.seek_false_tick:
         return float("nan")
-    return float(np.quantile(pool, 1.0 - FALSE_TICK))
+    return float(np.quantile(pool, 1.0 - MODEL.seek_false_tick))

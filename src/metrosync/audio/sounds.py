@@ -12,9 +12,9 @@ metronome's sound is the even mixture of its two kinds. Its log-likelihood ℓ_m
 that mixture's density.
 
 Whose it is. An onset clear of others is another metronome's **by its sound** where
-that one's log-likelihood exceeds this one's by `APART` (a likelihood ratio of 1000): two
-metronomes of different makes differ there by hundreds, two of one make by chance
-alone. Where a metronome has too few clear ticks to learn its sound (fewer than
+that one's log-likelihood exceeds this one's by ln `MODEL.sound_apart` (a likelihood
+ratio of 1000): two metronomes of different makes differ there by hundreds, two of one
+make by chance alone. Where a metronome has too few clear ticks to learn its sound (fewer than
 `MIN_TICKS`), nothing is said by sound about it.
 
 Contract: `learn_sounds(features, heard_ticks, kinds, times)` returns `Sounds`, whose
@@ -29,10 +29,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .settings import MODEL
 from .voices import FEATURE_LEAD, FEATURE_LENGTH, SPREAD_FLOOR
 
-#: Log-likelihood ratio (natural log) above which an onset is another's by its sound.
-APART = math.log(1000.0)
+#: The natural log of `MODEL.sound_apart`, the margin an onset's log-likelihoods need.
+_APART = math.log(MODEL.sound_apart)
 #: Ticks a kind's sound is learned from at least.
 MIN_TICKS = 8
 #: No other onset this near a tick (s) for its sound to be learned from it, or judged:
@@ -58,9 +59,9 @@ class Sounds:
     margin: np.ndarray
 
     def others(self, m: int) -> np.ndarray:
-        """(K,) clear onsets another learned metronome's sound explains `APART` better
-        (a crowded onset's sound is two at once: nothing is said of it)."""
-        return self.clear & (self.margin[m] < -APART)
+        """(K,) clear onsets another learned metronome's sound explains `MODEL.sound_apart`
+        times better (a crowded onset's sound is two at once: nothing is said of it)."""
+        return self.clear & (self.margin[m] < -_APART)
 
     def told_apart(self, m: int, ticks: list[np.ndarray]) -> bool:
         """Whether every other metronome's ticks (``ticks[j]``, indices of onsets) sound,
@@ -72,9 +73,9 @@ class Sounds:
                    if j != m and own.size)  # fmt: skip
 
     def mine(self, m: int) -> np.ndarray:
-        """(K,) clear onsets whose sound is m's, `APART` better than every other learned
-        one."""
-        return self.clear & (self.margin[m] > APART)
+        """(K,) clear onsets whose sound is m's, `MODEL.sound_apart` times better than every
+        other learned one."""
+        return self.clear & (self.margin[m] > _APART)
 
 
 def learn_sounds(x: np.ndarray, ticks: list[np.ndarray], kinds: list[np.ndarray],

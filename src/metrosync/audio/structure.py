@@ -14,10 +14,10 @@ than all along is another metronome's beat sliding past, and is clutter (`_passi
 so is one whose onsets keep to one residue of the beat's number modulo a small m,
 another metronome ticking in a whole-number ratio with this one (`_locked`). Each
 beat's onsets are then paired one-to-one with the impacts (`_assigned`: an impact is
-struck once a beat at most), the strike's timing taken as Student-t (`timing.DOF`).
+struck once a beat at most), the strike's timing taken as Student-t (`MODEL.jitter_dof`).
 
 The tick's time is the time of its most regular impact, the one of smallest spread
-among those heard in at least `MIN_PRESENCE` of the beats: the escapement's impact,
+among those heard in at least `MODEL.heard_share` of the beats: the escapement's impact,
 whose timing is the metronome's; a precursor or a bounce wanders more. The timing
 model is refitted to those impacts alone, and the two steps repeat.
 
@@ -38,24 +38,14 @@ from scipy.stats import t as student_t
 
 from ..errors import AnalysisError
 from .periodicity import SEGMENT
-from .timing import DOF, Timing, fit_timing
+from .settings import MODEL
+from .timing import Timing, fit_timing
 
-#: Share of the beats an impact must be heard in to time the tick.
-MIN_PRESENCE = 0.5
-#: Most impacts a tick is fitted with (more cost more parameters than they explain).
-MAX_IMPACTS = 4
-#: Reach of a tick about its beat, as a share of the beat: onsets farther off are
-#: another beat's, or clutter.
-REACH = 0.45
 #: Refits of the timing on the ticks' main impacts, and of the impacts on the timing.
 ROUNDS = 4
 #: Length of the first stretch the timing is fitted on, s; each next one doubles it, so
 #: that a tempo known to the periodicity search's resolution never loses count of beats.
 FIRST_STRETCH = 10.0
-#: ... and at least this many beats, eight of each kind (enough for a kind's main impact
-#: among clutter); no more, since a slow metronome's spring can change its tempo by a
-#: BPM a minute, which a first timing without drift cannot follow for long.
-FIRST_BEATS = 16
 #: Newton steps from t/T to the beat number the timing model puts nearest an onset (each
 #: squares the error: three take a guess whole beats off to the right beat).
 NEWTON_STEPS = 3
@@ -69,19 +59,10 @@ ONSETS_PER_IMPACT = 5
 #: to a BPM a minute, a millisecond's shift in twenty seconds, as much as the jitter,
 #: and a fit without it extrapolates the first stretch's tempo too far.
 DRIFT_TICKS = 12
-#: Narrowest spread of an impact, s: the onset detector's own timing noise.
-MIN_SPREAD = 0.2e-3
-#: False-alarm probability of the test that takes a component for another metronome's
-#: beat passing (`_passing`): an impact of this tick is taken for one this seldom.
-PASSING_P = 1e-3
 #: Largest m of the m-to-n ratios of beats in which another metronome is sought among a
 #: tick's impacts (`_locked`): the ratios of two tempi in 30-300 BPM that put the
 #: other's ticks near this one's offsets often enough to be learned as an impact.
 LOCKED_MAX = 6
-#: Widest, s: a quieter impact ahead of the strike wanders by several milliseconds tick
-#: to tick (a Neewer's by 11-42 ms, a spread of about 8), but keeps to its tick; the
-#: onsets of a metronome whose beat slides past this one's spread far wider.
-MAX_SPREAD = 15e-3
 
 
 @dataclass(frozen=True)
@@ -110,11 +91,12 @@ class Structure:
 
     def log_density(self, j: int, offset) -> np.ndarray:
         """log of impact j's rate at ``offset`` (s from the beat): presence × its density
-        (1/s); the main impact's timing is Student-t (`timing.DOF`), as the timing model
+        (1/s); the main impact's timing is Student-t (`MODEL.jitter_dof`), as the timing model
         takes it, the others' Gaussian."""
         impact = self.impacts[j]
         z = (np.asarray(offset, dtype=float) - impact.offset) / impact.spread
-        shape = student_t.logpdf(z, DOF) if j == self.main else -0.5 * z * z - _LOG_ROOT_2PI
+        main = j == self.main
+        shape = student_t.logpdf(z, MODEL.jitter_dof) if main else -0.5 * z * z - _LOG_ROOT_2PI
         return math.log(max(impact.presence, 1e-300)) + shape - math.log(impact.spread)
 
 
@@ -125,7 +107,7 @@ class Followed:
     timing : its timing model, fitted to the main impacts, whose offset is 0.
     structure : the impacts of its tick and of its tock (even and odd beats), offsets
         relative to that timing.
-    beat : (K,) for each onset, the beat it lies nearest (−1 beyond `REACH`).
+    beat : (K,) for each onset, the beat it lies nearest (−1 beyond `MODEL.reach`).
     impact : (K,) the impact that most probably explains it, −1 for clutter or beyond.
     main : (K,) True for the onset that times its beat (one a beat at most).
     """
@@ -144,10 +126,10 @@ class Followed:
     def intensity(self, times) -> np.ndarray:
         """(K,) how many of this metronome's onsets the model expects per second at each
         of ``times`` (1/s): Σ_j p_j N(t − τ_k − o_j; 0, s_j²) over the impacts j of the
-        nearest beat's kind, 0 beyond `REACH` of a beat."""
+        nearest beat's kind, 0 beyond `MODEL.reach` of a beat."""
         t = np.asarray(times, dtype=float)
         beat, offset = _nearest_beats(t, self.timing)
-        near = np.abs(offset) <= REACH * self.timing.period
+        near = np.abs(offset) <= MODEL.reach * self.timing.period
         out = np.zeros(t.size)
         for kind, structure in enumerate(self.structure):
             mine = near & (np.mod(beat, 2) == kind)
@@ -162,7 +144,7 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     each offset's impact (−1: clutter).
 
     The main impact is found first, as the sharpest bump of the offsets heard in at
-    least `MIN_PRESENCE` of the beats (`_main_bump`); the mixture starts from it, so
+    least `MODEL.heard_share` of the beats (`_main_bump`); the mixture starts from it, so
     that a few ticks cannot split its jitter, and fits the other impacts around it.
     """
     d = np.asarray(offsets, dtype=float)
@@ -171,7 +153,7 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     span = int(b.max() - b.min()) // 2 + 1 if b.size else 0  # beats of this kind
     centre, width = _main_bump(d, b, span)
     best = None
-    for count in range(1, MAX_IMPACTS + 1):
+    for count in range(1, MODEL.max_impacts + 1):
         if d.size < ONSETS_PER_IMPACT * count:
             break
         fitted = _mixture(d, count, reach, centre, width)
@@ -188,7 +170,8 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     # metronome whose beat slides past this one's (clutter, left for it to be found);
     # nor is one whose onsets come in a few runs of beats, not all along (`_passing`)
     label = np.argmax(resp, axis=1)
-    wide = (spreads > MAX_SPREAD) | _passing(b, label, means.size) | _locked(b, label, means.size)
+    wide = ((spreads > MODEL.impact_spread[1]) | _passing(b, label, means.size)
+            | _locked(b, label, means.size))  # fmt: skip
     if wide.all():
         wide[np.argmin(spreads)] = False
     if wide.any():
@@ -221,7 +204,7 @@ def _passing(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
     beat numbers of its onsets are spread evenly over the recording's beats; a train
     sliding past at another tempo crosses a given offset only now and then, in runs.
     Kolmogorov–Smirnov test of each component's beat numbers against the uniform over
-    the beats, at false-alarm probability `PASSING_P`; the first component (started on
+    the beats, at false-alarm probability `MODEL.false_alarm`; the first component (started on
     the main impact) is not tested."""
     out = np.zeros(count, dtype=bool)
     if beats.size == 0:
@@ -230,7 +213,7 @@ def _passing(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
     for j in range(1, count):
         mine = beats[label == j]
         if mine.size >= ONSETS_PER_IMPACT:
-            out[j] = _uniformity_p(np.clip((mine - lo) / width, 0.0, 1.0)) < PASSING_P
+            out[j] = _uniformity_p(np.clip((mine - lo) / width, 0.0, 1.0)) < MODEL.false_alarm
     return out
 
 
@@ -241,7 +224,7 @@ def _locked(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
     beat's number, but such a neighbour falls near the same offset only every m-th
     beat, in one residue of the beat's number modulo m. A χ² test of each component's
     residues modulo m = 2 … `LOCKED_MAX` against the beats available in each, at
-    false-alarm probability `PASSING_P` over the m tried; the first component (started
+    false-alarm probability `MODEL.false_alarm` over the m tried; the first component (started
     on the main impact) is not tested."""
     out = np.zeros(count, dtype=bool)
     if beats.size == 0:
@@ -257,7 +240,7 @@ def _locked(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
             expected = np.bincount(available % m, minlength=m) * mine.size / available.size
             seen = np.bincount(mine % m, minlength=m)
             statistic = float(np.sum((seen - expected) ** 2 / np.maximum(expected, 1e-12)))
-            if chi2.sf(statistic, m - 1) < PASSING_P / tried:
+            if chi2.sf(statistic, m - 1) < MODEL.false_alarm / tried:
                 out[j] = True
                 break
     return out
@@ -275,12 +258,12 @@ def _uniformity_p(u: np.ndarray) -> float:
 
 
 def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
-    """The main impact: of those heard in `MIN_PRESENCE` of the ``beats``, the most
+    """The main impact: of those heard in `MODEL.heard_share` of the ``beats``, the most
     regular; of impacts as regular as it within their sampling error (a bounce rigidly
     tied to the strike keeps the strike's jitter), the loudest, the strike itself. The
     mixture, started on the bump at ``centre``, has the last word, so that a first
     timing locked on a bounce corrects itself."""
-    heard = np.flatnonzero(presence >= MIN_PRESENCE)
+    heard = np.flatnonzero(presence >= MODEL.heard_share)
     if not heard.size:
         return int(np.argmin(np.abs(means - centre)))
     sharpest = heard[np.argmin(spreads[heard])]
@@ -293,7 +276,7 @@ def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
 
 
 def _main_bump(d: np.ndarray, beats: np.ndarray, span: int) -> tuple[float, float]:
-    """Offset and spread (s) of the most regular impact heard in `MIN_PRESENCE` of the
+    """Offset and spread (s) of the most regular impact heard in `MODEL.heard_share` of the
     beats: of the bumps of the offsets' density (a histogram of `BIN` smoothed over
     `WINDOW`), those that hold an onset in enough beats, the one of smallest robust
     spread."""
@@ -308,10 +291,10 @@ def _main_bump(d: np.ndarray, beats: np.ndarray, span: int) -> tuple[float, floa
     for p in peaks:
         near = np.abs(d - centres[p]) <= WINDOW
         heard = np.unique(beats[near]).size / max(span, 1)
-        if heard < MIN_PRESENCE:
+        if heard < MODEL.heard_share:
             continue
         centre = float(np.median(d[near]))
-        spread = max(1.4826 * float(np.median(np.abs(d[near] - centre))), MIN_SPREAD)
+        spread = max(1.4826 * float(np.median(np.abs(d[near] - centre))), MODEL.impact_spread[0])
         if best is None or spread < best[1]:
             best = (centre, spread)
     if best is None:
@@ -334,7 +317,8 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
     spreads = np.full(count, max(float(np.std(rest)) / count if rest.size else width, width))
     spreads[0] = width
     shares = np.full(count + 1, 1.0 / (count + 1))
-    resp, total = _em(d, means, spreads, shares, 1.0 / (2.0 * reach), iterations)
+    resp, total = _em(d, means, spreads, shares, 1.0 / (2.0 * reach), iterations,
+                      MODEL.impact_spread[0])  # fmt: skip
     loglik = float(np.log(np.maximum(total, 1e-300)).sum())
     parameters = 3 * count  # mean, spread, share each (the clutter's share is the rest)
     bic = -2.0 * loglik + parameters * math.log(d.size)
@@ -342,11 +326,12 @@ def _mixture(d: np.ndarray, count: int, reach: float, centre: float, width: floa
 
 
 @nb.njit(cache=True)
-def _em(d, means, spreads, shares, uniform, iterations):
+def _em(d, means, spreads, shares, uniform, iterations, narrowest):
     """`_mixture`'s EM iterations, in place on ``means``, ``spreads`` and ``shares``
     (the last the uniform clutter's): (responsibilities (K, count+1), each onset's
     total density). Stops early once an iteration moves no parameter by more than
-    `_SETTLED` (then every later one would repeat it)."""
+    `_SETTLED` (then every later one would repeat it); no spread below ``narrowest``
+    (s)."""
     k, count = d.size, means.size
     resp = np.empty((k, count + 1))
     total = np.empty(k)
@@ -385,7 +370,7 @@ def _em(d, means, spreads, shares, uniform, iterations):
             var = 0.0
             for i in range(k):
                 var += resp[i, j] * (d[i] - mean) ** 2
-            spread = max(math.sqrt(var / safe), MIN_SPREAD)
+            spread = max(math.sqrt(var / safe), narrowest)
             moved = max(moved, abs(mean - means[j]), abs(spread - spreads[j]))
             means[j], spreads[j] = mean, spread
         if moved < _SETTLED:
@@ -419,7 +404,7 @@ def follow(times, bpm: float, strengths=None, *, drift: bool = True,
     level = None if strengths is None else np.asarray(strengths, dtype=float)
     if start is None:
         timing = _start(t, 60.0 / float(bpm))
-        end = t[0] + max(FIRST_STRETCH, FIRST_BEATS * timing.period)
+        end = t[0] + max(FIRST_STRETCH, MODEL.min_beats * timing.period)
     else:
         timing, end = start, t[-1]
     first, lost_at = True, -math.inf
@@ -471,19 +456,19 @@ def _found_again(t, level, timing: Timing, mains, beats, end: float, drift: bool
     """(the timing refitted, the stretch's new end) where the ticks were lost before
     ``end``, or None. Another metronome's ticks can hide this one's for seconds (two
     falling into step sound as one), and the timing, carried past them, then misses
-    the ticks where they come out: with `FIRST_BEATS` beats' time of onsets after the
+    the ticks where they come out: with `MODEL.min_beats` beats' time of onsets after the
     last tick, a timing is started afresh on them (`_start`) and its beats numbered by
     the old timing's prediction, where that is sure to the beat (its spread under a
     quarter of one); refitted as `follow` fits (``drift``)."""
     period = float(timing.period_at(beats.max()))
     t_last = float(t[mains].max())
-    if end - t_last < FIRST_BEATS * period:
+    if end - t_last < MODEL.min_beats * period:
         return None
-    after = np.flatnonzero(t > t_last + REACH * period)
-    if after.size < FIRST_BEATS // 2:
+    after = np.flatnonzero(t > t_last + MODEL.reach * period)
+    if after.size < MODEL.min_beats // 2:
         return None
     local = _start(t[after], period)
-    stretch = after[t[after] <= t[after[0]] + max(FIRST_STRETCH, FIRST_BEATS * period)]
+    stretch = after[t[after] <= t[after[0]] + max(FIRST_STRETCH, MODEL.min_beats * period)]
     try:
         explained = _explain(t[stretch], local, None if level is None else level[stretch])
     except AnalysisError:
@@ -527,7 +512,7 @@ def _explain(t: np.ndarray, timing: Timing, level=None):
     """For onsets ``t`` about ``timing``'s beats: (K,) beat (−1 beyond reach), impact
     (−1: none), main (bool), and the (tick, tock) `Structure`s."""
     beat, offset = _nearest_beats(t, timing)
-    reach = REACH * timing.period
+    reach = MODEL.reach * timing.period
     near = np.abs(offset) <= reach
     impact = np.full(t.size, -1)
     main = np.zeros(t.size, dtype=bool)
@@ -549,7 +534,7 @@ def explained_by(times, followed: Followed) -> Followed:
     it times its beat, as `follow` decides them."""
     t = np.asarray(times, dtype=float)
     beat, offset = _nearest_beats(t, followed.timing)
-    reach = REACH * followed.timing.period
+    reach = MODEL.reach * followed.timing.period
     near = np.abs(offset) <= reach
     impact = np.full(t.size, -1)
     main = np.zeros(t.size, dtype=bool)
@@ -574,7 +559,7 @@ def _start(t: np.ndarray, period: float) -> Timing:
     the trials step by 2·`WINDOW`/S of the beat, so that the nearest misses by `WINDOW`
     at most over the stretch.
     """
-    stretch = t[t <= t[0] + max(FIRST_STRETCH, FIRST_BEATS * period)]
+    stretch = t[t <= t[0] + max(FIRST_STRETCH, MODEL.min_beats * period)]
     folded_at_once = min(max(float(t[-1] - t[0]), period), SEGMENT)
     search = period / folded_at_once
     step = 2.0 * WINDOW / max(float(stretch[-1] - stretch[0]), period)
@@ -648,7 +633,7 @@ def _assigned(offset: np.ndarray, beat: np.ndarray, structure: Structure, reach:
     an impact is struck once a beat at most, so within a beat the onsets and impacts are
     paired to maximise Σ log(p_j f_j(d_i) / c) over the pairs (f_j the impact's density,
     c the clutter's), an onset left unpaired being clutter. The main impact's timing is
-    Student-t (`timing.DOF`), as the timing model takes it: an escapement's rare large
+    Student-t (`MODEL.jitter_dof`), as the timing model takes it: an escapement's rare large
     error should not hand a tick to a precursor, nor the precursor of the same beat."""
     clutter = math.log(max(structure.clutter, 1e-3) / (2.0 * reach))
     gain = np.empty((offset.size, len(structure.impacts)))

@@ -12,7 +12,7 @@ with φ the time of beat 0, T the mean beat (s), Ṫ the change of the beat per 
 model is linear in (φ, T, λT/2, Ṫ/2), so it is fitted to the heard ticks by weighted
 least squares; the weights are each tick's probability of being this metronome's
 (an assignment's posterior), and a tick far off its predicted time is down-weighted
-by the Student-t likelihood (iteratively reweighted least squares, `DOF` degrees of
+by the Student-t likelihood (iteratively reweighted least squares, `MODEL.jitter_dof` degrees of
 freedom), so that one mistimed tick cannot bend the model.
 
 This is the pulsar-timing picture (PINT, tempo2): times of arrival, a timing model of
@@ -33,11 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import AnalysisError
+from .settings import MODEL
 from .wander import Wander, smooth_wander
 
-#: Degrees of freedom of the Student-t likelihood of a tick's timing error: few, so that
-#: a tick several jitters off (a hidden tick timed on another's sound) weighs little.
-DOF = 4.0
 #: Passes of iteratively reweighted least squares (the weights settle in a few).
 PASSES = 8
 #: Smoothings of the wander, each followed by a refit of the model to the ticks less it.
@@ -193,7 +191,8 @@ def _reweighted(x, norm, t, w, robust):
         scale = _t_scale(r, w, robust)
         if scale == 0:
             break
-        robust[:] = (DOF + 1.0) / (DOF + (r / scale) ** 2)
+        dof = MODEL.jitter_dof
+        robust[:] = (dof + 1.0) / (dof + (r / scale) ** 2)
     return coef, r, scale
 
 
@@ -217,8 +216,9 @@ def _covariance(x: np.ndarray, w: np.ndarray, r: np.ndarray, scale: float) -> np
     if scale == 0:
         return np.zeros((x.shape[1], x.shape[1]))
     z2 = (r / scale) ** 2
-    psi = r * (DOF + 1.0) / (DOF + z2)
-    slope = np.maximum((DOF + 1.0) * (DOF - z2) / (DOF + z2) ** 2, 0.0)
+    dof = MODEL.jitter_dof
+    psi = r * (dof + 1.0) / (dof + z2)
+    slope = np.maximum((dof + 1.0) * (dof - z2) / (dof + z2) ** 2, 0.0)
     bread = np.linalg.pinv(x.T @ (x * (w * slope)[:, None]))
     meat = x.T @ (x * (w**2 * psi**2)[:, None])
     return bread @ meat @ bread
