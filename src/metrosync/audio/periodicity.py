@@ -31,15 +31,19 @@ minute) and Z on it; `candidate_tempi(...)` the peaks above the threshold, refin
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 from .settings import MODEL
 
 #: Longest stretch of the recording folded coherently, s.
 SEGMENT = 60.0
+#: Frequencies a phasor is stepped over before it is computed afresh.
+_RESEED = 64
 #: Grid points per independent frequency (1/segment), so that no peak falls between.
 OVERSAMPLE = 5
 
@@ -75,18 +79,35 @@ def periodogram(times, weights=None, bpm_range=MODEL.bpm_range, *, segment: floa
         tp, wp = t[mine], w[mine] * taper
         if tp.size < 2:
             continue
-        power = np.zeros(f.size)
-        # in chunks of frequencies: F x K phases at once can be large for long recordings
-        for start in range(0, f.size, 256):
-            fs = f[start : start + 256]
-            phase = np.exp(2j * np.pi * np.outer(fs, tp - tp[0]))
-            power[start : start + 256] = np.abs(phase @ wp) ** 2
-            harmonic = phase
-            for _ in range(2, MODEL.harmonics + 1):  # e^{2πi h f t} = (e^{2πi f t})^h
-                harmonic = harmonic * phase
-                power[start : start + 256] += np.abs(harmonic @ wp) ** 2
+        power = _rayleigh(float(f[0]), 1.0 / (OVERSAMPLE * length), f.size, tp - tp[0], wp,
+                          MODEL.harmonics)  # fmt: skip
         z += power / float(np.sum(wp**2))
     return 60.0 * f, z / pieces
+
+
+@nb.njit(cache=True)
+def _rayleigh(f0: float, df: float, nf: int, t, w, harmonics: int):
+    """(nf,) Σ_h |Σ_k w_k exp(2πi h f t_k)|² over h = 1 … ``harmonics``, at f = f0 + j·df:
+    each onset's phasor stepped from one frequency to the next by one multiplication
+    (set afresh every `_RESEED` steps, so that rounding does not accumulate), and its
+    harmonics as its powers."""
+    sums = np.zeros((nf, harmonics), dtype=np.complex128)
+    for k in range(t.size):
+        step = cmath.exp(2j * math.pi * df * t[k])
+        phasor = 1.0 + 0j
+        for j in range(nf):
+            if j % _RESEED == 0:
+                phasor = cmath.exp(2j * math.pi * (f0 + j * df) * t[k])
+            power = phasor
+            for h in range(harmonics):
+                sums[j, h] += w[k] * power
+                power *= phasor
+            phasor *= step
+    out = np.zeros(nf)
+    for j in range(nf):
+        for h in range(harmonics):
+            out[j] += sums[j, h].real ** 2 + sums[j, h].imag ** 2
+    return out
 
 
 def candidate_tempi(

@@ -112,6 +112,24 @@ class Recording:
         return out
 
 
+    def segments(self, starts: np.ndarray, length: int) -> np.ndarray:
+        """(n, length, channels) float32: frames [s, s + length) for each of ``starts``,
+        zeros outside the file, the file opened once for them all."""
+        out = np.zeros((len(starts), length, self.channels), dtype=np.float32)
+        if self.samples is not None:
+            for i, start in enumerate(starts):
+                out[i] = self.segment(int(start), int(start) + length)
+            return out
+        with _open(self.path) as f:
+            for i, start in enumerate(starts):
+                lo, hi = max(int(start), 0), min(int(start) + length, self.frames)
+                if hi > lo:
+                    f.seek(lo)
+                    data = f.read(hi - lo, dtype="float32", always_2d=True)
+                    out[i, lo - start : lo - start + data.shape[0]] = data
+        return out
+
+
 def _open(path: Path):
     import soundfile as sf
 

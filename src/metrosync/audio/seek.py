@@ -242,7 +242,7 @@ def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:
 def _bands(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
     """(K, length) the band-passed channel mix of frames [start, start + length) for each
     of ``starts``, filtered together (each padded by its own length on both sides)."""
-    x = np.stack([recording.segment(a - length, a + 2 * length).mean(axis=1) for a in starts])
+    x = recording.segments(np.asarray(starts) - length, 3 * length).mean(axis=2)
     return signal.sosfiltfilt(scan.sos, x, axis=1)[:, length : 2 * length]
 
 

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numba as nb
 import numpy as np
-from scipy.stats import chi2, kstwo
-from scipy.stats import t as student_t
+from scipy import special
+from scipy.stats import kstwo
 
 from ..errors import AnalysisError
 from .periodicity import SEGMENT
@@ -96,7 +96,7 @@ class Structure:
         impact = self.impacts[j]
         z = (np.asarray(offset, dtype=float) - impact.offset) / impact.spread
         main = j == self.main
-        shape = student_t.logpdf(z, MODEL.jitter_dof) if main else -0.5 * z * z - _LOG_ROOT_2PI
+        shape = _student_t_logpdf(z, MODEL.jitter_dof) if main else -0.5 * z * z - _LOG_ROOT_2PI
         return math.log(max(impact.presence, 1e-300)) + shape - math.log(impact.spread)
 
 
@@ -240,10 +240,17 @@ def _locked(beats: np.ndarray, label: np.ndarray, count: int) -> np.ndarray:
             expected = np.bincount(available % m, minlength=m) * mine.size / available.size
             seen = np.bincount(mine % m, minlength=m)
             statistic = float(np.sum((seen - expected) ** 2 / np.maximum(expected, 1e-12)))
-            if chi2.sf(statistic, m - 1) < MODEL.false_alarm / tried:
+            if special.chdtrc(m - 1, statistic) < MODEL.false_alarm / tried:  # χ² survival
                 out[j] = True
                 break
     return out
+
+
+def _student_t_logpdf(z, dof: float):
+    """log of Student's t density with ``dof`` degrees of freedom at ``z`` (what
+    `scipy.stats.t.logpdf` returns, without its per-call checks)."""
+    norm = special.gammaln((dof + 1) / 2) - special.gammaln(dof / 2) - 0.5 * math.log(dof * math.pi)
+    return norm - (dof + 1) / 2 * np.log1p(np.square(z) / dof)
 
 
 def _uniformity_p(u: np.ndarray) -> float:

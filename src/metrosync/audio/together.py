@@ -68,6 +68,12 @@ class Together:
         out = [p.segment(start - int(o), stop - int(o)) for p, o in pairs]
         return np.concatenate(out, axis=1)
 
+    def segments(self, starts: np.ndarray, length: int) -> np.ndarray:
+        """(n, length, channels): `segment` at each of ``starts``, each file opened once."""
+        pairs = zip(self.parts, self.offsets, strict=True)
+        out = [p.segments(np.asarray(starts) - int(o), length) for p, o in pairs]
+        return np.concatenate(out, axis=2)
+
     def blocks(self, block_frames: int = BLOCK_FRAMES) -> Iterator[tuple[int, np.ndarray]]:
         for start in range(0, self.frames, block_frames):
             yield start, self.segment(start, min(self.frames, start + block_frames))
