@@ -259,3 +259,20 @@ def test_the_model_s_parameters_are_few_named_documented_and_recorded(tmp_path):
     ds = analyze_audio(clicks.write(tmp_path / "one.wav", clicks.render([train], 20)))
     recorded = json.loads(ds.attrs["timing_model"])
     assert recorded == json.loads(json.dumps(dataclasses.asdict(MODEL)))
+
+
+def test_two_metronomes_each_on_its_own_channel_falling_into_step_are_two(tmp_path, capsys):
+    """`metrosync listen`'s stereo track of two metronomes, one a channel, that lock a
+    third of a beat apart after about 30 s (docs/sound.md's figure): two metronomes.
+    A channel that hears none of a tick hears what else sounds there, the other's ring,
+    louder once they lock; counted down to 30 dB below the loudest channel, that does
+    not make the metronome two sounds (it had: three, one of them split at 29 s)."""
+    from metrosync.cli import main
+
+    path = tmp_path / "two.wav"
+    assert main(["listen", "--n", "2", "--sigma", "0.75", "--seed", "1", "--duration", "120",
+                 "--out", str(path)]) == 0  # fmt: skip
+    capsys.readouterr()
+    ds = analyze_audio(path)
+    assert ds.attrs["metronomes"] == 2 and ds.attrs["attribution"] == "sound"
+    assert np.all(ds.ticks.values > 360)  # each heard all along, 369 beats

@@ -32,7 +32,8 @@ BANDS = 16
 LOW_EDGE = 500.0
 HIGH_EDGE = 16000.0
 LEVEL_WEIGHT = 0.5
-#: Band levels are counted down to this far (dB) below the loudest band.
+#: Band levels, and a microphone's level of an onset, are counted down to this far (dB)
+#: below the loudest band or microphone.
 BAND_RANGE = 30.0
 #: Smallest spread a metronome's sound is credited with, per feature, dB (`sounds`):
 #: identical clicks vary by less, and must not be told apart by their rounding.
@@ -103,6 +104,9 @@ def impact_features(recording: Recording, times: np.ndarray, *, chunk: int = 409
         shape[sl] = mixed - mixed.mean(axis=1, keepdims=True)
         if c > 1:
             total = 10 * np.log10(per_channel.sum(axis=1))
+            # a microphone that hears the onset far below the loudest hears only what
+            # else sounds there: its level is counted down to `BAND_RANGE`, as a band's
+            total = np.maximum(total, total.max(axis=1, keepdims=True) - BAND_RANGE)
             channel[sl] = total - total.mean(axis=1, keepdims=True)
     return Features(shape, level, channel)
 
