@@ -64,6 +64,9 @@ def test_options_reach_the_analysis(capsys, pair_recording):
         # The filter's edges must lie below the Nyquist frequency, not be cut down to it.
         ("silent", ["s.wav", "--band", "1000,30000"], "high < 22050 Hz, the Nyquist frequency"),
         ("silent", ["s.wav", "--band", "1000,22050"], "got (1000.0, 22050.0)"),
+        # the option that chose between the stages and the timing model, gone with them
+        ("silent", ["s.wav", "--analysis", "stages"], "--analysis stages is no longer an"),
+        ("mixed", ["run.log", "--analysis", "timing"], "the timing model is the one sound"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, setup, argv, message):

@@ -102,6 +102,8 @@ def add_audio_options(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--cluster-gap", type=float, default=CLUSTER_GAP, metavar="F",
                    help="ticks closer than this fraction of a beat sound as one")  # fmt: skip
+    # gone with the stages it chose between; refused by name, not as an unknown option
+    g.add_argument("--analysis", default=None, help=argparse.SUPPRESS)
     g.add_argument("--together", action="store_true",
                    help="the recordings were made at the same time by several microphones "
                    "(one file each): align them and tell the metronomes apart by their "
@@ -119,6 +121,11 @@ def audio_requested(args, *, others: str = "light-gate logs") -> bool:
     warns about audio options given with logs (or what ``others`` names instead)."""
     from ..audio.reader import is_audio_path
 
+    if getattr(args, "analysis", None) is not None:
+        raise ParameterError(
+            f"--analysis {args.analysis} is no longer an option: the timing model is the "
+            f"one sound analysis now (docs/sound.md, \"How it works\"); leave it out."
+        )
     audio = [is_audio_path(p) for p in args.logs]
     if any(audio) and not all(audio):
         raise ParameterError(
