@@ -266,17 +266,19 @@ def _uniformity_p(u: np.ndarray) -> float:
 
 def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
     """The main impact: of those heard in `MODEL.heard_share` of the ``beats``, the most
-    regular; of impacts as regular as it within their sampling error (a bounce rigidly
-    tied to the strike keeps the strike's jitter), the loudest, the strike itself. The
+    regular; of impacts whose spreads the sharpest's cannot be told from (a bounce
+    rigidly tied to the strike keeps the strike's jitter), the loudest, the strike
+    itself. Told apart by the F-test of the two variances (their onsets' counts less
+    one as degrees of freedom) at false-alarm probability `MODEL.false_alarm`. The
     mixture, started on the bump at ``centre``, has the last word, so that a first
     timing locked on a bounce corrects itself."""
     heard = np.flatnonzero(presence >= MODEL.heard_share)
     if not heard.size:
         return int(np.argmin(np.abs(means - centre)))
     sharpest = heard[np.argmin(spreads[heard])]
-    # a spread from n onsets is known to about 1/√(2n) of itself
-    onsets = max(float(presence[sharpest]) * beats, 1.0)
-    alike = heard[spreads[heard] <= spreads[sharpest] * (1.0 + 2.0 / math.sqrt(2.0 * onsets))]
+    dof = np.maximum(presence * beats - 1.0, 1.0)
+    ratio = np.square(spreads[heard] / spreads[sharpest])
+    alike = heard[special.fdtrc(dof[heard], dof[sharpest], ratio) >= MODEL.false_alarm]
     if alike.size > 1 and np.all(np.isfinite(levels[alike])):
         return int(alike[np.argmax(levels[alike])])
     return int(sharpest)
