@@ -42,8 +42,11 @@ class TimingModel:
     min_beats: int = field(default=16, metadata={
         "unit": "beats", "meaning": "fewest beats a metronome spans, and the first "
         "stretch it is followed on (eight of each kind)"})
-    max_impacts: int = field(default=4, metadata={
-        "unit": "", "meaning": "most impacts a tick or a tock is learned with"})
+    strike_spread: float = field(default=2.5, metadata={
+        "unit": "ratio", "meaning": "an impact whose timing spreads more than this many "
+        "times the most regular one's is not the strike (a precursor's lead wanders by "
+        "milliseconds); of those within it (the strike and the bounces it makes, which "
+        "keep its jitter), the loudest is the strike"})
     impact_spread: tuple[float, float] = field(default=(0.2e-3, 15e-3), metadata={
         "unit": "s", "meaning": "narrowest spread of an impact about its tick (the onset "
         "detector's timing noise) and widest (a precursor's wandering lead keeps to its "

@@ -18,7 +18,9 @@ struck once a beat at most), the strike's timing taken as Student-t (`MODEL.jitt
 
 The tick's time is the time of its most regular impact, the one of smallest spread
 among those heard in at least `MODEL.heard_share` of the beats: the escapement's impact,
-whose timing is the metronome's; a precursor or a bounce wanders more. The timing
+whose timing is the metronome's; a precursor wanders more. A bounce is struck by the
+strike and keeps its jitter: of impacts within `MODEL.strike_spread` of the most regular
+one's spread, the loudest is the strike. The timing
 model is refitted to those impacts alone, and the two steps repeat.
 
 Contract: `follow(times, bpm)` finds, from a candidate tempo, the metronome whose ticks
@@ -41,6 +43,9 @@ from .periodicity import SEGMENT
 from .settings import MODEL
 from .timing import Timing, fit_timing
 
+#: Most impacts a tick or a tock is learned with: a bound on the search, not an
+#: assumption of the model (BIC chooses how many).
+MAX_IMPACTS = 4
 #: Refits of the timing on the ticks' main impacts, and of the impacts on the timing.
 ROUNDS = 4
 #: Length of the first stretch the timing is fitted on, s; each next one doubles it, so
@@ -153,7 +158,7 @@ def learn_structure(offsets, beats, reach: float, strengths=None) -> tuple[Struc
     span = int(b.max() - b.min()) // 2 + 1 if b.size else 0  # beats of this kind
     centre, width = _main_bump(d, b, span)
     best = None
-    for count in range(1, MODEL.max_impacts + 1):
+    for count in range(1, MAX_IMPACTS + 1):
         if d.size < ONSETS_PER_IMPACT * count:
             break
         fitted = _mixture(d, count, reach, centre, width)
@@ -265,20 +270,18 @@ def _uniformity_p(u: np.ndarray) -> float:
 
 
 def _main(means, spreads, presence, beats: int, levels, centre: float) -> int:
-    """The main impact: of those heard in `MODEL.heard_share` of the ``beats``, the most
-    regular; of impacts whose spreads the sharpest's cannot be told from (a bounce
-    rigidly tied to the strike keeps the strike's jitter), the loudest, the strike
-    itself. Told apart by the F-test of the two variances (their onsets' counts less
-    one as degrees of freedom) at false-alarm probability `MODEL.false_alarm`. The
-    mixture, started on the bump at ``centre``, has the last word, so that a first
-    timing locked on a bounce corrects itself."""
+    """The main impact, the strike: of those heard in `MODEL.heard_share` of the
+    ``beats``, the loudest of those whose spread is within `MODEL.strike_spread` times
+    the most regular one's. A bounce is struck by the strike and keeps its jitter, so
+    which of them is the more regular is down to how well each onset is timed; a
+    precursor's lead wanders, several times more. The mixture, started on the bump at
+    ``centre``, has the last word, so that a first timing locked on a bounce corrects
+    itself."""
     heard = np.flatnonzero(presence >= MODEL.heard_share)
     if not heard.size:
         return int(np.argmin(np.abs(means - centre)))
     sharpest = heard[np.argmin(spreads[heard])]
-    dof = np.maximum(presence * beats - 1.0, 1.0)
-    ratio = np.square(spreads[heard] / spreads[sharpest])
-    alike = heard[special.fdtrc(dof[heard], dof[sharpest], ratio) >= MODEL.false_alarm]
+    alike = heard[spreads[heard] <= MODEL.strike_spread * spreads[sharpest]]
     if alike.size > 1 and np.all(np.isfinite(levels[alike])):
         return int(alike[np.argmax(levels[alike])])
     return int(sharpest)
