@@ -12,7 +12,7 @@ import soundfile as sf
 
 from metrosync import synthetic
 from metrosync.audio import detection as det
-from metrosync.audio import seek
+from metrosync.audio import seek, waveform
 from metrosync.audio.analysis import analyze_audio
 from metrosync.audio.reader import open_recording
 from metrosync.synthetic import voices
@@ -41,7 +41,7 @@ def test_a_tick_in_another_s_ring_is_timed_by_its_sound(tmp_path):
     clean_times = 0.2 + 0.3 * np.arange(12)
     clean = _file(tmp_path, "clean.wav", [(t, tick) for t in clean_times])
     scan = det.scan(clean)
-    sound = seek._sound(clean, scan, clean_times)
+    sound = waveform.learn(clean, scan, clean_times)
     assert sound is not None and np.linalg.norm(sound) == pytest.approx(1.0)
     # the tick 12 ms into the loud one's ring, and a window in the ring alone
     t0 = 1.0123
@@ -53,9 +53,9 @@ def test_a_tick_in_another_s_ring_is_timed_by_its_sound(tmp_path):
 
 def test_too_few_clean_ticks_learn_no_sound(tmp_path):
     quiet = voices(1, 4)[0]
-    times = 0.2 + 0.3 * np.arange(seek.MIN_SOUND_TICKS - 1)
+    times = 0.2 + 0.3 * np.arange(waveform.MIN_SOUND_TICKS - 1)
     rec = _file(tmp_path, "few.wav", [(t, quiet.waveform(RATE)) for t in times])
-    assert seek._sound(rec, det.scan(rec), times) is None
+    assert waveform.learn(rec, det.scan(rec), times) is None
 
 
 def _quiet_among_loud(tmp_path, seed):

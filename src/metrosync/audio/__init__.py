@@ -8,7 +8,8 @@ metronome's timing model: phase, period, limp, drift, jitter), `wander` (its bea
 smooth wander), `structure` (a tick's impacts learned from the recording, and a
 metronome followed), `sounds` (each metronome's sound, and whose an onset is by it),
 `decompose` (the onsets explained as metronomes and clutter), `seek` (beats no onset
-was detected at, sought where the timing puts them), `together` (several microphones
+was detected at, sought where the timing puts them), `waveform` (each metronome's
+learned waveform, and its ticks timed against it), `together` (several microphones
 aligned), `metronome` (one metronome's tempo, jitter and beat), `order` (the acoustic
 order parameter and clusters), `attribution` (the phase of one metronome in another's
 beat), `tempo` (the beat period of ticks nobody told apart), `dataset` (the dataset's

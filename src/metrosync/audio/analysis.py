@@ -9,7 +9,8 @@ candidate tempi by epoch folding (`periodicity`), each metronome a timing model
 before and after the loudest (`structure`), with its sound (`sounds`); an impact heard
 from elsewhere is another metronome's. The beats no onset was detected at are sought
 where each metronome's timing puts them (`seek`), and each onset goes to the metronome
-likeliest to have made it. Then it measures: each metronome's tempo, jitter and beat
+likeliest to have made it; every tick is then timed against its metronome's learned
+waveform (`waveform`). Then it measures: each metronome's tempo, jitter and beat
 (`metronome`); its phases, r and frequency as the light gate's
 (`observables.crossings`); the phase of each in metronome 0's beat (`attribution`);
 and the acoustic order parameter and clusters of the ensemble, which need no
@@ -69,6 +70,7 @@ from .structure import Structure
 from .summary import summary_text
 from .tempo import HINT_RANGE, MIN_TICKS, beat_period
 from .voices import impact_features
+from .waveform import retimed
 
 
 def analyze_audio(
@@ -135,6 +137,8 @@ def analyze_audio(
         impacts = joined.taken(in_time)
         owner = np.concatenate([owner, whose])[in_time]
         heard, owner = one_tick_an_onset(impacts.time, heard, owner)
+        # each tick timed against its metronome's learned waveform, as a pulse is
+        impacts = replace(impacts, time=retimed(recording, scan, impacts, heard))
     # The ticks: each metronome's main impacts; a tick's other impacts are not ticks, nor
     # is clutter (a bump, a voice). With no metronome found, every onset is a tick.
     is_tick = np.full(owner.size, not heard)

@@ -12,37 +12,32 @@ chance, in a share `MODEL.seek_false_tick` of windows, read off the recording's 
 from its onsets; the largest rise in the window above it is the tick.
 
 Where the curve's rise is not enough (a tick in another's ring rises little over what
-rings there already), the beat is sought by the metronome's own sound, as pulsar
-timing times a pulse by a template learned from the data: the metronome's sound is
-the mean of its clean ticks' first `MODEL.sound_length` seconds (band-passed, aligned by their
-cross-correlation), and the statistic is the largest normalised cross-correlation of
-that sound with the recording over the beat's window. Its chance level is read where
-the confusion lies: the same statistic at windows in the rings of the onsets that are
-not this metronome's ticks; the threshold is passed by chance in `MODEL.seek_false_tick` of them.
+rings there already), the beat is sought by the metronome's own sound, as pulsar timing
+times a pulse by a template learned from the data: the metronome's sound is its learned
+waveform (`waveform.learn`), and the statistic is the largest normalised
+cross-correlation of that sound with the recording over the beat's window. Its chance level is
+read where the confusion lies: the same statistic at windows in the rings of the onsets
+that are not this metronome's ticks; the threshold is passed by chance in
+`MODEL.seek_false_tick` of them.
 
 Contract: `seek(recording, scan, impacts, heard)` returns the `detection.Ticks` found
-(timed by `detection.refine`) and (L,) the metronome of each.
+(timed by `detection.refine`, or by the best match of the sound) and (L,) the metronome
+of each; the analysis then times every tick against its waveform (`waveform.retimed`).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage, signal
+from scipy import ndimage
 
 from . import detection as det
 from .decompose import Heard
 from .settings import MODEL
+from .waveform import QUIET, bands, is_clean, learn
 
 #: Onsets this close (s) are kept out of the curve's chance level, and a window near one
 #: is left to the sound: the onset hides the beat from the curve.
 CLEAR = det.RESOLUTION
-#: ... and the quiet before its onset that is part of it, s: where the sound of a
-#: clean tick is silence, so that a match slid late (its onset over the tick's loud
-#: start, in another's ring) pays for the energy it puts there.
-QUIET = 1e-3
-#: Most of a metronome's clean ticks (no other onset from `MODEL.ring` before to
-#: `MODEL.sound_length` after) averaged into its sound, and fewest to learn it from.
-SOUND_TICKS, MIN_SOUND_TICKS = 48, 8
 #: Windows in others' rings the sound's chance level is read from: four of them pass
 #: it by chance.
 CHANCE_WINDOWS = round(4 / MODEL.seek_false_tick)
@@ -125,13 +120,13 @@ def _by_sound(recording, scan, impacts: det.Ticks, heard: list[Heard], unfound):
         if not mine:
             continue
         others = np.setdiff1d(np.arange(impacts.time.size), h.ticks)
-        clean = _clean(impacts.time, h.ticks, others)
+        clean = h.ticks[is_clean(impacts.time, h.ticks, others)]
         half = mine[0][3]
         null = _ring_windows(impacts.time, others, h, half, rng)
         for kind in (0, 1):
             beats = [u for u in mine if u[1] == kind]
             ticks = clean[np.mod(h.followed.beat[np.searchsorted(h.pool, clean)], 2) == kind]
-            sound = _sound(recording, scan, impacts.time[ticks])
+            sound = learn(recording, scan, impacts.time[ticks])
             if not beats or sound is None or null.size < CHANCE_WINDOWS:
                 continue
             chance = _match(recording, scan, sound, null, half)[0]
@@ -175,20 +170,6 @@ def _off_their_beat(t: np.ndarray, h: Heard, main_offset: np.ndarray, half: floa
     return np.abs(t[h.ticks] - predicted) > half
 
 
-def _clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
-    """Of ``ticks``, those no other onset precedes within `MODEL.ring` nor follows within
-    `MODEL.sound_length`: the metronome's sound alone."""
-    other = np.sort(t[others])
-    if not other.size:
-        return ticks
-    j = np.searchsorted(other, t[ticks])
-    before = t[ticks] - other[np.maximum(j - 1, 0)]
-    after = other[np.minimum(j, other.size - 1)] - t[ticks]
-    before[j == 0] = np.inf
-    after[j == other.size] = np.inf
-    return ticks[(before > MODEL.ring) & (after > MODEL.sound_length)]
-
-
 def _ring_windows(t, others, h: Heard, half: float, rng) -> np.ndarray:
     """Centres of windows in the rings of the onsets ``others`` (from `half` to `MODEL.ring`
     after one), clear of every onset and of this metronome's beats; where those are too
@@ -217,35 +198,6 @@ def _gap_to_onsets(t: np.ndarray, centre: np.ndarray) -> np.ndarray:
                       np.abs(t[np.maximum(j - 1, 0)] - centre))  # fmt: skip
 
 
-def _sound(recording, scan, ticks_s: np.ndarray) -> np.ndarray | None:
-    """A metronome's sound: its clean ticks' `QUIET` before the onset and first `MODEL.sound_length`
-    after it, band-passed, each aligned to the first by cross-correlation, averaged and
-    normalised (None: too few)."""
-    if ticks_s.size < MIN_SOUND_TICKS:
-        return None
-    pick = ticks_s[np.linspace(0, ticks_s.size - 1, min(SOUND_TICKS, ticks_s.size)).astype(int)]
-    rate = recording.sample_rate
-    n = round((QUIET + MODEL.sound_length) * rate)
-    slack = round(det.RESOLUTION * rate)
-    starts = np.round(pick * rate).astype(np.int64) - round(QUIET * rate) - slack
-    x = _bands(recording, scan, starts, n + 2 * slack)
-    reference = x[0, slack : slack + n]
-    total = reference.copy()
-    for row in x[1:]:
-        lag = int(np.argmax(np.correlate(row, reference, mode="valid")))
-        total += row[lag : lag + n]
-    total -= total.mean()
-    norm = np.linalg.norm(total)
-    return total / norm if norm > 0 else None
-
-
-def _bands(recording, scan, starts: np.ndarray, length: int) -> np.ndarray:
-    """(K, length) the band-passed channel mix of frames [start, start + length) for each
-    of ``starts``, filtered together (each padded by its own length on both sides)."""
-    x = recording.segments(np.asarray(starts) - length, 3 * length).mean(axis=2)
-    return signal.sosfiltfilt(scan.sos, x, axis=1)[:, length : 2 * length]
-
-
 def _match(recording, scan, sound: np.ndarray, centres, half: float):
     """(the largest normalised cross-correlation of ``sound`` with the recording over
     each window centre ± half (s), and the time (s) where it is)."""
@@ -254,7 +206,7 @@ def _match(recording, scan, sound: np.ndarray, centres, half: float):
     starts = np.round(np.asarray(centres, dtype=float) * rate).astype(np.int64) - w - quiet
     if not starts.size:
         return np.zeros(0), np.zeros(0)
-    x = _bands(recording, scan, starts, 2 * w + n)
+    x = bands(recording, scan, starts, 2 * w + n)
     dot = np.lib.stride_tricks.sliding_window_view(x, n, axis=1) @ sound
     s1 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x, axis=1)], axis=1)
     s2 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x * x, axis=1)], axis=1)
