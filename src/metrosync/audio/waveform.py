@@ -43,6 +43,8 @@ QUIET = 1e-3
 SOUND_TICKS, MIN_SOUND_TICKS = 48, 8
 #: A tick is sought this far either side of its detected onset, s.
 REACH = det.RESOLUTION
+#: Onsets timed at once.
+BLOCK = 256
 
 
 def is_clean(t: np.ndarray, ticks: np.ndarray, others: np.ndarray) -> np.ndarray:
@@ -100,25 +102,37 @@ def matched(recording, scan, waveform: np.ndarray, lower: np.ndarray, upper: np.
     With ``expected`` and ``spread`` (K,) s, the time is the posterior's mode: the
     likelihood of the shift, (⟨x, s⟩² / 2σ²) with σ² the residual's variance per sample
     at the best fit, times a Gaussian prior about ``expected`` of that spread."""
-    rate = recording.sample_rate
     if not np.size(lower):
         return np.zeros(0)
+    # in blocks of onsets, so that memory stays that of a few hundred windows
+    parts = []
+    for first in range(0, np.size(lower), BLOCK):
+        block = slice(first, first + BLOCK)
+        prior = None if expected is None or spread is None else (expected[block], spread[block])
+        parts.append(_matched(recording, scan, waveform, lower[block], upper[block], prior))
+    return np.concatenate(parts)
+
+
+def _matched(recording, scan, waveform, lower, upper, prior) -> np.ndarray:
+    """`matched` for one block of windows; ``prior`` (expected, spread) or None."""
+    rate = recording.sample_rate
     n, quiet = waveform.size, round(QUIET * rate)
     lo = np.floor(lower * rate).astype(np.int64)
     width = int(np.max(np.ceil(upper * rate).astype(np.int64) - lo)) + 1
     x = bands(recording, scan, lo - quiet, width + n - 1)
-    windows = np.lib.stride_tricks.sliding_window_view(x, n, axis=1)
-    dot = windows @ waveform
+    dot = signal.fftconvolve(x, waveform[None, ::-1], mode="valid", axes=1)
     at = (lo[:, None] + np.arange(width)[None, :]) / rate
     inside = (at >= lower[:, None]) & (at <= upper[:, None])
     score = np.where(inside & (dot > 0), dot, -np.inf)
     rows = np.arange(lo.size)
-    if expected is not None and spread is not None:
+    if prior is not None:
+        expected, spread = prior
         top = np.argmax(score, axis=1)
-        energy = np.einsum("kn,kn->k", windows[rows, top], windows[rows, top])
+        squares = np.concatenate([np.zeros((lo.size, 1)), np.cumsum(x * x, axis=1)], axis=1)
+        energy = squares[rows, top + n] - squares[rows, top]
         noise = np.maximum(energy - dot[rows, top] ** 2, 1e-30) / (n - 1)
-        prior = (at - expected[:, None]) ** 2 / (2 * spread[:, None] ** 2)
-        score = np.where(np.isfinite(score), dot**2 / (2 * noise[:, None]) - prior, -np.inf)
+        away = (at - expected[:, None]) ** 2 / (2 * spread[:, None] ** 2)
+        score = np.where(np.isfinite(score), dot**2 / (2 * noise[:, None]) - away, -np.inf)
     best = np.argmax(score, axis=1)
     i = np.clip(best, 1, width - 2)
     y0, y1, y2 = score[rows, i - 1], score[rows, i], score[rows, i + 1]
@@ -155,7 +169,8 @@ def retimed(recording, scan, impacts: det.Ticks, heard) -> np.ndarray:
             lower = np.maximum(t[own] - REACH, previous[own] + gap)
             upper = np.minimum(t[own] + REACH, following[own] - gap)
             # the waveform's zero, from the clean ticks, which need no prior
-            offsets = (t[own] - matched(recording, scan, waveform, lower, upper))[own_clean]
+            offsets = t[own[own_clean]] - matched(recording, scan, waveform, lower[own_clean],
+                                                  upper[own_clean])  # fmt: skip
             offsets = offsets[np.isfinite(offsets)]
             if offsets.size < MIN_SOUND_TICKS:
                 continue
