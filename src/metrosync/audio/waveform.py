@@ -21,10 +21,10 @@ the onset is kept. The waveform's own zero is the median of its clean ticks' det
 onsets less their matched times, so that a clean tick keeps its detected time on
 average.
 
-Contract: `learn(recording, scan, times)` returns the waveform of ticks at ``times``
-(or None: too few); `matched(recording, scan, waveform, times, lower, upper)` the times
-that best fit it; `retimed(recording, scan, impacts, heard)` every metronome's ticks so
-timed.
+Contract: `learn(recording, scan, times)` returns the waveform of ticks at ``times`` (or
+None: too few); `matched(recording, scan, waveform, lower, upper)` the time in each
+window that best fits it (with the timing model's prior where given);
+`retimed(recording, scan, impacts, heard)` every metronome's ticks so timed.
 """
 
 from __future__ import annotations
@@ -154,6 +154,7 @@ def retimed(recording, scan, impacts: det.Ticks, heard) -> np.ndarray:
     # never past a neighbouring onset: one onset is one impact
     previous = np.concatenate([[-np.inf], t[:-1]])
     following = np.concatenate([t[1:], [np.inf]])
+    sample = 1.0 / recording.sample_rate
     for h in heard:
         others = np.setdiff1d(np.arange(t.size), h.ticks)
         clean = is_clean(t, h.ticks, others)
@@ -165,9 +166,8 @@ def retimed(recording, scan, impacts: det.Ticks, heard) -> np.ndarray:
             waveform = learn(recording, scan, t[own[own_clean]])
             if waveform is None:
                 continue
-            gap = 1.0 / recording.sample_rate
-            lower = np.maximum(t[own] - REACH, previous[own] + gap)
-            upper = np.minimum(t[own] + REACH, following[own] - gap)
+            lower = np.maximum(t[own] - REACH, previous[own] + sample)
+            upper = np.minimum(t[own] + REACH, following[own] - sample)
             # the waveform's zero, from the clean ticks, which need no prior
             offsets = t[own[own_clean]] - matched(recording, scan, waveform, lower[own_clean],
                                                   upper[own_clean])  # fmt: skip
@@ -177,7 +177,7 @@ def retimed(recording, scan, impacts: det.Ticks, heard) -> np.ndarray:
             zero = float(np.median(offsets))
             main = h.followed.structure[kind].main_impact.offset
             expected = timing.predict(h.beats[of_kind]) + main - zero
-            spread = np.full(own.size, max(timing.jitter, 1.0 / recording.sample_rate))
+            spread = np.full(own.size, max(timing.jitter, sample))
             fit = matched(recording, scan, waveform, lower - zero, upper - zero, expected,
                           spread) + zero  # fmt: skip
             ok = np.isfinite(fit)
