@@ -28,7 +28,7 @@ of each; the analysis then times every tick against its waveform (`waveform.reti
 from __future__ import annotations
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, signal
 
 from . import detection as det
 from .decompose import Heard
@@ -207,7 +207,7 @@ def _match(recording, scan, sound: np.ndarray, centres, half: float):
     if not starts.size:
         return np.zeros(0), np.zeros(0)
     x = bands(recording, scan, starts, 2 * w + n)
-    dot = np.lib.stride_tricks.sliding_window_view(x, n, axis=1) @ sound
+    dot = signal.fftconvolve(x, sound[None, ::-1], mode="valid", axes=1)
     s1 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x, axis=1)], axis=1)
     s2 = np.concatenate([np.zeros((x.shape[0], 1)), np.cumsum(x * x, axis=1)], axis=1)
     sums, squares = s1[:, n:] - s1[:, :-n], s2[:, n:] - s2[:, :-n]
